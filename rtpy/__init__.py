@@ -1,0 +1,92 @@
+"""rtpy: a ray tracer in Python for teaching.
+
+    import rtpy
+    scene = rtpy.load_scene("cornell")        # a path or a bundled scene's name
+    image = rtpy.render(scene, spp=16, width=200)
+    image.save("cornell.png")                 # image.linear is the float array
+
+The modules follow the course's structure: vec3 / interval / ray / hit_info /
+scatter_info (utilities), camera, sphere / quad / triangle / scene (hittables),
+materials, light, texture, integrators, renderer.
+"""
+
+from __future__ import annotations
+
+from .camera import Camera
+from .hit_info import HitInfo
+from .image import RenderedImage
+from .interval import Interval
+from .light import PointLight
+from .materials import (
+    Dielectric,
+    DiffuseLight,
+    Lambertian,
+    Material,
+    Metal,
+    Mirror,
+    register_material,
+)
+from .quad import Quad
+from .ray import Ray
+from .render_settings import RenderSettings
+from .renderer import Renderer
+from .scatter_info import ScatterInfo
+from .scene import Scene
+from .sphere import Sphere
+from .texture import CheckerTexture, ImageTexture, SolidColor, Texture
+from .triangle import Triangle
+from .vec3 import Color, Point3, Vec3
+
+__version__ = "0.1.0"
+
+
+def load_scene(path_or_name: str):
+    """Load a scene file (TOML, see the README) or a bundled scene by name."""
+    from .bundled import resolve_scene
+    from .scene_file import load_scene as _load
+
+    return _load(resolve_scene(str(path_or_name)))
+
+
+def render(
+    scene: Scene,
+    *,
+    camera: Camera | None = None,
+    width: int | None = None,
+    workers: int = 1,
+    quiet: bool = True,
+    background: Color | None = None,
+    sky: bool | None = None,
+    **settings,
+) -> RenderedImage:
+    """Render `scene` and return the image (linear array + PIL image).
+
+    Keyword overrides: any [render] setting (integrator, spp, max_depth, nee,
+    russian_roulette, seed, gamma), background, sky, the camera width, or a
+    whole `camera`. workers = number of processes; quiet = no progress bar.
+    """
+    base = scene.settings or RenderSettings()
+    render_settings = base.with_overrides(**settings)
+    camera = camera or scene.camera
+    if camera is None:
+        raise ValueError("the scene has no camera: pass camera=rtpy.Camera(...)")
+    if width is not None:
+        camera = camera.with_width(width)
+    if background is not None or sky is not None:
+        import copy
+
+        scene = copy.copy(scene)
+        if background is not None:
+            scene.background = background
+        if sky is not None:
+            scene.sky = sky
+    return Renderer(scene, camera, render_settings, workers=workers, quiet=quiet).render()
+
+
+__all__ = [
+    "Camera", "CheckerTexture", "Color", "Dielectric", "DiffuseLight", "HitInfo",
+    "ImageTexture", "Interval", "Lambertian", "Material", "Metal", "Mirror", "Point3",
+    "PointLight", "Quad", "Ray", "RenderSettings", "RenderedImage", "Renderer", "ScatterInfo",
+    "Scene", "SolidColor", "Sphere", "Texture", "Triangle", "Vec3", "load_scene",
+    "register_material", "render",
+]

@@ -1,0 +1,121 @@
+"""Camera: a pinhole or thin-lens camera that makes one ray per pixel sample.
+
+Image coordinates: pixel (i, j) is column i (left to right) and row j (top to
+bottom); pixel (0, 0) is the top-left. World: right-handed, y up. Angles are
+degrees. Rays leave the camera with unit directions.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .ray import Ray
+from .sampling import generator, random_in_unit_disk
+from .vec3 import Vec3, cross, unit_vector
+
+
+def parse_aspect_ratio(value: float | str) -> float:
+    """16/9 from 1.777..., "16:9" or "16/9"."""
+    if isinstance(value, str):
+        for sep in (":", "/"):
+            if sep in value:
+                a, b = value.split(sep, 1)
+                return float(a) / float(b)
+        return float(value)
+    return float(value)
+
+
+class Camera:
+    """Thin-lens camera (RTIOW's model).
+
+    look_from, look_at, vup  eye, target and up hint (world units)
+    vfov                     vertical field of view in degrees
+    aspect_ratio             width / height (number or "16:9")
+    width                    image width in pixels; height = max(1, int(width / aspect_ratio))
+    defocus_angle            cone angle (degrees) of rays through a pixel; 0 = pinhole
+    focus_distance           distance from look_from to the plane in perfect focus
+    """
+
+    def __init__(
+        self,
+        look_from: Vec3 = Vec3(0.0, 0.0, 0.0),
+        look_at: Vec3 = Vec3(0.0, 0.0, -1.0),
+        vup: Vec3 = Vec3(0.0, 1.0, 0.0),
+        vfov: float = 90.0,
+        aspect_ratio: float | str = 16.0 / 9.0,
+        width: int = 400,
+        defocus_angle: float = 0.0,
+        focus_distance: float = 10.0,
+    ) -> None:
+        self.look_from, self.look_at, self.vup = look_from, look_at, vup
+        self.vfov = float(vfov)
+        self.aspect_ratio = parse_aspect_ratio(aspect_ratio)
+        self.width = int(width)
+        self.defocus_angle = float(defocus_angle)
+        self.focus_distance = float(focus_distance)
+        if not 0.0 < self.vfov < 180.0:
+            raise ValueError(f"vfov must be between 0 and 180 degrees, got {vfov}")
+        if not self.aspect_ratio > 0.0 or not math.isfinite(self.aspect_ratio):
+            raise ValueError(f"aspect_ratio must be > 0, got {aspect_ratio}")
+        if self.width < 1:
+            raise ValueError(f"width must be >= 1, got {width}")
+        if not self.focus_distance > 0.0:
+            raise ValueError(f"focus_distance must be > 0, got {focus_distance}")
+        if not 0.0 <= self.defocus_angle < 180.0:
+            raise ValueError(f"defocus_angle must be in [0, 180), got {defocus_angle}")
+        self.height = max(1, int(self.width / self.aspect_ratio))
+
+        view = look_from - look_at
+        if view.near_zero(0.0):
+            raise ValueError("look_from and look_at are the same point")
+        self.w = unit_vector(view)  # points backward, away from the scene
+        side = cross(vup, self.w)
+        if side.length() < 1e-9 * vup.length():
+            raise ValueError("vup is parallel to the view direction")
+        self.u = unit_vector(side)  # camera right
+        self.v = cross(self.w, self.u)  # camera up
+
+        # The viewport lies on the focus plane; its width follows the rounded
+        # pixel count, not the nominal aspect ratio (as in RTIOW).
+        h = math.tan(math.radians(self.vfov) / 2.0)
+        viewport_height = 2.0 * h * self.focus_distance
+        viewport_width = viewport_height * self.width / self.height
+        viewport_u = self.u * viewport_width  # left edge -> right edge
+        viewport_v = self.v * -viewport_height  # top edge -> bottom edge
+        self.pixel_delta_u = viewport_u / self.width
+        self.pixel_delta_v = viewport_v / self.height
+        upper_left = look_from - self.w * self.focus_distance - viewport_u / 2.0 - viewport_v / 2.0
+        self.pixel00 = upper_left + (self.pixel_delta_u + self.pixel_delta_v) * 0.5
+        radius = self.focus_distance * math.tan(math.radians(self.defocus_angle / 2.0))
+        self.defocus_disk_u = self.u * radius
+        self.defocus_disk_v = self.v * radius
+
+    def with_width(self, width: int) -> Camera:
+        """The same camera with another image width (height follows the aspect ratio)."""
+        return Camera(
+            self.look_from, self.look_at, self.vup, self.vfov, self.aspect_ratio, width,
+            self.defocus_angle, self.focus_distance,
+        )
+
+    def _ray_through(self, px: float, py: float) -> Ray:
+        """Ray through the viewport at fractional pixel position (px, py)."""
+        p00, du, dv = self.pixel00, self.pixel_delta_u, self.pixel_delta_v
+        tx = p00.e0 + px * du.e0 + py * dv.e0
+        ty = p00.e1 + px * du.e1 + py * dv.e1
+        tz = p00.e2 + px * du.e2 + py * dv.e2
+        origin = self.look_from
+        if self.defocus_angle > 0.0:
+            d = random_in_unit_disk()
+            origin = origin + self.defocus_disk_u * d.e0 + self.defocus_disk_v * d.e1
+        dx, dy, dz = tx - origin.e0, ty - origin.e1, tz - origin.e2
+        k = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+        return Ray(origin, Vec3(dx * k, dy * k, dz * k))
+
+    def get_center_ray(self, i: int, j: int) -> Ray:
+        """The ray through the center of pixel (i, j)."""
+        return self._ray_through(float(i), float(j))
+
+    def get_ray(self, i: int, j: int) -> Ray:
+        """A ray through a uniformly random point of pixel (i, j) (a box filter)."""
+        r = generator().random
+        return self._ray_through(i + r() - 0.5, j + r() - 0.5)

@@ -1,0 +1,72 @@
+"""HitInfo: what a ray learns where it hits a surface."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from .vec3 import Vec3
+
+if TYPE_CHECKING:
+    from .hittable import Hittable
+    from .materials.material import Material
+
+
+class HitInfo:
+    """The closest hit of a ray.
+
+    point       world position of the hit
+    normal      unit normal on the side the ray came from (dot(normal, ray.direction) <= 0)
+    t           ray parameter of the hit
+    front_face  True when the ray hit the side the geometric normal points to
+                (the outside of a sphere, the u x v side of a quad)
+    material    the object's material
+    u, v        surface coordinates in [0, 1]; computed on first access, because only
+                textures that need them should pay for them
+    obj         the object that was hit
+    """
+
+    __slots__ = ("point", "normal", "t", "front_face", "material", "obj", "_u", "_v")
+
+    def __init__(
+        self,
+        point: Vec3,
+        normal: Vec3,
+        t: float,
+        front_face: bool,
+        material: Material,
+        obj: Hittable | None = None,
+        u: float | None = None,
+        v: float | None = None,
+    ) -> None:
+        self.point = point
+        self.normal = normal
+        self.t = t
+        self.front_face = front_face
+        self.material = material
+        self.obj = obj
+        self._u = u
+        self._v = v
+
+    def _compute_uv(self) -> None:
+        if self.obj is None:
+            self._u, self._v = 0.0, 0.0
+        else:
+            self._u, self._v = self.obj.surface_uv(self)
+
+    @property
+    def u(self) -> float:
+        if self._u is None:
+            self._compute_uv()
+        return self._u
+
+    @property
+    def v(self) -> float:
+        if self._v is None:
+            self._compute_uv()
+        return self._v
+
+    def __repr__(self) -> str:
+        return (
+            f"HitInfo(t={self.t!r}, point={self.point!r}, normal={self.normal!r}, "
+            f"front_face={self.front_face!r})"
+        )

@@ -1,0 +1,88 @@
+"""Hittable: the interface every object in a scene has."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from .hit_info import HitInfo
+from .interval import Interval
+from .ray import Ray
+from .vec3 import Vec3
+
+if TYPE_CHECKING:
+    from .materials.material import Material
+
+
+class Hittable:
+    """A surface a ray can hit.
+
+    Subclasses implement `hit_t`, the cheap part (the ray parameter of the
+    closest hit inside an interval, or None), and `hit_info`, which builds the
+    full record for one t. `intersect` combines them, as the course's
+    `intersect(ray, interval)`. The scene calls `hit_t` on every object and
+    `hit_info` only for the closest, so records are not built for hits that
+    something nearer hides.
+    """
+
+    material: Material
+
+    def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
+        raise NotImplementedError
+
+    def hit_info(self, ray: Ray, t: float) -> HitInfo:
+        raise NotImplementedError
+
+    def intersect(self, ray: Ray, interval: Interval) -> HitInfo | None:
+        """The closest hit with t inside [interval.min, interval.max], or None."""
+        t = self.hit_t(ray, interval.min, interval.max)
+        if t is None:
+            return None
+        return self.hit_info(ray, t)
+
+    def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
+        """Surface coordinates (u, v) of a hit on this object."""
+        return 0.0, 0.0
+
+    # --- as an area light ---------------------------------------------------
+    # An object with an emitting material is also a light. Light sampling picks
+    # a direction from a receiving point p toward the object; the renderer then
+    # traces that direction to find the point and its emission. Densities are
+    # per unit solid angle at p. The default samples the surface uniformly by
+    # area and converts: pdf_solid_angle = pdf_area * distance^2 / |cos theta_light|.
+
+    def area(self) -> float:
+        raise NotImplementedError(f"{type(self).__name__} cannot be an area light")
+
+    def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:
+        """A point uniform over the surface from two uniform numbers in [0, 1),
+        with the geometric unit normal there: (point, normal)."""
+        raise NotImplementedError(f"{type(self).__name__} cannot be an area light")
+
+    def sample_direction(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float] | None:
+        """A unit direction from p toward this object and its solid-angle pdf, or
+        None when the sample is useless (p on the object's plane)."""
+        point, normal = self.sample_point(r1, r2)
+        dx, dy, dz = point.e0 - p.e0, point.e1 - p.e1, point.e2 - p.e2
+        dist2 = dx * dx + dy * dy + dz * dz
+        if dist2 == 0.0:
+            return None
+        k = 1.0 / math.sqrt(dist2)
+        direction = Vec3(dx * k, dy * k, dz * k)
+        cos_light = abs(direction.e0 * normal.e0 + direction.e1 * normal.e1 + direction.e2 * normal.e2)
+        if cos_light < 1e-12:
+            return None
+        return direction, dist2 / (cos_light * self.area())
+
+    def direction_pdf(self, p: Vec3, hit: HitInfo) -> float:
+        """Solid-angle density with which sample_direction(p) picks the direction
+        from p to `hit`, a point on this object."""
+        q, n = hit.point, hit.normal
+        dx, dy, dz = q.e0 - p.e0, q.e1 - p.e1, q.e2 - p.e2
+        dist2 = dx * dx + dy * dy + dz * dz
+        if dist2 == 0.0:
+            return 0.0
+        cos_light = abs(dx * n.e0 + dy * n.e1 + dz * n.e2) / math.sqrt(dist2)
+        if cos_light < 1e-12:
+            return 0.0
+        return dist2 / (cos_light * self.area())

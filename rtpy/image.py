@@ -1,0 +1,402 @@
+"""Writing rendered images to disk.
+
+Conventions used throughout rtpy:
+
+* A rendered image is an ``(H, W, 3)`` float array of **linear** RGB radiance.
+  Row 0 is the **top** of the image and column 0 is the **left**, so pixel
+  ``(0, 0)`` is the top-left corner (the same as PIL and most image viewers).
+* Gamma encoding is applied **only** when producing 8-bit display output
+  (``.png``, ``.jpg``, ``.jpeg``). Linear output (``.npy``, ``.pfm``) is never
+  gamma-encoded: it stores the radiance values exactly as rendered, unclamped.
+* Every file is written atomically: the data goes to a temporary file in the
+  destination directory which is then renamed over the target, so a crash or
+  Ctrl-C never leaves a half-written output file behind.
+* Output paths can (and should) be checked with :func:`check_image_path` or
+  :func:`check_linear_path` *before* a long render starts, so that a typo in a
+  directory name is reported in a second instead of after an hour of rendering.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import stat
+import tempfile
+from collections.abc import Callable, Collection
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+__all__ = [
+    "IMAGE_EXTENSIONS",
+    "LINEAR_EXTENSIONS",
+    "OUTPUT_EXTENSIONS",
+    "OutputError",
+    "RenderedImage",
+    "atomic_write",
+    "check_image_path",
+    "check_linear_path",
+    "check_writable",
+    "read_pfm",
+    "to_8bit",
+    "write_linear",
+    "write_npy",
+    "write_pfm",
+    "write_png",
+]
+
+StrPath = str | os.PathLike[str]
+
+#: Extensions for 8-bit, gamma-encoded display output.
+IMAGE_EXTENSIONS: tuple[str, ...] = (".png", ".jpg", ".jpeg")
+#: Extensions for linear (never gamma-encoded) floating-point output.
+LINEAR_EXTENSIONS: tuple[str, ...] = (".npy", ".pfm")
+#: Every extension :meth:`RenderedImage.save` understands.
+OUTPUT_EXTENSIONS: tuple[str, ...] = IMAGE_EXTENSIONS + LINEAR_EXTENSIONS
+
+_PIL_FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG"}
+_JPEG_QUALITY = 95
+
+
+class OutputError(Exception):
+    """An output file cannot be written; the message names the path and the problem."""
+
+
+# --------------------------------------------------------------------------- path checks
+
+
+def _ext(path: Path) -> str:
+    return path.suffix.lower()
+
+
+def _ext_list(extensions: Collection[str]) -> str:
+    exts = list(extensions)
+    if len(exts) == 1:
+        return exts[0]
+    return ", ".join(exts[:-1]) + " or " + exts[-1]
+
+
+def _extension_error(path: StrPath, allowed: Collection[str], role: str) -> OutputError:
+    suffix = Path(path).suffix
+    what = f"unsupported extension '{suffix}'" if suffix else "no file extension"
+    return OutputError(
+        f"cannot write '{os.fspath(path)}': {what} for {role} (use {_ext_list(allowed)})"
+    )
+
+
+def check_writable(
+    path: StrPath,
+    extensions: Collection[str] | None = None,
+    role: str = "output",
+) -> Path:
+    """Check that ``path`` can be written, before any expensive work is done.
+
+    Raises :class:`OutputError` (naming the path) if the parent directory does
+    not exist, is not a directory or is not writable, if ``path`` itself is an
+    existing directory, or if ``extensions`` is given and the file extension
+    (case-insensitive) is not one of them. ``role`` describes the kind of
+    output in that last message. Returns ``path`` as a :class:`Path`.
+    """
+    p = Path(path)
+    where = f"cannot write '{os.fspath(path)}'"
+    if extensions is not None:
+        allowed = tuple(e.lower() for e in extensions)
+        if _ext(p) not in allowed:
+            raise _extension_error(path, allowed, role)
+    parent = p.parent
+    if not parent.exists():
+        raise OutputError(f"{where}: directory '{parent}' does not exist")
+    if not parent.is_dir():
+        raise OutputError(f"{where}: '{parent}' is not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{where}: directory '{parent}' is not writable")
+    if p.is_dir():
+        raise OutputError(f"{where}: it is an existing directory")
+    return p
+
+
+def check_image_path(path: StrPath) -> Path:
+    """:func:`check_writable` for 8-bit display output (``.png``, ``.jpg``, ``.jpeg``)."""
+    return check_writable(path, IMAGE_EXTENSIONS, "8-bit image output")
+
+
+def check_linear_path(path: StrPath) -> Path:
+    """:func:`check_writable` for linear float output (``.npy``, ``.pfm``)."""
+    return check_writable(path, LINEAR_EXTENSIONS, "linear output")
+
+
+# --------------------------------------------------------------------------- conversion
+
+
+def _as_rgb(linear: np.ndarray, name: str = "linear") -> np.ndarray:
+    arr = np.asarray(linear)
+    if arr.ndim != 3 or arr.shape[2] != 3:
+        raise ValueError(f"{name} must have shape (H, W, 3), got {arr.shape}")
+    if arr.shape[0] == 0 or arr.shape[1] == 0:
+        raise ValueError(f"{name} must not be empty, got shape {arr.shape}")
+    return arr
+
+
+def _check_gamma(gamma: float) -> float:
+    gamma = float(gamma)
+    if not (np.isfinite(gamma) and gamma > 0.0):
+        raise ValueError(f"gamma must be a positive finite number, got {gamma!r}")
+    return gamma
+
+
+def to_8bit(linear: np.ndarray, gamma: float) -> np.ndarray:
+    """Convert an ``(H, W, 3)`` linear RGB image to ``uint8`` for display.
+
+    Values are clamped to ``[0, 1]`` (NaN counts as 0, +inf as 1), encoded
+    with ``x ** (1 / gamma)`` (``gamma == 1`` means no encoding), scaled by
+    255 and rounded to the nearest integer (halves round up).
+    """
+    gamma = _check_gamma(gamma)
+    x = np.array(_as_rgb(linear), dtype=np.float64)  # a copy: the input is never modified
+    x[np.isnan(x)] = 0.0
+    np.clip(x, 0.0, 1.0, out=x)
+    if gamma != 1.0:
+        np.power(x, 1.0 / gamma, out=x)
+    return np.floor(x * 255.0 + 0.5).astype(np.uint8)
+
+
+# --------------------------------------------------------------------------- atomic writes
+
+
+def _new_file_mode() -> int:
+    """Permission bits a newly created file would get (0o666 minus the umask)."""
+    # os.umask can only be read by setting it; restore it immediately.
+    umask = os.umask(0o022)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def atomic_write(path: StrPath, write_fn: Callable[[Path], object]) -> Path:
+    """Write ``path`` atomically by way of a temporary file in the same directory.
+
+    ``write_fn(tmp_path)`` must write the complete file to ``tmp_path``; the
+    temporary file is then renamed over ``path`` with :func:`os.replace`. If
+    anything fails (including ``KeyboardInterrupt``) the temporary file is
+    removed, the exception propagates, and ``path`` is left untouched: either
+    absent or with its previous content. Returns ``path`` as a :class:`Path`.
+    """
+    target = Path(path)
+    directory = target.parent
+    try:
+        # Existing targets keep their permissions; new ones get the usual umask-based
+        # mode rather than the private 0o600 that tempfile uses.
+        mode = stat.S_IMODE(os.stat(target).st_mode)
+    except OSError:
+        mode = _new_file_mode()
+    with tempfile.NamedTemporaryFile(
+        delete=False, dir=directory, prefix="." + target.name + ".", suffix=".tmp"
+    ) as tmp:
+        tmp_path = Path(tmp.name)
+    try:
+        write_fn(tmp_path)
+        with open(tmp_path, "rb+") as f:  # make sure the data is on disk before renaming
+            os.fsync(f.fileno())
+        os.chmod(tmp_path, mode)
+        os.replace(tmp_path, target)
+    except BaseException:
+        tmp_path.unlink(missing_ok=True)
+        raise
+    return target
+
+
+# --------------------------------------------------------------------------- writers
+
+
+def write_png(path: StrPath, linear: np.ndarray, gamma: float) -> Path:
+    """Write 8-bit display output, gamma-encoded with ``gamma`` (see :func:`to_8bit`).
+
+    The format follows the extension: ``.png`` is written as PNG, ``.jpg`` and
+    ``.jpeg`` as JPEG (quality 95).
+    """
+    p = check_image_path(path)
+    pil = Image.fromarray(to_8bit(linear, gamma))
+    fmt = _PIL_FORMATS[_ext(p)]
+    options = {"quality": _JPEG_QUALITY} if fmt == "JPEG" else {}
+
+    def write(tmp: Path) -> None:
+        pil.save(tmp, format=fmt, **options)
+
+    return atomic_write(p, write)
+
+
+def write_npy(path: StrPath, linear: np.ndarray) -> Path:
+    """Write the linear ``(H, W, 3)`` array as ``.npy``, keeping its dtype (not gamma-encoded)."""
+    p = check_writable(path, (".npy",), "NumPy output")
+    arr = _as_rgb(linear)
+
+    def write(tmp: Path) -> None:
+        # Save through a file object: np.save(path) would append ".npy" to the temp name.
+        with open(tmp, "wb") as f:
+            np.save(f, arr, allow_pickle=False)
+
+    return atomic_write(p, write)
+
+
+def _pfm_bytes(linear: np.ndarray) -> bytes:
+    arr = _as_rgb(linear)
+    h, w, _ = arr.shape
+    header = b"PF\n" + f"{w} {h}\n".encode("ascii") + b"-1.0\n"
+    # PFM stores rows from the bottom of the image to the top; "-1.0" = little-endian.
+    data = np.ascontiguousarray(arr[::-1], dtype="<f4")
+    return header + data.tobytes()
+
+
+def write_pfm(path: StrPath, linear: np.ndarray) -> Path:
+    """Write the linear image as a Portable Float Map (float32, not gamma-encoded).
+
+    The file is ``PF\\n``, ``"{W} {H}\\n"``, ``"-1.0\\n"`` (a negative scale
+    means little-endian) and then little-endian float32 RGB rows from the
+    bottom row of the image to the top row.
+    """
+    p = check_writable(path, (".pfm",), "PFM output")
+    data = _pfm_bytes(linear)
+    return atomic_write(p, lambda tmp: tmp.write_bytes(data))
+
+
+def write_linear(path: StrPath, linear: np.ndarray) -> Path:
+    """Write linear output (never gamma-encoded), choosing ``.npy`` or ``.pfm`` by extension."""
+    p = check_linear_path(path)
+    if _ext(p) == ".npy":
+        return write_npy(p, linear)
+    return write_pfm(p, linear)
+
+
+def read_pfm(path: StrPath) -> np.ndarray:
+    """Read a Portable Float Map into an ``(H, W, 3)`` float32 array, top row first.
+
+    Handles both byte orders (by the sign of the scale) and greyscale ``Pf``
+    files (replicated to three channels). Raises ``ValueError`` if the file is
+    not a valid PFM.
+    """
+    raw = Path(path).read_bytes()
+
+    def bad(what: str) -> ValueError:
+        return ValueError(f"'{os.fspath(path)}' is not a valid PFM file: {what}")
+
+    tokens: list[bytes] = []
+    pos = 0
+    while len(tokens) < 4:
+        while pos < len(raw) and raw[pos : pos + 1].isspace():
+            pos += 1
+        start = pos
+        while pos < len(raw) and not raw[pos : pos + 1].isspace():
+            pos += 1
+        if start == pos:
+            raise bad("truncated header")
+        tokens.append(raw[start:pos])
+    if pos >= len(raw):
+        raise bad("no pixel data")
+    pos += 1  # exactly one whitespace byte separates the header from the data
+
+    magic, w_tok, h_tok, scale_tok = tokens
+    if magic not in (b"PF", b"Pf"):
+        raise bad(f"magic is {magic!r}, expected b'PF' or b'Pf'")
+    channels = 3 if magic == b"PF" else 1
+    try:
+        width, height, scale = int(w_tok), int(h_tok), float(scale_tok)
+    except ValueError:
+        raise bad("malformed size or scale") from None
+    if width <= 0 or height <= 0:
+        raise bad(f"size {width}x{height}")
+    if scale == 0.0 or not np.isfinite(scale):
+        raise bad(f"scale {scale}")
+
+    count = width * height * channels
+    if len(raw) - pos < count * 4:
+        raise bad(f"expected {count * 4} bytes of pixel data, found {len(raw) - pos}")
+    dtype = np.dtype("<f4") if scale < 0 else np.dtype(">f4")
+    data = np.frombuffer(raw, dtype=dtype, count=count, offset=pos)
+    img = data.reshape(height, width, channels)[::-1].astype(np.float32)  # bottom-up -> top-down
+    if channels == 1:
+        img = np.repeat(img, 3, axis=2)
+    return np.ascontiguousarray(img)
+
+
+# --------------------------------------------------------------------------- result object
+
+
+class RenderedImage:
+    """The result of a render.
+
+    Attributes:
+        linear: ``(H, W, 3)`` float64 array of **linear** RGB; pixel ``(0, 0)``
+            is the top-left corner (row index = y going down, column = x).
+        gamma: display gamma, used **only** for 8-bit output (:attr:`pil`,
+            ``.png``/``.jpg``); linear output is never gamma-encoded.
+        spp: requested samples per pixel.
+        samples_min, samples_max: fewest and most samples any pixel actually
+            holds (both default to ``spp``; smaller after an interrupted render).
+        interrupted: True if the render was stopped before finishing.
+        stats: free-form statistics, e.g. ``seconds``, ``paths``, ``paths_per_second``.
+    """
+
+    def __init__(
+        self,
+        linear: np.ndarray,
+        gamma: float = 2.0,
+        spp: int = 0,
+        samples_min: int | None = None,
+        samples_max: int | None = None,
+        interrupted: bool = False,
+        stats: dict | None = None,
+    ) -> None:
+        self.linear: np.ndarray = np.asarray(_as_rgb(linear), dtype=np.float64)
+        self.gamma: float = _check_gamma(gamma)
+        self.spp: int = int(spp)
+        self.samples_min: int = self.spp if samples_min is None else int(samples_min)
+        self.samples_max: int = self.spp if samples_max is None else int(samples_max)
+        self.interrupted: bool = bool(interrupted)
+        self.stats: dict = {} if stats is None else dict(stats)
+
+    @property
+    def width(self) -> int:
+        """Image width in pixels (``linear.shape[1]``)."""
+        return int(self.linear.shape[1])
+
+    @property
+    def height(self) -> int:
+        """Image height in pixels (``linear.shape[0]``)."""
+        return int(self.linear.shape[0])
+
+    @property
+    def pil(self) -> Image.Image:
+        """An 8-bit RGB PIL image, gamma-encoded with :attr:`gamma`."""
+        return Image.fromarray(to_8bit(self.linear, self.gamma))
+
+    def to_pil(self) -> Image.Image:
+        """Same as :attr:`pil`."""
+        return self.pil
+
+    def save(self, path: StrPath) -> Path:
+        """Save by extension and return the path written.
+
+        ``.png``/``.jpg``/``.jpeg`` are 8-bit and gamma-encoded with :attr:`gamma`;
+        ``.npy``/``.pfm`` are linear and never gamma-encoded. Any other extension
+        raises :class:`OutputError`.
+        """
+        ext = _ext(Path(path))
+        if ext in IMAGE_EXTENSIONS:
+            return write_png(path, self.linear, self.gamma)
+        if ext in LINEAR_EXTENSIONS:
+            return write_linear(path, self.linear)
+        raise _extension_error(path, OUTPUT_EXTENSIONS, "image output")
+
+    def _repr_png_(self) -> bytes:
+        """PNG bytes of the 8-bit image, so Jupyter displays a RenderedImage inline."""
+        buf = io.BytesIO()
+        self.pil.save(buf, format="PNG")
+        return buf.getvalue()
+
+    def __repr__(self) -> str:
+        samples = f"spp={self.spp}"
+        if (self.samples_min, self.samples_max) != (self.spp, self.spp):
+            samples += f", samples={self.samples_min}..{self.samples_max}"
+        return (
+            f"RenderedImage({self.width}x{self.height}, {samples}, interrupted={self.interrupted})"
+        )

@@ -1,0 +1,24 @@
+"""The "direct" integrator (course week 5): emission plus one bounce of light."""
+
+from __future__ import annotations
+
+from ..ray import Ray
+from ..scene import Scene
+from ..vec3 import Color
+from .direct_lighting import direct_lighting
+from .integrator import FORWARD, Integrator
+
+
+class DirectIntegrator(Integrator):
+    """Emission seen directly plus light arriving after one reflection, from
+    point and area lights (with shadow rays) and the background. No indirect
+    bounce. This is exactly the "path" estimator with max_depth = 2."""
+
+    name = "direct"
+
+    def radiance(self, ray: Ray, scene: Scene) -> Color:
+        hit = scene.find_intersection(ray, FORWARD)
+        if hit is None:
+            return scene.background_radiance(ray.direction)
+        emitted = hit.material.emitting(hit)
+        return emitted + direct_lighting(scene, ray, hit)

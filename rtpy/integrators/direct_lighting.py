@@ -1,0 +1,89 @@
+"""Direct lighting: light that reaches a point straight from the light sources.
+
+Two strategies estimate it, and multiple importance sampling (MIS, Veach 1997)
+combines them so that each works where it is good:
+- light sampling (next-event estimation): pick a light, pick a direction
+  toward it, send a shadow ray; best for small and point lights;
+- BRDF sampling: follow the direction scattering() picks and see whether it
+  hits a light; best for glossy surfaces and big lights.
+Each area-light contribution is weighted by the power heuristic, so the two
+estimates add up to the right answer and light is never counted twice.
+Point lights can only be reached by light sampling (weight 1).
+"""
+
+from __future__ import annotations
+
+from ..hit_info import HitInfo
+from ..interval import Interval
+from ..light import Light
+from ..ray import Ray, offset_scale, spawn_ray
+from ..sampling import power_heuristic, random_double
+from ..scene import Scene
+from ..vec3 import BLACK, Color
+from .integrator import FORWARD
+
+
+def sample_one_light(scene: Scene, ray_in: Ray, hit: HitInfo, lights: list[Light]) -> Color:
+    """Light-sampling estimate of the radiance reflected toward -ray_in.direction
+    by light arriving directly from `lights`: one light picked uniformly, one
+    direction toward it, weight f_r * L * cos(theta_i) / pdf (times the MIS weight
+    for area lights)."""
+    n_lights = len(lights)
+    light = lights[min(int(random_double() * n_lights), n_lights - 1)]
+    sample = light.sample(hit.point)
+    if sample is None or sample.radiance.is_black():
+        return BLACK
+    normal, wi = hit.normal, sample.direction
+    cos_i = normal.e0 * wi.e0 + normal.e1 * wi.e1 + normal.e2 * wi.e2
+    if cos_i <= 0.0:
+        return BLACK  # the light is behind the surface
+    shadow_ray = spawn_ray(hit.point, normal, wi)
+    f = hit.material.BRDF(ray_in, shadow_ray, hit)
+    if f.is_black():
+        return BLACK
+    # Stop the shadow ray just short of the light's surface so it cannot hit it.
+    t_max = sample.distance - offset_scale(sample.point) - offset_scale(hit.point)
+    if scene.find_occlusion(shadow_ray, Interval(0.0, t_max)):
+        return BLACK
+    pdf = sample.pdf / n_lights  # choosing this light, then this direction
+    if sample.is_delta:
+        return f * sample.radiance * (cos_i / pdf)
+    weight = power_heuristic(pdf, hit.material.pdf(ray_in, shadow_ray, hit))
+    return f * sample.radiance * (cos_i * weight / pdf)
+
+
+def emission_weight(
+    scene: Scene, hit: HitInfo, prev_point, prev_pdf: float, prev_specular: bool, n_lights: int
+) -> float:
+    """MIS weight of emission found by BRDF sampling: the ray that reached `hit`
+    left `prev_point` with solid-angle pdf `prev_pdf`. Emission seen directly by
+    the camera or after a specular bounce could not have been light-sampled and
+    keeps weight 1; so does emission when light sampling is off (n_lights = 0)."""
+    if prev_specular or n_lights == 0:
+        return 1.0
+    light_pdf = hit.obj.direction_pdf(prev_point, hit) / n_lights
+    return power_heuristic(prev_pdf, light_pdf)
+
+
+def direct_lighting(scene: Scene, ray_in: Ray, hit: HitInfo) -> Color:
+    """Radiance reflected at `hit` toward -ray_in.direction after exactly one
+    bounce: light sampling plus BRDF sampling, combined by MIS. A BRDF-sampled
+    ray that escapes sees the background. At specular materials only the
+    sampled ray is followed."""
+    material = hit.material
+    lights = scene.lights
+    result = BLACK
+    if lights and not material.is_specular:
+        result = sample_one_light(scene, ray_in, hit, lights)
+    scatter = material.scattering(ray_in, hit)
+    if scatter is None:
+        return result
+    next_hit = scene.find_intersection(scatter.ray, FORWARD)
+    if next_hit is None:
+        return result + scatter.attenuation * scene.background_radiance(scatter.ray.direction)
+    if next_hit.material.is_emitter:
+        emitted = next_hit.material.emitting(next_hit)
+        if not emitted.is_black():
+            w = emission_weight(scene, next_hit, hit.point, scatter.pdf, scatter.is_specular, len(lights))
+            result = result + scatter.attenuation * emitted * w
+    return result

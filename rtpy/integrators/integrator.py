@@ -1,0 +1,30 @@
+"""Integrator: turns a camera ray into the radiance it carries back."""
+
+from __future__ import annotations
+
+import math
+
+from ..interval import Interval
+from ..ray import Ray
+from ..render_settings import RenderSettings
+from ..scene import Scene
+from ..vec3 import Color
+
+# Rays spawned by rtpy start off their surface (see ray.spawn_ray), so every
+# search for a hit can run over all t > 0.
+FORWARD = Interval(0.0, math.inf)
+
+
+class Integrator:
+    """Base class. `radiance(ray, scene)` estimates the radiance arriving at the
+    ray's origin along -ray.direction (a Monte Carlo estimate for the stochastic
+    integrators: its expectation is the pixel value)."""
+
+    name = "integrator"
+    uses_center_ray = False  # True: one ray through each pixel's center, spp = 1
+
+    def __init__(self, settings: RenderSettings | None = None) -> None:
+        self.settings = settings or RenderSettings()
+
+    def radiance(self, ray: Ray, scene: Scene) -> Color:
+        raise NotImplementedError

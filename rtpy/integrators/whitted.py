@@ -1,0 +1,37 @@
+"""The "whitted" integrator (course week 6): direct light at diffuse surfaces,
+perfect reflection and refraction at mirrors and glass."""
+
+from __future__ import annotations
+
+from ..ray import Ray
+from ..scene import Scene
+from ..vec3 import Color
+from .direct_lighting import direct_lighting
+from .integrator import FORWARD, Integrator
+
+
+class WhittedIntegrator(Integrator):
+    """Whitted-style ray tracing (Whitted 1980).
+
+    At a non-specular hit: emission + direct light, as the "direct" integrator.
+    At a specular hit: recurse along the material's deterministic rays: the
+    perfect reflection for mirror and metal (fuzz ignored); for glass both the
+    reflected ray (weight R) and the refracted ray (weight 1 - R). Recursion
+    stops after max_depth segments.
+    """
+
+    name = "whitted"
+
+    def radiance(self, ray: Ray, scene: Scene, depth: int = 1) -> Color:
+        hit = scene.find_intersection(ray, FORWARD)
+        if hit is None:
+            return scene.background_radiance(ray.direction)
+        material = hit.material
+        result = material.emitting(hit)
+        if depth >= self.settings.max_depth:
+            return result
+        if not material.is_specular:
+            return result + direct_lighting(scene, ray, hit)
+        for next_ray, weight in material.specular_rays(ray, hit):
+            result = result + weight * self.radiance(next_ray, scene, depth + 1)
+        return result

@@ -1,0 +1,87 @@
+"""Lights: point lights and area lights (objects with an emitting material).
+
+A light is sampled from a receiving point p. The sample gives the unit
+direction wi from p toward the light, the distance to it, the radiance L that
+arrives along wi, and the solid-angle pdf of wi, so the direct-light estimate
+is f_r * L * cos(theta_i) / pdf. A point light is a delta light: there is only
+one direction, its "pdf" is 1 and L is already the irradiance I / d^2 at normal
+incidence (radiant intensity falls off with the square of the distance).
+"""
+
+from __future__ import annotations
+
+import math
+
+from .hit_info import HitInfo
+from .hittable import Hittable
+from .ray import Ray
+from .sampling import random_double
+from .vec3 import Color, Vec3
+
+
+class LightSample:
+    __slots__ = ("direction", "distance", "radiance", "pdf", "is_delta", "point")
+
+    def __init__(
+        self, direction: Vec3, distance: float, radiance: Color, pdf: float, is_delta: bool,
+        point: Vec3,
+    ) -> None:
+        self.direction = direction  # unit, from the receiving point toward the light
+        self.distance = distance
+        self.radiance = radiance
+        self.pdf = pdf
+        self.is_delta = is_delta
+        self.point = point  # the point on the light
+
+
+class Light:
+    is_delta = False
+
+    def sample(self, p: Vec3) -> LightSample | None:
+        raise NotImplementedError
+
+
+class PointLight(Light):
+    """Emits radiant intensity `intensity` (W/sr per channel) equally in all
+    directions from `position`: a surface at distance d whose normal makes angle
+    theta with the direction to the light receives irradiance I cos(theta) / d^2."""
+
+    is_delta = True
+
+    def __init__(self, position: Vec3, intensity: Color) -> None:
+        self.position = position
+        self.intensity = intensity
+
+    def sample(self, p: Vec3) -> LightSample | None:
+        q = self.position
+        dx, dy, dz = q.e0 - p.e0, q.e1 - p.e1, q.e2 - p.e2
+        dist2 = dx * dx + dy * dy + dz * dz
+        if dist2 == 0.0:
+            return None
+        dist = math.sqrt(dist2)
+        direction = Vec3(dx / dist, dy / dist, dz / dist)
+        return LightSample(direction, dist, self.intensity / dist2, 1.0, True, q)
+
+
+class AreaLight(Light):
+    """An object whose material emits (DiffuseLight), sampled by its shape's
+    sample_direction (by area, or by solid angle for spheres seen from outside)."""
+
+    def __init__(self, shape: Hittable) -> None:
+        self.shape = shape
+
+    def sample(self, p: Vec3) -> LightSample | None:
+        s = self.shape.sample_direction(p, random_double(), random_double())
+        if s is None:
+            return None
+        direction, pdf = s
+        ray = Ray(p, direction)
+        t = self.shape.hit_t(ray, 0.0, math.inf)
+        if t is None or not pdf > 0.0:
+            return None  # a grazing sample that rounding moved off the shape
+        hit = self.shape.hit_info(ray, t)
+        return LightSample(direction, t, self.shape.material.emitting(hit), pdf, False, hit.point)
+
+    def pdf(self, p: Vec3, hit: HitInfo) -> float:
+        """Solid-angle density of sample(p) choosing the direction toward `hit`."""
+        return self.shape.direction_pdf(p, hit)

@@ -1,0 +1,42 @@
+"""Lambertian: ideal diffuse reflection, f_r = albedo / pi."""
+
+from __future__ import annotations
+
+import math
+
+from ..hit_info import HitInfo
+from ..onb import ONB
+from ..ray import Ray, spawn_ray
+from ..sampling import random_cosine_direction
+from ..scatter_info import ScatterInfo
+from ..texture import Texture
+from ..vec3 import BLACK, Color
+from .material import Material, as_texture
+
+INV_PI = 1.0 / math.pi
+
+
+class Lambertian(Material):
+    """Reflects equally in all directions: f_r = albedo / pi.
+
+    Sampling is cosine-weighted, pdf = cos(theta) / pi, so the weight
+    BRDF * cos / pdf is exactly the albedo.
+    """
+
+    def __init__(self, albedo: Color | Texture = Color(0.5, 0.5, 0.5)) -> None:
+        self.albedo = as_texture(albedo)
+
+    def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
+        x, y, z = random_cosine_direction()
+        direction = ONB(hit.normal).to_world(x, y, z)
+        return ScatterInfo(spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), z * INV_PI)
+
+    def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
+        n, wi = hit.normal, ray_light.direction
+        if n.e0 * wi.e0 + n.e1 * wi.e1 + n.e2 * wi.e2 <= 0.0:
+            return BLACK  # light below the surface
+        return self.albedo.value(hit) * INV_PI
+
+    def pdf(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> float:
+        n, wi = hit.normal, ray_light.direction
+        return max(0.0, n.e0 * wi.e0 + n.e1 * wi.e1 + n.e2 * wi.e2) * INV_PI

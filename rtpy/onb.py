@@ -1,0 +1,33 @@
+"""Orthonormal basis around a unit normal (local frame with z = normal)."""
+
+from __future__ import annotations
+
+import math
+
+from .vec3 import Vec3
+
+
+class ONB:
+    """Frame (u, v, w) with w the given unit vector; right-handed.
+
+    Built with the branchless method of Duff et al. 2017 ("Building an
+    Orthonormal Basis, Revisited"), which is stable for every w.
+    """
+
+    __slots__ = ("u", "v", "w")
+
+    def __init__(self, w: Vec3) -> None:
+        sign = math.copysign(1.0, w.e2)
+        a = -1.0 / (sign + w.e2)
+        b = w.e0 * w.e1 * a
+        self.u = Vec3(1.0 + sign * w.e0 * w.e0 * a, sign * b, -sign * w.e0)
+        self.v = Vec3(b, sign + w.e1 * w.e1 * a, -w.e1)
+        self.w = w
+
+    def to_world(self, x: float, y: float, z: float) -> Vec3:
+        u, v, w = self.u, self.v, self.w
+        return Vec3(
+            x * u.e0 + y * v.e0 + z * w.e0,
+            x * u.e1 + y * v.e1 + z * w.e1,
+            x * u.e2 + y * v.e2 + z * w.e2,
+        )

@@ -1,0 +1,65 @@
+"""Quad: the parallelogram q + a*u + b*v with a, b in [0, 1]."""
+
+from __future__ import annotations
+
+import math
+
+from .hit_info import HitInfo
+from .hittable import Hittable
+from .ray import Ray
+from .vec3 import Vec3, cross, dot
+
+
+class Quad(Hittable):
+    """Front face normal = normalize(u x v); surface coordinates (u, v) = (a, b)."""
+
+    def __init__(self, q: Vec3, u: Vec3, v: Vec3, material) -> None:
+        n = cross(u, v)
+        n_len = n.length()
+        if not n_len > 0.0 or not math.isfinite(n_len):
+            raise ValueError("quad is degenerate: u and v are parallel or zero")
+        self.q, self.u, self.v = q, u, v
+        self.material = material
+        self.normal = n / n_len
+        self.d = dot(self.normal, q)  # plane: dot(normal, p) = d
+        self.w = n / dot(n, n)  # turns a planar vector into (a, b) coordinates
+        self._area = n_len
+
+    def _coords(self, p: Vec3) -> tuple[float, float]:
+        q, w = self.q, self.w
+        px, py, pz = p.e0 - q.e0, p.e1 - q.e1, p.e2 - q.e2
+        u, v = self.u, self.v
+        # alpha = w . (p x v), beta = w . (u x p)
+        a = w.e0 * (py * v.e2 - pz * v.e1) + w.e1 * (pz * v.e0 - px * v.e2) + w.e2 * (px * v.e1 - py * v.e0)
+        b = w.e0 * (u.e1 * pz - u.e2 * py) + w.e1 * (u.e2 * px - u.e0 * pz) + w.e2 * (u.e0 * py - u.e1 * px)
+        return a, b
+
+    def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
+        n, o, d = self.normal, ray.origin, ray.direction
+        denom = n.e0 * d.e0 + n.e1 * d.e1 + n.e2 * d.e2
+        if denom == 0.0:
+            return None  # parallel to the plane
+        t = (self.d - (n.e0 * o.e0 + n.e1 * o.e1 + n.e2 * o.e2)) / denom
+        if not t_min < t < t_max:
+            return None
+        a, b = self._coords(Vec3(o.e0 + t * d.e0, o.e1 + t * d.e1, o.e2 + t * d.e2))
+        if 0.0 <= a <= 1.0 and 0.0 <= b <= 1.0:
+            return t
+        return None
+
+    def hit_info(self, ray: Ray, t: float) -> HitInfo:
+        n, d = self.normal, ray.direction
+        front_face = n.e0 * d.e0 + n.e1 * d.e1 + n.e2 * d.e2 < 0.0
+        return HitInfo(ray.at(t), n if front_face else -n, t, front_face, self.material, self)
+
+    def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
+        a, b = self._coords(hit.point)
+        return min(1.0, max(0.0, a)), min(1.0, max(0.0, b))
+
+    def area(self) -> float:
+        return self._area
+
+    def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:
+        q, u, v = self.q, self.u, self.v
+        p = Vec3(q.e0 + r1 * u.e0 + r2 * v.e0, q.e1 + r1 * u.e1 + r2 * v.e1, q.e2 + r1 * u.e2 + r2 * v.e2)
+        return p, self.normal

@@ -1,0 +1,80 @@
+"""Random numbers and the sampling routines built on them.
+
+rtpy never draws from Python's or numpy's global generator. The renderer gives
+every unit of work (a tile and a batch of samples) its own generator, seeded by
+(seed, tile, batch), and installs it with `use_generator` while that unit runs;
+the functions below draw from the installed one. So an image depends only on the
+seed and the settings, never on how many worker processes rendered it.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from contextlib import contextmanager
+
+from .vec3 import Vec3
+
+_generator = random.Random(0)
+
+
+def make_generator(*key: int) -> random.Random:
+    """A Mersenne-Twister generator seeded from a tuple of integers (stable across
+    processes and runs: string seeds are hashed with SHA-512, not hash())."""
+    return random.Random(":".join(str(int(k)) for k in key))
+
+
+@contextmanager
+def use_generator(generator: random.Random):
+    """Make `generator` the source of random_double() and friends inside the block."""
+    global _generator
+    previous = _generator
+    _generator = generator
+    try:
+        yield generator
+    finally:
+        _generator = previous
+
+
+def generator() -> random.Random:
+    """The generator in use now."""
+    return _generator
+
+
+def random_double(lo: float = 0.0, hi: float = 1.0) -> float:
+    """Uniform in [lo, hi)."""
+    return lo + (hi - lo) * _generator.random()
+
+
+def random_unit_vector() -> Vec3:
+    """Uniform on the unit sphere (pdf 1 / (4 pi) per steradian)."""
+    r = _generator.random
+    z = 1.0 - 2.0 * r()
+    s = math.sqrt(max(0.0, 1.0 - z * z))
+    phi = 2.0 * math.pi * r()
+    return Vec3(s * math.cos(phi), s * math.sin(phi), z)
+
+
+def random_in_unit_disk() -> Vec3:
+    """Uniform in the unit disk of the z = 0 plane."""
+    r = _generator.random
+    radius = math.sqrt(r())
+    phi = 2.0 * math.pi * r()
+    return Vec3(radius * math.cos(phi), radius * math.sin(phi), 0.0)
+
+
+def random_cosine_direction() -> tuple[float, float, float]:
+    """Local (x, y, z) of a direction in the z-up hemisphere with pdf cos(theta) / pi."""
+    r = _generator.random
+    r1 = r()
+    r2 = r()
+    phi = 2.0 * math.pi * r1
+    s = math.sqrt(r2)
+    return s * math.cos(phi), s * math.sin(phi), math.sqrt(max(0.0, 1.0 - r2))
+
+
+def power_heuristic(pdf_a: float, pdf_b: float) -> float:
+    """Veach's power heuristic (beta = 2): MIS weight of a sample drawn with pdf_a
+    when the same direction could also have come from the strategy with pdf_b."""
+    a2 = pdf_a * pdf_a
+    return a2 / (a2 + pdf_b * pdf_b)

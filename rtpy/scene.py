@@ -1,0 +1,95 @@
+"""Scene: the objects, the lights and what rays see when they escape."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from .hit_info import HitInfo
+from .hittable import Hittable
+from .interval import Interval
+from .light import AreaLight, Light, PointLight
+from .ray import Ray
+from .vec3 import Color
+
+if TYPE_CHECKING:
+    from .camera import Camera
+    from .render_settings import RenderSettings
+
+
+class Scene:
+    """Objects, point lights and the background.
+
+    Every object whose material emits (a DiffuseLight) is also an area light;
+    `lights` lists the point lights and then those area lights, the set that
+    integrators sample. The scene keeps no per-ray state: find_intersection and
+    find_occlusion are pure queries.
+
+    background  radiance of rays that escape (a constant environment)
+    sky         True: the RTIOW blue-white gradient instead of `background`
+    camera, settings  what a scene file gave (None for scenes built in code)
+    """
+
+    def __init__(
+        self,
+        objects: list[Hittable] | None = None,
+        point_lights: list[PointLight] | None = None,
+        background: Color = Color(0.0, 0.0, 0.0),
+        sky: bool = False,
+        camera: Camera | None = None,
+        settings: RenderSettings | None = None,
+        name: str = "scene",
+    ) -> None:
+        self.objects: list[Hittable] = list(objects or [])
+        self.point_lights: list[PointLight] = list(point_lights or [])
+        self.background = background
+        self.sky = sky
+        self.camera = camera
+        self.settings = settings
+        self.name = name
+        self.area_lights: list[AreaLight] = []
+        self.update_lights()
+
+    def add(self, obj: Hittable) -> None:
+        self.objects.append(obj)
+        self.update_lights()
+
+    def update_lights(self) -> None:
+        self.area_lights = [
+            AreaLight(o) for o in self.objects if getattr(o.material, "is_emitter", False)
+        ]
+
+    @property
+    def lights(self) -> list[Light]:
+        return [*self.point_lights, *self.area_lights]
+
+    def find_intersection(self, ray: Ray, interval: Interval) -> HitInfo | None:
+        """The closest hit with t in (interval.min, interval.max), or None."""
+        closest_t = interval.max
+        closest_obj = None
+        t_min = interval.min
+        for obj in self.objects:
+            t = obj.hit_t(ray, t_min, closest_t)
+            if t is not None:
+                closest_t = t
+                closest_obj = obj
+        if closest_obj is None:
+            return None
+        return closest_obj.hit_info(ray, closest_t)
+
+    def find_occlusion(self, ray: Ray, interval: Interval) -> bool:
+        """True if anything (glass included) lies on the ray with t in the interval."""
+        t_min, t_max = interval.min, interval.max
+        for obj in self.objects:
+            if obj.hit_t(ray, t_min, t_max) is not None:
+                return True
+        return False
+
+    def background_radiance(self, direction) -> Color:
+        """Radiance arriving along a ray that escapes with this direction."""
+        if not self.sky:
+            return self.background
+        # RTIOW's sky: white at the horizon to light blue overhead, by the
+        # direction's y component.
+        a = 0.5 * (direction.e1 / math.sqrt(direction.length_squared()) + 1.0)
+        return Color(1.0 - 0.5 * a, 1.0 - 0.3 * a, 1.0)

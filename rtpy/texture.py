@@ -1,0 +1,80 @@
+"""Textures: colours that vary over a surface. value(hit) returns a linear Color."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .hit_info import HitInfo
+from .vec3 import Color
+
+
+class Texture:
+    def value(self, hit: HitInfo) -> Color:
+        raise NotImplementedError
+
+
+class SolidColor(Texture):
+    """The same colour everywhere."""
+
+    def __init__(self, color: Color) -> None:
+        self.color = color
+
+    def value(self, hit: HitInfo) -> Color:
+        return self.color
+
+
+class CheckerTexture(Texture):
+    """3-D checker cells of edge `scale` (world units): point p takes `even` when
+    floor(px/scale) + floor(py/scale) + floor(pz/scale) is even, else `odd`.
+    Solid cells, so it needs no (u, v)."""
+
+    def __init__(self, scale: float, even: Color, odd: Color) -> None:
+        if not scale > 0.0:
+            raise ValueError(f"checker scale must be > 0, got {scale}")
+        self.inv_scale = 1.0 / scale
+        self.even = even
+        self.odd = odd
+
+    def value(self, hit: HitInfo) -> Color:
+        p, k = hit.point, self.inv_scale
+        cell = math.floor(p.e0 * k) + math.floor(p.e1 * k) + math.floor(p.e2 * k)
+        return self.even if cell % 2 == 0 else self.odd
+
+
+def srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    """The sRGB transfer curve inverted: 8-bit file values (as 0..1) to linear."""
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+class ImageTexture(Texture):
+    """An image wrapped by the hit's (u, v): u = 0 at the left column, v = 0 at the
+    bottom row. Nearest-pixel lookup (as RTIOW); u and v are clamped to [0, 1].
+    PNG/JPEG pixels are sRGB-encoded and decoded to linear RGB on load."""
+
+    def __init__(self, pixels: np.ndarray) -> None:
+        pixels = np.asarray(pixels, dtype=np.float64)
+        if pixels.ndim != 3 or pixels.shape[2] != 3 or pixels.shape[0] < 1 or pixels.shape[1] < 1:
+            raise ValueError(f"image texture needs an (H, W, 3) array, got shape {pixels.shape}")
+        self.pixels = pixels  # linear RGB, row 0 at the top
+        self.height, self.width = pixels.shape[:2]
+        # Rows as lists of Colors: the scalar renderer reads one texel at a time,
+        # and Python floats are much cheaper to read than numpy scalars.
+        self._rows = [[Color(*map(float, px)) for px in row] for row in pixels]
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> ImageTexture:
+        from PIL import Image
+
+        with Image.open(path) as im:
+            data = np.asarray(im.convert("RGB"), dtype=np.float64) / 255.0
+        return cls(srgb_to_linear(data))
+
+    def value(self, hit: HitInfo) -> Color:
+        u = min(1.0, max(0.0, hit.u))
+        v = 1.0 - min(1.0, max(0.0, hit.v))  # image rows run top to bottom
+        i = min(int(u * self.width), self.width - 1)
+        j = min(int(v * self.height), self.height - 1)
+        return self._rows[j][i]

@@ -1,0 +1,94 @@
+"""Triangle with vertices a, b, c."""
+
+from __future__ import annotations
+
+import math
+
+from .hit_info import HitInfo
+from .hittable import Hittable
+from .ray import Ray
+from .vec3 import Vec3, cross
+
+
+class Triangle(Hittable):
+    """Front face normal = normalize((b - a) x (c - a)).
+
+    Surface coordinates (u, v) are the barycentric weights of b and c, so the
+    triangle is the half of Quad(a, b - a, c - a) with u + v <= 1 and shares its
+    texture mapping.
+    """
+
+    def __init__(self, a: Vec3, b: Vec3, c: Vec3, material) -> None:
+        self.a, self.b, self.c = a, b, c
+        self.e1 = b - a
+        self.e2 = c - a
+        n = cross(self.e1, self.e2)
+        n_len = n.length()
+        if not n_len > 0.0 or not math.isfinite(n_len):
+            raise ValueError("triangle is degenerate: its vertices are collinear")
+        self.normal = n / n_len
+        self.material = material
+        self._area = 0.5 * n_len
+
+    def _barycentric(self, ray: Ray) -> tuple[float, float, float] | None:
+        """Moller-Trumbore: (t, u, v) of the ray's hit with the triangle's plane
+        inside the triangle, or None."""
+        e1, e2, o, d = self.e1, self.e2, ray.origin, ray.direction
+        # p = d x e2
+        px = d.e1 * e2.e2 - d.e2 * e2.e1
+        py = d.e2 * e2.e0 - d.e0 * e2.e2
+        pz = d.e0 * e2.e1 - d.e1 * e2.e0
+        det = e1.e0 * px + e1.e1 * py + e1.e2 * pz
+        if det == 0.0:
+            return None  # parallel to the plane
+        inv = 1.0 / det
+        a = self.a
+        sx, sy, sz = o.e0 - a.e0, o.e1 - a.e1, o.e2 - a.e2
+        u = (sx * px + sy * py + sz * pz) * inv
+        if u < 0.0 or u > 1.0:
+            return None
+        # q = s x e1
+        qx = sy * e1.e2 - sz * e1.e1
+        qy = sz * e1.e0 - sx * e1.e2
+        qz = sx * e1.e1 - sy * e1.e0
+        v = (d.e0 * qx + d.e1 * qy + d.e2 * qz) * inv
+        if v < 0.0 or u + v > 1.0:
+            return None
+        t = (e2.e0 * qx + e2.e1 * qy + e2.e2 * qz) * inv
+        return t, u, v
+
+    def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
+        r = self._barycentric(ray)
+        if r is None or not t_min < r[0] < t_max:
+            return None
+        return r[0]
+
+    def hit_info(self, ray: Ray, t: float) -> HitInfo:
+        n, d = self.normal, ray.direction
+        front_face = n.e0 * d.e0 + n.e1 * d.e1 + n.e2 * d.e2 < 0.0
+        return HitInfo(ray.at(t), n if front_face else -n, t, front_face, self.material, self)
+
+    def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
+        # Barycentric coordinates of the hit point from areas of sub-triangles.
+        p = hit.point - self.a
+        e1, e2 = self.e1, self.e2
+        d00 = e1.e0 * e1.e0 + e1.e1 * e1.e1 + e1.e2 * e1.e2
+        d01 = e1.e0 * e2.e0 + e1.e1 * e2.e1 + e1.e2 * e2.e2
+        d11 = e2.e0 * e2.e0 + e2.e1 * e2.e1 + e2.e2 * e2.e2
+        d20 = p.e0 * e1.e0 + p.e1 * e1.e1 + p.e2 * e1.e2
+        d21 = p.e0 * e2.e0 + p.e1 * e2.e1 + p.e2 * e2.e2
+        denom = d00 * d11 - d01 * d01
+        u = (d11 * d20 - d01 * d21) / denom
+        v = (d00 * d21 - d01 * d20) / denom
+        return min(1.0, max(0.0, u)), min(1.0, max(0.0, v))
+
+    def area(self) -> float:
+        return self._area
+
+    def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:
+        # Uniform by area: s = sqrt(r1) warps the unit square onto the triangle.
+        s = math.sqrt(r1)
+        wb, wc = s * (1.0 - r2), s * r2
+        a, e1, e2 = self.a, self.e1, self.e2
+        p = Vec3(a.e0 + wb * e1.e0 + wc * e2.e0, a.e1 + wb * e1.e1 + wc * e2.e1, a.e2 + wb * e1.e2 + wc * e2.e2)
+        return p, self.normal

@@ -1,0 +1,1 @@
+"""Bundled scenes (installed from the top-level scenes/ folder)."""

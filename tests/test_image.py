@@ -1,0 +1,525 @@
+"""Tests for rtpy.image: 8-bit conversion, file formats, atomic writes, path checks."""
+
+from __future__ import annotations
+
+import io
+import os
+import stat
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from PIL import Image
+
+from rtpy.image import (
+    OutputError,
+    RenderedImage,
+    atomic_write,
+    check_image_path,
+    check_linear_path,
+    check_writable,
+    read_pfm,
+    to_8bit,
+    write_linear,
+    write_npy,
+    write_pfm,
+    write_png,
+)
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def rgb(values: list[float]) -> np.ndarray:
+    """A 1 x N image whose pixels are grey with the given values."""
+    v = np.asarray(values, dtype=np.float64)
+    return np.repeat(v[None, :, None], 3, axis=2)
+
+
+def random_image(h: int, w: int, seed: int = 0) -> np.ndarray:
+    """Distinct, un-rounded values in every pixel and channel, some outside [0, 1]."""
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-0.5, 4.0, size=(h, w, 3))
+
+
+def listing(directory: Path) -> list[str]:
+    return sorted(p.name for p in directory.iterdir())
+
+
+# --------------------------------------------------------------------------- to_8bit
+
+
+# NaN -> uint8 casts are platform-dependent (and warn): NaN must be handled explicitly.
+@pytest.mark.filterwarnings("error")
+def test_to_8bit_endpoints_and_clamping() -> None:
+    out = to_8bit(rgb([0.0, 1.0, 1.5, 1e9, np.inf, -0.2, -np.inf, np.nan]), gamma=2.0)
+    assert out.dtype == np.uint8
+    assert out.shape == (1, 8, 3)
+    assert out[0, :, 0].tolist() == [0, 255, 255, 255, 255, 0, 0, 0]
+    # All three channels are treated the same.
+    assert np.array_equal(out[..., 0], out[..., 1])
+    assert np.array_equal(out[..., 0], out[..., 2])
+
+
+# NaN -> uint8 casts are platform-dependent (and warn): NaN must be handled explicitly.
+@pytest.mark.filterwarnings("error")
+def test_to_8bit_nan_is_zero_per_channel() -> None:
+    img = np.array([[[np.nan, 1.0, 0.25]]])
+    assert to_8bit(img, 1.0).tolist() == [[[0, 255, 64]]]
+
+
+def test_to_8bit_gamma_2() -> None:
+    # 0.25 ** (1/2) = 0.5 -> 127.5 -> rounds to 128 (round(255 * 0.5) == 128).
+    assert to_8bit(rgb([0.25]), 2.0)[0, 0, 0] == 128
+    # 0.5 ** (1/2) = 0.7071 -> 180.3 -> 180.
+    assert to_8bit(rgb([0.5]), 2.0)[0, 0, 0] == 180
+
+
+def test_to_8bit_gamma_2_2() -> None:
+    # 0.5 ** (1/2.2) = 0.7297 -> 186.08 -> 186; gamma encoding brightens mid-tones.
+    assert to_8bit(rgb([0.5]), 2.2)[0, 0, 0] == 186
+
+
+def test_to_8bit_gamma_1_is_linear() -> None:
+    values = [0.0, 0.1, 0.2, 0.5, 0.75, 1.0]
+    out = to_8bit(rgb(values), 1.0)[0, :, 0].tolist()
+    assert out == [0, 26, 51, 128, 191, 255]
+    # No encoding: output / 255 equals the input to within half a step.
+    assert np.all(np.abs(np.array(out) / 255.0 - np.array(values)) <= 0.5 / 255.0)
+
+
+def test_to_8bit_does_not_modify_input() -> None:
+    img = np.array([[[np.nan, 2.0, -1.0]]])
+    to_8bit(img, 2.0)
+    assert np.isnan(img[0, 0, 0]) and img[0, 0, 1] == 2.0 and img[0, 0, 2] == -1.0
+
+
+@pytest.mark.parametrize("gamma", [0.0, -1.0, float("nan"), float("inf")])
+def test_to_8bit_rejects_bad_gamma(gamma: float) -> None:
+    with pytest.raises(ValueError, match="gamma"):
+        to_8bit(rgb([0.5]), gamma)
+
+
+@pytest.mark.parametrize("shape", [(4, 4), (4, 4, 4), (4, 4, 1), (3,)])
+def test_to_8bit_rejects_bad_shape(shape: tuple[int, ...]) -> None:
+    with pytest.raises(ValueError, match="shape"):
+        to_8bit(np.zeros(shape), 2.0)
+
+
+finite_or_inf = st.floats(allow_nan=False, min_value=-1e300, max_value=1e300) | st.sampled_from(
+    [float("inf"), float("-inf")]
+)
+
+
+@given(a=finite_or_inf, b=finite_or_inf, gamma=st.floats(min_value=0.2, max_value=5.0))
+def test_to_8bit_monotone(a: float, b: float, gamma: float) -> None:
+    lo, hi = min(a, b), max(a, b)
+    out = to_8bit(rgb([lo, hi]), gamma)[0, :, 0]
+    assert int(out[0]) <= int(out[1])
+
+
+@given(x=st.floats(min_value=0.0, max_value=1.0), gamma=st.floats(min_value=0.2, max_value=5.0))
+def test_to_8bit_matches_formula(x: float, gamma: float) -> None:
+    expected = np.floor(255.0 * x ** (1.0 / gamma) + 0.5)
+    assert to_8bit(rgb([x]), gamma)[0, 0, 0] == expected
+
+
+# --------------------------------------------------------------------------- PFM
+
+
+@pytest.mark.parametrize("h, w", [(1, 1), (2, 3), (3, 2), (1, 5), (5, 1), (7, 4)])
+def test_pfm_round_trip(tmp_path: Path, h: int, w: int) -> None:
+    img = random_image(h, w, seed=h * 10 + w)
+    path = tmp_path / "img.pfm"
+    assert write_pfm(path, img) == path
+    back = read_pfm(path)
+    assert back.dtype == np.float32
+    assert back.shape == (h, w, 3)
+    assert np.array_equal(back, img.astype(np.float32))
+
+
+def test_pfm_header_and_row_order(tmp_path: Path) -> None:
+    h, w = 3, 5
+    img = random_image(h, w, seed=1)
+    path = tmp_path / "img.pfm"
+    write_pfm(path, img)
+    raw = path.read_bytes()
+    header = b"PF\n5 3\n-1.0\n"
+    assert raw[: len(header)] == header
+    assert len(raw) == len(header) + h * w * 3 * 4
+    data = np.frombuffer(raw[len(header) :], dtype="<f4").reshape(h, w, 3)
+    # Row 0 in the file is the BOTTOM image row; the last file row is the top.
+    assert np.array_equal(data[0], img[-1].astype(np.float32))
+    assert np.array_equal(data[-1], img[0].astype(np.float32))
+    assert np.array_equal(data[::-1], img.astype(np.float32))
+
+
+def test_pfm_keeps_values_outside_0_1_and_no_gamma(tmp_path: Path) -> None:
+    img = rgb([-2.0, 0.25, 1000.0])
+    path = tmp_path / "hdr.pfm"
+    write_pfm(path, img)
+    assert read_pfm(path)[0, :, 0].tolist() == [-2.0, 0.25, 1000.0]
+
+
+def test_read_pfm_big_endian(tmp_path: Path) -> None:
+    img = random_image(2, 3, seed=2).astype(np.float32)
+    path = tmp_path / "be.pfm"
+    path.write_bytes(b"PF\n3 2\n1.0\n" + np.ascontiguousarray(img[::-1], dtype=">f4").tobytes())
+    back = read_pfm(path)
+    assert back.dtype == np.float32
+    assert np.array_equal(back, img)
+
+
+def test_read_pfm_greyscale(tmp_path: Path) -> None:
+    grey = np.array([[1.0, 2.0], [3.0, 4.0], [5.0, 6.0]], dtype=np.float32)  # 3 rows, 2 cols
+    path = tmp_path / "grey.pfm"
+    path.write_bytes(b"Pf\n2 3\n-1.0\n" + grey[::-1].astype("<f4").tobytes())
+    back = read_pfm(path)
+    assert back.shape == (3, 2, 3)
+    for c in range(3):
+        assert np.array_equal(back[..., c], grey)
+
+
+@pytest.mark.parametrize(
+    "content",
+    [
+        b"P6\n1 1\n255\n\x00\x00\x00",  # not a PFM
+        b"PF\n2 2\n-1.0\n" + b"\x00" * 12,  # truncated data
+        b"PF\n2\n",  # truncated header
+        b"PF\nx 2\n-1.0\n" + b"\x00" * 48,  # bad width
+    ],
+)
+def test_read_pfm_rejects_invalid(tmp_path: Path, content: bytes) -> None:
+    path = tmp_path / "bad.pfm"
+    path.write_bytes(content)
+    with pytest.raises(ValueError, match="bad.pfm"):
+        read_pfm(path)
+
+
+# --------------------------------------------------------------------------- npy / png / jpg
+
+
+def test_npy_round_trip_keeps_float64(tmp_path: Path) -> None:
+    img = random_image(3, 4, seed=3)
+    path = tmp_path / "img.npy"
+    write_npy(path, img)
+    assert listing(tmp_path) == ["img.npy"]  # np.save did not add a second ".npy"
+    back = np.load(path)
+    assert back.dtype == np.float64
+    assert back.shape == (3, 4, 3)
+    assert np.array_equal(back, img)
+
+
+def test_write_linear_dispatches_by_extension(tmp_path: Path) -> None:
+    img = random_image(2, 3, seed=4)
+    write_linear(tmp_path / "a.npy", img)
+    write_linear(tmp_path / "b.PFM", img)
+    assert np.array_equal(np.load(tmp_path / "a.npy"), img)
+    assert (tmp_path / "b.PFM").read_bytes().startswith(b"PF\n3 2\n-1.0\n")
+    assert np.array_equal(read_pfm(tmp_path / "b.PFM"), img.astype(np.float32))
+    with pytest.raises(OutputError, match="c.png"):
+        write_linear(tmp_path / "c.png", img)
+
+
+@pytest.mark.parametrize("gamma", [1.0, 2.0, 2.2])
+def test_png_round_trip(tmp_path: Path, gamma: float) -> None:
+    img = random_image(3, 5, seed=5) / 4.0
+    path = tmp_path / "img.png"
+    write_png(path, img, gamma)
+    with Image.open(path) as pil:
+        assert pil.format == "PNG"
+        assert pil.mode == "RGB"
+        assert pil.size == (5, 3)
+        back = np.asarray(pil)
+    assert np.array_equal(back, to_8bit(img, gamma))
+
+
+@pytest.mark.parametrize("name", ["img.jpg", "img.jpeg", "IMG.JPG"])
+def test_jpeg_written_by_extension(tmp_path: Path, name: str) -> None:
+    img = np.full((4, 6, 3), 0.25)
+    path = tmp_path / name
+    write_png(path, img, 2.0)
+    with Image.open(path) as pil:
+        assert pil.format == "JPEG"
+        assert pil.size == (6, 4)
+        back = np.asarray(pil).astype(int)
+    assert np.all(np.abs(back - 128) <= 2)  # lossy, but a flat image survives closely
+
+
+def test_write_png_rejects_linear_extension(tmp_path: Path) -> None:
+    with pytest.raises(OutputError, match="img.pfm"):
+        write_png(tmp_path / "img.pfm", rgb([0.5]), 2.0)
+    assert listing(tmp_path) == []
+
+
+# --------------------------------------------------------------------------- atomic_write
+
+
+class Boom(Exception):
+    pass
+
+
+def test_atomic_write_success_uses_temp_in_same_dir(tmp_path: Path) -> None:
+    target = tmp_path / "out.bin"
+    seen: list[Path] = []
+
+    def write(tmp: Path) -> None:
+        seen.append(tmp)
+        assert tmp.parent == tmp_path
+        assert tmp.name.startswith(".out.bin.") and tmp.name.endswith(".tmp")
+        assert not target.exists()  # the target only appears at the end
+        tmp.write_bytes(b"hello")
+
+    assert atomic_write(target, write) == target
+    assert target.read_bytes() == b"hello"
+    assert len(seen) == 1 and not seen[0].exists()
+    assert listing(tmp_path) == ["out.bin"]
+
+
+@pytest.mark.parametrize("exc", [Boom("disk full"), KeyboardInterrupt()])
+def test_atomic_write_failure_leaves_no_file(tmp_path: Path, exc: BaseException) -> None:
+    target = tmp_path / "out.png"
+
+    def write(tmp: Path) -> None:
+        tmp.write_bytes(b"half a PNG")
+        raise exc
+
+    with pytest.raises(type(exc)):
+        atomic_write(target, write)
+    assert not target.exists()
+    assert listing(tmp_path) == []
+
+
+def test_atomic_write_failure_keeps_old_content(tmp_path: Path) -> None:
+    target = tmp_path / "out.png"
+    target.write_bytes(b"old image")
+
+    def write(tmp: Path) -> None:
+        tmp.write_bytes(b"new, partial")
+        raise Boom("crash")
+
+    with pytest.raises(Boom):
+        atomic_write(target, write)
+    assert target.read_bytes() == b"old image"
+    assert listing(tmp_path) == ["out.png"]
+
+
+def test_atomic_write_replaces_existing(tmp_path: Path) -> None:
+    target = tmp_path / "out.txt"
+    target.write_bytes(b"old")
+    atomic_write(target, lambda tmp: tmp.write_bytes(b"new"))
+    assert target.read_bytes() == b"new"
+    assert listing(tmp_path) == ["out.txt"]
+
+
+def test_failed_write_png_leaves_no_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    def fail(self: Image.Image, *args: object, **kwargs: object) -> None:
+        raise Boom("encoder crashed")
+
+    monkeypatch.setattr(Image.Image, "save", fail)
+    with pytest.raises(Boom):
+        write_png(tmp_path / "img.png", rgb([0.5]), 2.0)
+    assert listing(tmp_path) == []
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX permission bits")
+def test_atomic_write_file_mode(tmp_path: Path) -> None:
+    old_umask = os.umask(0o022)
+    try:
+        new = tmp_path / "new.bin"
+        atomic_write(new, lambda tmp: tmp.write_bytes(b"x"))
+        # Not tempfile's private 0o600: a normal file for the current umask.
+        assert stat.S_IMODE(new.stat().st_mode) == 0o644
+        existing = tmp_path / "existing.bin"
+        existing.write_bytes(b"old")
+        existing.chmod(0o640)
+        atomic_write(existing, lambda tmp: tmp.write_bytes(b"new"))
+        assert stat.S_IMODE(existing.stat().st_mode) == 0o640
+    finally:
+        os.umask(old_umask)
+
+
+# --------------------------------------------------------------------------- path checks
+
+
+def test_check_writable_good_paths(tmp_path: Path) -> None:
+    assert check_image_path(tmp_path / "x.png") == tmp_path / "x.png"
+    assert check_image_path(str(tmp_path / "x.JPEG")) == tmp_path / "x.JPEG"
+    assert check_linear_path(tmp_path / "x.pfm") == tmp_path / "x.pfm"
+    assert check_linear_path(tmp_path / "x.npy") == tmp_path / "x.npy"
+    (tmp_path / "exists.png").write_bytes(b"old")
+    assert check_image_path(tmp_path / "exists.png") == tmp_path / "exists.png"
+    assert check_writable(tmp_path / "anything.xyz") == tmp_path / "anything.xyz"
+    assert listing(tmp_path) == ["exists.png"]  # checking creates nothing
+
+
+def test_check_writable_relative_path_in_cwd(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert check_image_path("x.png") == Path("x.png")
+
+
+def test_check_writable_missing_directory(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(OutputError) as info:
+        check_image_path("out/x.png")
+    assert str(info.value) == "cannot write 'out/x.png': directory 'out' does not exist"
+
+
+def test_check_writable_parent_is_a_file(tmp_path: Path) -> None:
+    (tmp_path / "notadir").write_bytes(b"")
+    path = tmp_path / "notadir" / "x.png"
+    with pytest.raises(OutputError, match="not a directory") as info:
+        check_image_path(path)
+    assert str(path) in str(info.value)
+
+
+def test_check_writable_path_is_directory(tmp_path: Path) -> None:
+    path = tmp_path / "render.png"
+    path.mkdir()
+    with pytest.raises(OutputError, match="directory") as info:
+        check_image_path(path)
+    assert str(path) in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "check, name",
+    [
+        (check_image_path, "x.bmp"),
+        (check_image_path, "x.pfm"),
+        (check_image_path, "x"),
+        (check_linear_path, "x.png"),
+        (check_linear_path, "x.exr"),
+    ],
+)
+def test_check_writable_unsupported_extension(tmp_path: Path, check, name: str) -> None:
+    path = tmp_path / name
+    with pytest.raises(OutputError, match="extension") as info:
+        check(path)
+    assert str(path) in str(info.value)
+
+
+def test_check_writable_not_writable(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Simulated, because permission bits do not stop root from writing.
+    monkeypatch.setattr(os, "access", lambda *args, **kwargs: False)
+    path = tmp_path / "x.png"
+    with pytest.raises(OutputError, match="not writable") as info:
+        check_image_path(path)
+    assert str(path) in str(info.value)
+
+
+@pytest.mark.skipif(
+    os.name != "posix" or os.geteuid() == 0, reason="needs POSIX permissions, non-root"
+)
+def test_check_writable_read_only_directory(tmp_path: Path) -> None:
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o500)
+    try:
+        with pytest.raises(OutputError, match="not writable"):
+            check_image_path(ro / "x.png")
+    finally:
+        ro.chmod(0o700)
+
+
+# --------------------------------------------------------------------------- RenderedImage
+
+
+def make_result(h: int = 3, w: int = 5) -> RenderedImage:
+    return RenderedImage(random_image(h, w, seed=7) / 4.0, gamma=2.2, spp=16)
+
+
+def test_rendered_image_attributes() -> None:
+    img = RenderedImage(np.zeros((3, 5, 3), dtype=np.float32), spp=8)
+    assert img.linear.dtype == np.float64
+    assert (img.width, img.height) == (5, 3)
+    assert img.gamma == 2.0
+    assert img.spp == 8 and img.samples_min == 8 and img.samples_max == 8
+    assert img.interrupted is False
+    assert img.stats == {}
+    partial = RenderedImage(
+        np.zeros((2, 2, 3)),
+        spp=64,
+        samples_min=3,
+        samples_max=4,
+        interrupted=True,
+        stats={"seconds": 1.5},
+    )
+    assert (partial.samples_min, partial.samples_max) == (3, 4)
+    assert partial.interrupted is True
+    assert partial.stats["seconds"] == 1.5
+
+
+def test_rendered_image_rejects_bad_shape() -> None:
+    with pytest.raises(ValueError, match="shape"):
+        RenderedImage(np.zeros((3, 5)))
+
+
+def test_rendered_image_pil_size_and_origin() -> None:
+    linear = np.zeros((3, 5, 3))
+    linear[0, 4] = [1.0, 0.0, 0.0]  # top-right pixel red
+    linear[2, 0] = [0.0, 0.0, 1.0]  # bottom-left pixel blue
+    result = RenderedImage(linear)
+    pil = result.pil
+    assert isinstance(pil, Image.Image)
+    assert pil.mode == "RGB"
+    assert pil.size == (5, 3)  # (W, H)
+    assert pil.getpixel((4, 0)) == (255, 0, 0)
+    assert pil.getpixel((0, 2)) == (0, 0, 255)
+    assert pil.getpixel((0, 0)) == (0, 0, 0)
+    assert np.array_equal(np.asarray(result.to_pil()), np.asarray(pil))
+
+
+def test_rendered_image_pil_uses_gamma() -> None:
+    result = RenderedImage(np.full((1, 1, 3), 0.25), gamma=2.0)
+    assert result.pil.getpixel((0, 0)) == (128, 128, 128)
+    assert RenderedImage(np.full((1, 1, 3), 0.25), gamma=1.0).pil.getpixel((0, 0)) == (64,) * 3
+
+
+def test_rendered_image_repr_png() -> None:
+    result = make_result()
+    data = result._repr_png_()
+    assert isinstance(data, bytes)
+    assert data.startswith(PNG_SIGNATURE)
+    with Image.open(io.BytesIO(data)) as pil:
+        assert pil.size == (5, 3)
+        assert np.array_equal(np.asarray(pil), to_8bit(result.linear, result.gamma))
+
+
+def test_rendered_image_repr() -> None:
+    text = repr(make_result(h=3, w=5))
+    assert "5x3" in text and "spp=16" in text and "interrupted=False" in text
+    partial = RenderedImage(
+        np.zeros((2, 2, 3)), spp=64, samples_min=3, samples_max=4, interrupted=True
+    )
+    assert "interrupted=True" in repr(partial)
+
+
+def test_rendered_image_save_all_extensions(tmp_path: Path) -> None:
+    result = make_result()
+    expected_8bit = to_8bit(result.linear, result.gamma)
+    for name in ["a.png", "b.jpg", "c.jpeg", "d.npy", "e.pfm"]:
+        assert result.save(tmp_path / name) == tmp_path / name
+    assert listing(tmp_path) == ["a.png", "b.jpg", "c.jpeg", "d.npy", "e.pfm"]
+    with Image.open(tmp_path / "a.png") as pil:
+        assert np.array_equal(np.asarray(pil), expected_8bit)
+    for name in ["b.jpg", "c.jpeg"]:
+        with Image.open(tmp_path / name) as pil:
+            assert pil.format == "JPEG" and pil.size == (5, 3)
+    # Linear outputs hold the raw values: no clamping, no gamma.
+    assert np.array_equal(np.load(tmp_path / "d.npy"), result.linear)
+    assert np.array_equal(read_pfm(tmp_path / "e.pfm"), result.linear.astype(np.float32))
+
+
+def test_rendered_image_save_unsupported(tmp_path: Path) -> None:
+    path = tmp_path / "out.bmp"
+    with pytest.raises(OutputError, match="out.bmp"):
+        make_result().save(path)
+    assert listing(tmp_path) == []
+
+
+def test_rendered_image_save_missing_directory(tmp_path: Path) -> None:
+    with pytest.raises(OutputError, match="does not exist"):
+        make_result().save(tmp_path / "missing" / "out.png")
