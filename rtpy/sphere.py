@@ -18,30 +18,35 @@ class Sphere(Hittable):
         self.center = center
         self.radius = radius
         self.material = material
+        # Plain floats for the hot intersection loop.
+        self._cx, self._cy, self._cz = center.e0, center.e1, center.e2
+        self._r2 = radius * radius
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
-        c, o, d = self.center, ray.origin, ray.direction
+        o, d = ray.origin, ray.direction
         dx, dy, dz = d.e0, d.e1, d.e2
-        ocx, ocy, ocz = c.e0 - o.e0, c.e1 - o.e1, c.e2 - o.e2  # origin -> center
-        a = dx * dx + dy * dy + dz * dz
+        ocx, ocy, ocz = self._cx - o.e0, self._cy - o.e1, self._cz - o.e2  # origin -> center
         h = dx * ocx + dy * ocy + dz * ocz
-        r = self.radius
+        c_term = ocx * ocx + ocy * ocy + ocz * ocz - self._r2  # > 0: origin outside
+        if h < 0.0 and c_term > 0.0:
+            return None  # outside and moving away
+        a = dx * dx + dy * dy + dz * dz
         # The textbook discriminant h^2 - a*c cancels catastrophically for big
         # spheres seen from far away. a * (r^2 - |f|^2), with f the offset from
         # the center to the ray's closest point to it, is the same number
         # computed without cancellation (pbrt-v4, Ray Tracing Gems ch. 7).
         k = h / a
         fx, fy, fz = ocx - k * dx, ocy - k * dy, ocz - k * dz
-        f = math.sqrt(fx * fx + fy * fy + fz * fz)
+        f2 = fx * fx + fy * fy + fz * fz
+        if f2 > self._r2:
+            return None  # the line passes the sphere by
+        r, f = self.radius, math.sqrt(f2)
         disc = a * (r - f) * (r + f)
-        if disc < 0.0:
-            return None
         # Roots (h -+ sqrt(disc)) / a, written as c/q and q/a so neither
         # subtracts two nearly equal numbers.
         q = h + math.copysign(math.sqrt(disc), h)
         if q == 0.0:
             return None
-        c_term = ocx * ocx + ocy * ocy + ocz * ocz - r * r
         t0 = c_term / q
         t1 = q / a
         if t0 > t1:

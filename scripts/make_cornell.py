@@ -124,7 +124,7 @@ def build() -> str:
         "look_at = [278, 278, 0]\n",
         "vfov = 40\n",
         "aspect_ratio = 1.0\n",
-        "width = 300  # pure Python is slow: raise it with --width\n",
+        "width = 300  # pure Python is slow: override the width on the command line\n",
         "\n",
         "[render]\n",
         "spp = 64\n",

@@ -22,7 +22,7 @@ from PIL import Image
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 OUT_NAME = "planet.png"
 WIDTH, HEIGHT = 128, 64
-SEED = 7
+SEED = 3
 N_WAVES = 64
 SEA_LEVEL = 0.08  # in units of the noise's standard deviation; ~47% land
 
@@ -71,9 +71,9 @@ def colorize(height_map: np.ndarray, points: np.ndarray, detail: np.ndarray) -> 
     land_t = np.clip((h - SEA_LEVEL) / 2.0, 0.0, 1.0) ** 1.5
     land = LAND_LOW + (LAND_HIGH - LAND_LOW) * land_t
     rgb = np.where(h > SEA_LEVEL, land, ocean)
-    # Polar caps: |y| above ~0.94 (about 70 degrees of latitude), with a ragged edge.
-    polar = np.abs(points[..., 1]) + 0.05 * detail
-    ice = np.clip((polar - 0.94) / 0.02, 0.0, 1.0)[..., np.newaxis]
+    # Polar caps: above about 70 degrees of latitude, with a ragged edge.
+    latitude = np.degrees(np.arcsin(np.abs(points[..., 1])))
+    ice = np.clip((latitude + 4.0 * detail - 70.0) / 2.0, 0.0, 1.0)[..., np.newaxis]
     return rgb + (ICE - rgb) * ice
 
 

@@ -1,0 +1,169 @@
+"""Command line: `python -m rtpy render SCENE ...` and `python -m rtpy scenes`.
+
+Exit status: 0 done, 2 bad input (scene file, option or output path; nothing is
+written), 130 interrupted by Ctrl-C (what was finished is written first).
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import tomllib
+from pathlib import Path
+
+from .image import OutputError, check_image_path, check_linear_path
+from .render_settings import INTEGRATOR_NAMES
+
+EXIT_BAD_INPUT = 2
+EXIT_INTERRUPTED = 130
+
+# --set KEY=VALUE accepts these [render] keys (VALUE is read as a TOML value).
+SETTABLE_KEYS = (
+    "integrator", "spp", "max_depth", "nee", "russian_roulette", "seed", "gamma",
+    "background", "sky", "width",
+)
+
+
+def positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a number >= 1, got {value}")
+    return value
+
+
+def non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {value}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m rtpy", description="rtpy: a teaching ray tracer in Python."
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    r = sub.add_parser(
+        "render", help="render a scene file to an image",
+        description="Render SCENE (a .toml path or a bundled scene's name) to a PNG.",
+    )
+    r.add_argument("scene", metavar="SCENE", help="scene file, or the name of a bundled scene")
+    r.add_argument("-o", "--output", metavar="OUT.png",
+                   help="8-bit image (.png/.jpg), gamma-encoded; default SCENE_NAME.png")
+    r.add_argument("--linear", metavar="OUT.npy|OUT.pfm",
+                   help="also write the linear float image (never gamma-encoded)")
+    r.add_argument("--spp", type=positive_int, help="samples per pixel")
+    r.add_argument("--width", type=positive_int, help="image width in pixels")
+    r.add_argument("--integrator", choices=INTEGRATOR_NAMES)
+    r.add_argument("--max-depth", type=positive_int, help="most ray segments per path")
+    r.add_argument("--seed", type=non_negative_int)
+    r.add_argument("--workers", type=positive_int, default=1, help="processes (default 1)")
+    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help=f"override a [render] key, VALUE in TOML syntax ({', '.join(SETTABLE_KEYS)})")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    sub.add_parser("scenes", help="list the bundled scenes")
+    return parser
+
+
+class UsageError(Exception):
+    pass
+
+
+def parse_set(items: list[str]) -> dict:
+    """--set KEY=VALUE pairs -> {key: value}, values parsed as TOML."""
+    import difflib
+
+    result = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep:
+            raise UsageError(f"--set {item!r}: expected KEY=VALUE")
+        if key not in SETTABLE_KEYS:
+            near = difflib.get_close_matches(key, SETTABLE_KEYS, n=1)
+            hint = f"; did you mean '{near[0]}'?" if near else ""
+            raise UsageError(f"--set {key}: not a settable key ({', '.join(SETTABLE_KEYS)}){hint}")
+        try:
+            value = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text.strip()  # a bare word such as path or center
+        result[key] = value
+    return result
+
+
+def command_scenes() -> int:
+    from .bundled import bundled_scenes
+
+    scenes = bundled_scenes()
+    width = max((len(name) for name, _ in scenes), default=0)
+    for name, description in scenes:
+        print(f"{name:<{width}}  {description}")
+    return 0
+
+
+def command_render(args: argparse.Namespace) -> int:
+    from . import render
+    from .bundled import resolve_scene
+    from .scene_file import SceneError, load_scene, validate_overrides
+
+    try:
+        path = resolve_scene(args.scene)
+        scene = load_scene(path)
+        overrides = parse_set(args.set)
+        for key in ("spp", "width", "integrator", "seed"):
+            if getattr(args, key) is not None:
+                overrides[key] = getattr(args, key)
+        if args.max_depth is not None:
+            overrides["max_depth"] = args.max_depth
+        overrides = validate_overrides(overrides)
+        output = Path(args.output) if args.output else Path(f"{path.stem}.png")
+        check_image_path(output)
+        linear = check_linear_path(args.linear) if args.linear else None
+    except (SceneError, OutputError, UsageError) as err:
+        print(f"rtpy: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+    image = render(scene, workers=args.workers, quiet=args.quiet, **overrides)
+
+    # A second Ctrl-C while the partial image is written ends at once; writes
+    # are atomic, so no half-written file is left.
+    if image.interrupted:
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+    written = [image.save(output)]
+    if linear is not None:
+        written.append(image.save(linear))
+    stats = image.stats
+    files = ", ".join(str(p) for p in written)
+    if image.interrupted:
+        print(
+            f"rtpy: interrupted: wrote {files} holding {image.samples_min}-{image.samples_max} "
+            f"of {image.spp} samples per pixel",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
+    print(
+        f"rtpy: wrote {files}: {image.width}x{image.height}, {image.spp} spp, "
+        f"{stats['seconds']:.2f} s, {stats['paths_per_second']:,.0f} paths/s",
+        file=sys.stderr,
+    )
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)  # usage errors exit with status 2
+    if args.command == "scenes":
+        return command_scenes()
+    return command_render(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,295 @@
+"""Integrators against answers known in closed form, and against each other.
+
+Statistical checks use fixed seeds and z-tests against the noise measured from
+the samples themselves (|z| < Z_MAX, about a 1e-4 two-sided false-alarm rate,
+Bonferroni-corrected where several tests are made at once).
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+
+import numpy as np
+import pytest
+
+import rtpy
+from rtpy import (
+    Camera,
+    Color,
+    Dielectric,
+    DiffuseLight,
+    Lambertian,
+    Metal,
+    PointLight,
+    Quad,
+    RenderSettings,
+    Scene,
+    Sphere,
+    Vec3,
+)
+from rtpy.integrators import INTEGRATORS, make_integrator
+from rtpy.sampling import make_generator, use_generator
+
+
+def z_limit(n_tests: int, alpha: float = 1e-4) -> float:
+    """Two-sided z threshold for family-wise error alpha over n_tests (Bonferroni)."""
+    from statistics import NormalDist
+
+    return NormalDist().inv_cdf(1.0 - alpha / (2.0 * n_tests))
+
+
+# --- a Lambertian plane under a point light: exact per pixel ------------------
+
+
+def test_point_light_on_plane_is_exact_per_pixel():
+    """direct = albedo/pi * I * cos(theta) / d^2 at every pixel's center ray.
+    The course code has no 1/d^2 and an unnormalised cosine: both would fail."""
+    albedo, intensity = 0.6, Color(5.0, 2.5, 1.0)
+    light_pos = Vec3(0.3, 2.0, -0.5)
+    plane = Quad(Vec3(-50, 0, -50), Vec3(100, 0, 0), Vec3(0, 0, 100), None)
+    plane.material = Lambertian(Color(albedo, albedo, albedo))
+    # Quad(q, u, v) with u x v pointing down; a Lambertian plane is two-sided,
+    # which the test relies on only through hit.normal facing the camera.
+    scene = Scene([plane], [PointLight(light_pos, intensity)])
+    camera = Camera(Vec3(0, 3, 2), Vec3(0, 0, -1), vfov=70, aspect_ratio=1.5, width=30)
+    integrator = make_integrator(RenderSettings(integrator="direct"))
+    checked = 0
+    with use_generator(make_generator(7)):
+        for j in range(camera.height):
+            for i in range(camera.width):
+                ray = camera.get_center_ray(i, j)
+                got = integrator.radiance(ray, scene)
+                o, d = ray.origin, ray.direction
+                if d.e1 >= 0:
+                    assert got == Color(0, 0, 0)
+                    continue
+                t = -o.e1 / d.e1
+                p = (o.e0 + t * d.e0, 0.0, o.e2 + t * d.e2)
+                to_light = (light_pos.e0 - p[0], light_pos.e1, light_pos.e2 - p[2])
+                d2 = sum(c * c for c in to_light)
+                cos_theta = to_light[1] / math.sqrt(d2)
+                for ch, inten in enumerate((5.0, 2.5, 1.0)):
+                    expected = albedo / math.pi * inten * cos_theta / d2
+                    assert got[ch] == pytest.approx(expected, rel=1e-9)
+                checked += 1
+    assert checked > 100
+
+
+# --- furnace tests -----------------------------------------------------------
+
+
+def furnace_scene(material) -> tuple[Scene, Camera]:
+    scene = Scene([Sphere(Vec3(0, 0, -3), 1.0, material)], background=Color(1.0, 1.0, 1.0))
+    camera = Camera(Vec3(0, 0, 0), Vec3(0, 0, -3), vfov=50, aspect_ratio=1.0, width=24)
+    return scene, camera
+
+
+def pixels_fully_on_sphere(camera: Camera, scene: Scene) -> np.ndarray:
+    """Mask of pixels whose whole footprint sees the sphere (all 4 corners hit)."""
+    mask = np.zeros((camera.height, camera.width), dtype=bool)
+    sphere = scene.objects[0]
+    for j in range(camera.height):
+        for i in range(camera.width):
+            corners = [camera._ray_through(i + dx, j + dy) for dx in (-0.5, 0.5) for dy in (-0.5, 0.5)]
+            mask[j, i] = all(sphere.hit_t(r, 0.0, math.inf) is not None for r in corners)
+    return mask
+
+
+def pixels_fully_off_sphere(camera: Camera, scene: Scene) -> np.ndarray:
+    mask = np.zeros((camera.height, camera.width), dtype=bool)
+    sphere = scene.objects[0]
+    for j in range(camera.height):
+        for i in range(camera.width):
+            corners = [camera._ray_through(i + dx, j + dy) for dx in (-0.5, 0.5) for dy in (-0.5, 0.5)]
+            mask[j, i] = not any(sphere.hit_t(r, 0.0, math.inf) is not None for r in corners)
+    return mask
+
+
+@pytest.mark.parametrize(
+    "integrator,nee", [("direct", True), ("path", True), ("path", False), ("whitted", True)]
+)
+def test_furnace_convex_lambertian_sphere_shows_its_albedo(integrator, nee):
+    """A convex object never sees itself: lit by a uniform environment of radiance 1
+    its radiance is exactly its albedo, whatever direction a bounce takes (so every
+    sample is exact, no noise). A missing 1/pdf or cosine would scale it."""
+    a = 0.7
+    scene, camera = furnace_scene(Lambertian(Color(a, 0.5 * a, 0.25)))
+    image = rtpy.render(scene, camera=camera, integrator=integrator, nee=nee, spp=4, max_depth=6)
+    on, off = pixels_fully_on_sphere(camera, scene), pixels_fully_off_sphere(camera, scene)
+    assert on.sum() > 50 and off.sum() > 50
+    np.testing.assert_allclose(image.linear[on], np.broadcast_to([a, 0.5 * a, 0.25], (on.sum(), 3)), rtol=1e-12)
+    np.testing.assert_array_equal(image.linear[off], 1.0)
+
+
+@pytest.mark.parametrize("integrator", ["path", "whitted"])
+def test_furnace_glass_sphere_conserves_energy(integrator):
+    """Clear glass (albedo 1) in a white furnace neither adds nor loses light:
+    every pixel is 1, up to the energy still trapped inside after max_depth."""
+    scene, camera = furnace_scene(Dielectric(1.5))
+    image = rtpy.render(scene, camera=camera, integrator=integrator, spp=4, max_depth=40)
+    np.testing.assert_allclose(image.linear, 1.0, atol=1e-6)
+
+
+class GlowingLambertian(Lambertian):
+    """Diffuse reflection plus uniform emission Le from both faces."""
+
+    is_emitter = True
+
+    def __init__(self, albedo: Color, emit: Color) -> None:
+        super().__init__(albedo)
+        self.emit = emit
+
+    def emitting(self, hit):
+        return self.emit
+
+
+@pytest.mark.parametrize("nee", [True, False])
+def test_furnace_inside_glowing_sphere_converges_to_le_over_one_minus_rho(nee):
+    """Inside a closed sphere of albedo rho that emits Le, radiance is the same
+    everywhere: L = Le + rho L, so L = Le / (1 - rho) = 1 for rho = Le = 0.5.
+    The sphere is also an area light sampled from inside it, so this checks the
+    area-to-solid-angle conversion and the MIS weights, with Russian roulette on."""
+    rho, le = 0.5, 0.5
+    sphere = Sphere(Vec3(0, 0, 0), 2.0, GlowingLambertian(Color(rho, rho, rho), Color(le, le, le)))
+    scene = Scene([sphere])
+    camera = Camera(Vec3(0.3, -0.2, 0.1), Vec3(0, 0, -1), vfov=100, aspect_ratio=1.0, width=12)
+    image = rtpy.render(
+        scene, camera=camera, integrator="path", nee=nee, spp=32, max_depth=200,
+        russian_roulette=3, seed=11,
+    )
+    pixels = image.linear[..., 0].ravel()
+    mean = pixels.mean()
+    standard_error = pixels.std(ddof=1) / math.sqrt(pixels.size)
+    assert standard_error > 0  # the estimate is noisy: the test measures that noise
+    z = (mean - le / (1 - rho)) / standard_error
+    assert abs(z) < z_limit(1), f"mean {mean:.5f} +- {standard_error:.5f}, z = {z:.2f}"
+
+
+# --- strategies that must agree ----------------------------------------------
+
+
+def box_scene() -> tuple[Scene, list]:
+    white = Lambertian(Color(0.73, 0.73, 0.73))
+    red = Lambertian(Color(0.65, 0.05, 0.05))
+    objects = [
+        Quad(Vec3(-1, -1, -1), Vec3(2, 0, 0), Vec3(0, 0, -2), white),  # floor
+        Quad(Vec3(-1, -1, -3), Vec3(2, 0, 0), Vec3(0, 2, 0), white),  # back wall
+        Quad(Vec3(-1, -1, -1), Vec3(0, 0, -2), Vec3(0, 2, 0), red),  # left wall
+        Sphere(Vec3(0.3, -0.6, -2.0), 0.4, Metal(Color(0.8, 0.8, 0.8), 0.3)),
+        Sphere(Vec3(-0.4, -0.7, -1.6), 0.3, white),
+        # a ceiling light facing down (u x v = -y)
+        Quad(Vec3(-0.4, 0.99, -1.6), Vec3(0, 0, -0.8), Vec3(0.8, 0, 0), DiffuseLight(Color(6, 6, 6))),
+    ]
+    scene = Scene(objects, [PointLight(Vec3(0.6, 0.5, -1.2), Color(0.5, 0.5, 0.5))])
+    camera = Camera(Vec3(0, 0, 1.5), Vec3(0, -0.2, -2), vfov=60, aspect_ratio=1.0, width=40)
+    # Camera rays that see a surface other than the light, spread over the image.
+    rays = []
+    for i, j in [(8, 14), (12, 20), (16, 26), (20, 18), (24, 24), (26, 28), (10, 28), (22, 14)]:
+        ray = camera.get_center_ray(i, j)
+        hit = scene.find_intersection(ray, rtpy.Interval(0.0, math.inf))
+        if hit is not None and not hit.material.is_emitter and not hit.material.is_specular:
+            rays.append(ray)
+    assert len(rays) >= 5
+    return scene, rays
+
+
+def sample_mean(integrator, ray, scene, n, seed):
+    values = []
+    with use_generator(make_generator(seed)):
+        for _ in range(n):
+            values.append(integrator.radiance(ray, scene).e1)
+    return statistics.fmean(values), statistics.stdev(values) / math.sqrt(n)
+
+
+def test_path_with_and_without_nee_agree():
+    """BRDF sampling alone and MIS with light sampling estimate the same integral:
+    per-ray means agree within the measured noise. Light counted twice (the course
+    code's bug) or a wrong MIS weight would shift the MIS estimate."""
+    scene, rays = box_scene()
+    with_nee = make_integrator(RenderSettings(nee=True, max_depth=5))
+    without = make_integrator(RenderSettings(nee=False, max_depth=5))
+    limit = z_limit(len(rays))
+    for k, ray in enumerate(rays):
+        m1, s1 = sample_mean(with_nee, ray, scene, 1500, seed=100 + k)
+        m2, s2 = sample_mean(without, ray, scene, 4000, seed=200 + k)
+        z = (m1 - m2) / math.hypot(s1, s2)
+        assert abs(z) < limit, f"ray {k}: nee {m1:.4f}+-{s1:.4f} vs brdf {m2:.4f}+-{s2:.4f}"
+        assert m1 > 0
+
+
+def test_mis_catches_light_counted_twice():
+    """The comparison above has power: adding the emission found by BRDF sampling
+    with weight 1 on top of light sampling (counting light twice) is rejected."""
+    from rtpy.integrators import direct_lighting, path
+
+    scene, rays = box_scene()
+    good = make_integrator(RenderSettings(nee=False, max_depth=5))
+    bad = make_integrator(RenderSettings(nee=True, max_depth=5))
+    original = direct_lighting.emission_weight
+
+    def double_counting(*args):
+        return 1.0
+
+    path.emission_weight = double_counting
+    try:
+        zs = []
+        for k, ray in enumerate(rays):
+            m1, s1 = sample_mean(bad, ray, scene, 1500, seed=100 + k)
+            m2, s2 = sample_mean(good, ray, scene, 4000, seed=200 + k)
+            zs.append((m1 - m2) / math.hypot(s1, s2))
+    finally:
+        path.emission_weight = original
+    assert max(abs(z) for z in zs) > z_limit(len(rays))
+
+
+def test_direct_equals_path_with_max_depth_2():
+    """"direct" is exactly "path" with max_depth 2: same seed, same numbers."""
+    scene, _ = box_scene()
+    camera = Camera(Vec3(0, 0, 1.5), Vec3(0, -0.2, -2), vfov=60, aspect_ratio=1.0, width=16)
+    direct = rtpy.render(scene, camera=camera, integrator="direct", spp=4, seed=5)
+    path = rtpy.render(scene, camera=camera, integrator="path", max_depth=2, spp=4, seed=5)
+    assert direct.linear.max() > 0
+    np.testing.assert_allclose(direct.linear, path.linear, rtol=1e-12, atol=1e-15)
+
+
+def test_whitted_equals_direct_without_specular_materials():
+    """Without mirrors or glass, Whitted ray tracing is direct lighting."""
+    white = Lambertian(Color(0.7, 0.7, 0.7))
+    scene = Scene(
+        [Sphere(Vec3(0, -100.5, -1), 100, white), Sphere(Vec3(0, 0, -1), 0.5, white),
+         Sphere(Vec3(0, 1.5, -1), 0.3, DiffuseLight(Color(5, 5, 5)))],
+        [PointLight(Vec3(1, 1, 0), Color(1, 1, 1))],
+    )
+    camera = Camera(Vec3(0, 0.5, 1), Vec3(0, 0, -1), vfov=60, width=16)
+    direct = rtpy.render(scene, camera=camera, integrator="direct", spp=2, seed=3)
+    whitted = rtpy.render(scene, camera=camera, integrator="whitted", spp=2, seed=3)
+    np.testing.assert_array_equal(direct.linear, whitted.linear)
+
+
+def test_whitted_follows_perfect_mirror():
+    """A mirror facing the camera shows what is behind the camera, scaled by its albedo."""
+    mirror = Quad(Vec3(-5, -5, -2), Vec3(10, 0, 0), Vec3(0, 10, 0), rtpy.Mirror(Color(0.5, 0.6, 0.7)))
+    scene = Scene([mirror], background=Color(2.0, 2.0, 2.0))
+    camera = Camera(Vec3(0, 0, 0), Vec3(0, 0, -1), vfov=30, width=8)
+    image = rtpy.render(scene, camera=camera, integrator="whitted", spp=1)
+    np.testing.assert_allclose(image.linear, np.broadcast_to([1.0, 1.2, 1.4], image.linear.shape), rtol=1e-12)
+
+
+def test_center_shows_albedo_emission_and_background():
+    light = Quad(Vec3(-1, -1, -3), Vec3(1, 0, 0), Vec3(0, 2, 0), DiffuseLight(Color(3, 2, 1)))
+    wall = Quad(Vec3(0, -1, -3), Vec3(1, 0, 0), Vec3(0, 2, 0), Lambertian(Color(0.2, 0.4, 0.6)))
+    scene = Scene([light, wall], background=Color(0.1, 0.1, 0.1))
+    camera = Camera(Vec3(0, 0, 0), Vec3(0, 0, -1), vfov=90, aspect_ratio=2.0, width=40)
+    image = rtpy.render(scene, camera=camera, integrator="center")
+    middle = camera.height // 2
+    np.testing.assert_array_equal(image.linear[middle, 18], [3, 2, 1])  # the light
+    np.testing.assert_array_equal(image.linear[middle, 21], [0.2, 0.4, 0.6])  # the wall
+    np.testing.assert_array_equal(image.linear[middle, 0], [0.1, 0.1, 0.1])  # background
+    assert image.spp == 1
+
+
+def test_every_integrator_is_registered_by_its_scene_name():
+    assert set(INTEGRATORS) == {"center", "jittered", "direct", "whitted", "path"}
+    for name, cls in INTEGRATORS.items():
+        assert cls.name == name
