@@ -93,8 +93,14 @@ class Camera:
     def with_width(self, width: int) -> Camera:
         """The same camera with another image width (height follows the aspect ratio)."""
         return Camera(
-            self.look_from, self.look_at, self.vup, self.vfov, self.aspect_ratio, width,
-            self.defocus_angle, self.focus_distance,
+            self.look_from,
+            self.look_at,
+            self.vup,
+            self.vfov,
+            self.aspect_ratio,
+            width,
+            self.defocus_angle,
+            self.focus_distance,
         )
 
     def _ray_through(self, px: float, py: float) -> Ray:

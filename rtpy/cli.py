@@ -20,8 +20,16 @@ EXIT_INTERRUPTED = 130
 
 # --set KEY=VALUE accepts these [render] keys (VALUE is read as a TOML value).
 SETTABLE_KEYS = (
-    "integrator", "spp", "max_depth", "nee", "russian_roulette", "seed", "gamma",
-    "background", "sky", "width",
+    "integrator",
+    "spp",
+    "max_depth",
+    "nee",
+    "russian_roulette",
+    "seed",
+    "gamma",
+    "background",
+    "sky",
+    "width",
 )
 
 
@@ -52,22 +60,35 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     r = sub.add_parser(
-        "render", help="render a scene file to an image",
+        "render",
+        help="render a scene file to an image",
         description="Render SCENE (a .toml path or a bundled scene's name) to a PNG.",
     )
     r.add_argument("scene", metavar="SCENE", help="scene file, or the name of a bundled scene")
-    r.add_argument("-o", "--output", metavar="OUT.png",
-                   help="8-bit image (.png/.jpg), gamma-encoded; default SCENE_NAME.png")
-    r.add_argument("--linear", metavar="OUT.npy|OUT.pfm",
-                   help="also write the linear float image (never gamma-encoded)")
+    r.add_argument(
+        "-o",
+        "--output",
+        metavar="OUT.png",
+        help="8-bit image (.png/.jpg), gamma-encoded; default SCENE_NAME.png",
+    )
+    r.add_argument(
+        "--linear",
+        metavar="OUT.npy|OUT.pfm",
+        help="also write the linear float image (never gamma-encoded)",
+    )
     r.add_argument("--spp", type=positive_int, help="samples per pixel")
     r.add_argument("--width", type=positive_int, help="image width in pixels")
     r.add_argument("--integrator", choices=INTEGRATOR_NAMES)
     r.add_argument("--max-depth", type=positive_int, help="most ray segments per path")
     r.add_argument("--seed", type=non_negative_int)
     r.add_argument("--workers", type=positive_int, default=1, help="processes (default 1)")
-    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help=f"override a [render] key, VALUE in TOML syntax ({', '.join(SETTABLE_KEYS)})")
+    r.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help=f"override a [render] key, VALUE in TOML syntax ({', '.join(SETTABLE_KEYS)})",
+    )
     r.add_argument("--quiet", action="store_true", help="no progress bar")
 
     sub.add_parser("scenes", help="list the bundled scenes")
@@ -100,6 +121,64 @@ def parse_set(items: list[str]) -> dict:
     return result
 
 
+MAX_WIDTH = 16384
+MAX_SPP = 1_000_000
+
+
+def validate_overrides(overrides: dict) -> dict:
+    """Check command-line overrides as strictly as the scene file's own values;
+    returns them with background turned into a Color."""
+    import math
+
+    from .vec3 import Color
+
+    def fail(key: str, expected: str, value) -> UsageError:
+        return UsageError(f"--set {key}: expected {expected}, got {value!r}")
+
+    def is_int(v) -> bool:
+        return isinstance(v, int) and not isinstance(v, bool)
+
+    checked = {}
+    for key, value in overrides.items():
+        if key in ("spp", "width", "max_depth"):
+            limit = {"spp": MAX_SPP, "width": MAX_WIDTH, "max_depth": 10_000}[key]
+            if not is_int(value) or not 1 <= value <= limit:
+                raise fail(key, f"a whole number from 1 to {limit}", value)
+        elif key in ("russian_roulette", "seed"):
+            if not is_int(value) or value < 0:
+                raise fail(key, "a whole number >= 0", value)
+        elif key in ("nee", "sky"):
+            if not isinstance(value, bool):
+                raise fail(key, "true or false", value)
+        elif key == "gamma":
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, int | float)
+                or not (math.isfinite(value) and value > 0)
+            ):
+                raise fail(key, "a finite number > 0", value)
+        elif key == "integrator":
+            if value not in INTEGRATOR_NAMES:
+                raise fail(key, f"one of {', '.join(INTEGRATOR_NAMES)}", value)
+        elif key == "background":
+            ok = (
+                isinstance(value, list)
+                and len(value) == 3
+                and all(
+                    isinstance(c, int | float)
+                    and not isinstance(c, bool)
+                    and math.isfinite(c)
+                    and c >= 0
+                    for c in value
+                )
+            )
+            if not ok:
+                raise fail(key, "3 finite numbers >= 0, such as [0.1, 0.1, 0.1]", value)
+            value = Color(*map(float, value))
+        checked[key] = value
+    return checked
+
+
 def command_scenes() -> int:
     from .bundled import bundled_scenes
 
@@ -113,7 +192,7 @@ def command_scenes() -> int:
 def command_render(args: argparse.Namespace) -> int:
     from . import render
     from .bundled import resolve_scene
-    from .scene_file import SceneError, load_scene, validate_overrides
+    from .scene_file import SceneError, load_scene
 
     try:
         path = resolve_scene(args.scene)

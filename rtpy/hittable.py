@@ -69,7 +69,9 @@ class Hittable:
             return None
         k = 1.0 / math.sqrt(dist2)
         direction = Vec3(dx * k, dy * k, dz * k)
-        cos_light = abs(direction.e0 * normal.e0 + direction.e1 * normal.e1 + direction.e2 * normal.e2)
+        cos_light = abs(
+            direction.e0 * normal.e0 + direction.e1 * normal.e1 + direction.e2 * normal.e2
+        )
         if cos_light < 1e-12:
             return None
         return direction, dist2 / (cos_light * self.area())

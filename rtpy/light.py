@@ -23,7 +23,12 @@ class LightSample:
     __slots__ = ("direction", "distance", "radiance", "pdf", "is_delta", "point")
 
     def __init__(
-        self, direction: Vec3, distance: float, radiance: Color, pdf: float, is_delta: bool,
+        self,
+        direction: Vec3,
+        distance: float,
+        radiance: Color,
+        pdf: float,
+        is_delta: bool,
         point: Vec3,
     ) -> None:
         self.direction = direction  # unit, from the receiving point toward the light

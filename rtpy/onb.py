@@ -31,3 +31,17 @@ class ONB:
             x * u.e1 + y * v.e1 + z * w.e1,
             x * u.e2 + y * v.e2 + z * w.e2,
         )
+
+
+def local_to_world(w: Vec3, x: float, y: float, z: float) -> Vec3:
+    """x * u + y * v + z * w for the frame ONB(w) builds, without building it
+    (the same numbers; this is the hot path of every diffuse bounce)."""
+    w0, w1, w2 = w.e0, w.e1, w.e2
+    sign = math.copysign(1.0, w2)
+    a = -1.0 / (sign + w2)
+    b = w0 * w1 * a
+    return Vec3(
+        x * (1.0 + sign * w0 * w0 * a) + y * b + z * w0,
+        x * sign * b + y * (sign + w1 * w1 * a) + z * w1,
+        -x * sign * w0 - y * w1 + z * w2,
+    )

@@ -30,8 +30,16 @@ class Quad(Hittable):
         px, py, pz = p.e0 - q.e0, p.e1 - q.e1, p.e2 - q.e2
         u, v = self.u, self.v
         # alpha = w . (p x v), beta = w . (u x p)
-        a = w.e0 * (py * v.e2 - pz * v.e1) + w.e1 * (pz * v.e0 - px * v.e2) + w.e2 * (px * v.e1 - py * v.e0)
-        b = w.e0 * (u.e1 * pz - u.e2 * py) + w.e1 * (u.e2 * px - u.e0 * pz) + w.e2 * (u.e0 * py - u.e1 * px)
+        a = (
+            w.e0 * (py * v.e2 - pz * v.e1)
+            + w.e1 * (pz * v.e0 - px * v.e2)
+            + w.e2 * (px * v.e1 - py * v.e0)
+        )
+        b = (
+            w.e0 * (u.e1 * pz - u.e2 * py)
+            + w.e1 * (u.e2 * px - u.e0 * pz)
+            + w.e2 * (u.e0 * py - u.e1 * px)
+        )
         return a, b
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
@@ -61,5 +69,7 @@ class Quad(Hittable):
 
     def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:
         q, u, v = self.q, self.u, self.v
-        p = Vec3(q.e0 + r1 * u.e0 + r2 * v.e0, q.e1 + r1 * u.e1 + r2 * v.e1, q.e2 + r1 * u.e2 + r2 * v.e2)
+        p = Vec3(
+            q.e0 + r1 * u.e0 + r2 * v.e0, q.e1 + r1 * u.e1 + r2 * v.e1, q.e2 + r1 * u.e2 + r2 * v.e2
+        )
         return p, self.normal

@@ -40,8 +40,12 @@ def spawn_ray(point: Vec3, normal: Vec3, direction: Vec3) -> Ray:
     surface to the side `direction` goes to, so the new ray cannot re-hit the
     surface it starts on; it works for reflected and refracted rays alike.
     """
-    eps = offset_scale(point)
+    eps = SPAWN_ABSOLUTE_OFFSET + SPAWN_RELATIVE_OFFSET * max(
+        abs(point.e0), abs(point.e1), abs(point.e2)
+    )
     if direction.e0 * normal.e0 + direction.e1 * normal.e1 + direction.e2 * normal.e2 < 0.0:
         eps = -eps
-    origin = Vec3(point.e0 + eps * normal.e0, point.e1 + eps * normal.e1, point.e2 + eps * normal.e2)
+    origin = Vec3(
+        point.e0 + eps * normal.e0, point.e1 + eps * normal.e1, point.e2 + eps * normal.e2
+    )
     return Ray(origin, direction)

@@ -31,7 +31,9 @@ class RenderSettings:
 
     def __post_init__(self) -> None:
         if self.integrator not in INTEGRATOR_NAMES:
-            raise ValueError(f"integrator must be one of {', '.join(INTEGRATOR_NAMES)}; got {self.integrator!r}")
+            raise ValueError(
+                f"integrator must be one of {', '.join(INTEGRATOR_NAMES)}; got {self.integrator!r}"
+            )
         if self.spp < 1:
             raise ValueError(f"spp must be >= 1, got {self.spp}")
         if self.max_depth < 1:

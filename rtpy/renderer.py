@@ -122,8 +122,12 @@ class Renderer:
         results: dict[tuple[int, int], np.ndarray] = {}
         total_paths = camera.width * camera.height * spp
         bar = tqdm(
-            total=total_paths, unit="path", unit_scale=True, file=sys.stderr,
-            disable=self.quiet, desc=f"{self.scene.name} ({settings.integrator})",
+            total=total_paths,
+            unit="path",
+            unit_scale=True,
+            file=sys.stderr,
+            disable=self.quiet,
+            desc=f"{self.scene.name} ({settings.integrator})",
             dynamic_ncols=True,
         )
         start = time.perf_counter()
@@ -145,7 +149,10 @@ class Renderer:
         if self.workers == 1:
             integrator = make_integrator(self.settings)
             for unit in units:
-                yield unit, render_unit(self.scene, self.camera, integrator, self.settings.seed, unit)
+                yield (
+                    unit,
+                    render_unit(self.scene, self.camera, integrator, self.settings.seed, unit),
+                )
             return
         pool = multiprocessing.get_context().Pool(
             self.workers, _init_worker, (self.scene, self.camera, self.settings)
@@ -179,7 +186,11 @@ class Renderer:
             "integrator": self.settings.integrator,
         }
         return RenderedImage(
-            linear, gamma=self.settings.gamma, spp=spp,
-            samples_min=int(counts.min()), samples_max=int(counts.max()),
-            interrupted=interrupted, stats=stats,
+            linear,
+            gamma=self.settings.gamma,
+            spp=spp,
+            samples_min=int(counts.min()),
+            samples_max=int(counts.max()),
+            interrupted=interrupted,
+            stats=stats,
         )

@@ -6,7 +6,7 @@ import math
 
 from .hit_info import HitInfo
 from .hittable import Hittable
-from .onb import ONB
+from .onb import local_to_world
 from .ray import Ray
 from .vec3 import Vec3
 
@@ -117,7 +117,7 @@ class Sphere(Hittable):
         c = self.center
         axis = Vec3(c.e0 - p.e0, c.e1 - p.e1, c.e2 - p.e2)
         axis = axis / axis.length()
-        direction = ONB(axis).to_world(sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
+        direction = local_to_world(axis, sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
         return direction, 1.0 / (2.0 * math.pi * one_minus_cos_max)
 
     def direction_pdf(self, p: Vec3, hit: HitInfo) -> float:

@@ -90,5 +90,9 @@ class Triangle(Hittable):
         s = math.sqrt(r1)
         wb, wc = s * (1.0 - r2), s * r2
         a, e1, e2 = self.a, self.e1, self.e2
-        p = Vec3(a.e0 + wb * e1.e0 + wc * e2.e0, a.e1 + wb * e1.e1 + wc * e2.e1, a.e2 + wb * e1.e2 + wc * e2.e2)
+        p = Vec3(
+            a.e0 + wb * e1.e0 + wc * e2.e0,
+            a.e1 + wb * e1.e1 + wc * e2.e1,
+            a.e2 + wb * e1.e2 + wc * e2.e2,
+        )
         return p, self.normal

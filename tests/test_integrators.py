@@ -91,7 +91,9 @@ def pixels_fully_on_sphere(camera: Camera, scene: Scene) -> np.ndarray:
     sphere = scene.objects[0]
     for j in range(camera.height):
         for i in range(camera.width):
-            corners = [camera._ray_through(i + dx, j + dy) for dx in (-0.5, 0.5) for dy in (-0.5, 0.5)]
+            corners = [
+                camera._ray_through(i + dx, j + dy) for dx in (-0.5, 0.5) for dy in (-0.5, 0.5)
+            ]
             mask[j, i] = all(sphere.hit_t(r, 0.0, math.inf) is not None for r in corners)
     return mask
 
@@ -101,7 +103,9 @@ def pixels_fully_off_sphere(camera: Camera, scene: Scene) -> np.ndarray:
     sphere = scene.objects[0]
     for j in range(camera.height):
         for i in range(camera.width):
-            corners = [camera._ray_through(i + dx, j + dy) for dx in (-0.5, 0.5) for dy in (-0.5, 0.5)]
+            corners = [
+                camera._ray_through(i + dx, j + dy) for dx in (-0.5, 0.5) for dy in (-0.5, 0.5)
+            ]
             mask[j, i] = not any(sphere.hit_t(r, 0.0, math.inf) is not None for r in corners)
     return mask
 
@@ -118,7 +122,9 @@ def test_furnace_convex_lambertian_sphere_shows_its_albedo(integrator, nee):
     image = rtpy.render(scene, camera=camera, integrator=integrator, nee=nee, spp=4, max_depth=6)
     on, off = pixels_fully_on_sphere(camera, scene), pixels_fully_off_sphere(camera, scene)
     assert on.sum() > 50 and off.sum() > 50
-    np.testing.assert_allclose(image.linear[on], np.broadcast_to([a, 0.5 * a, 0.25], (on.sum(), 3)), rtol=1e-12)
+    np.testing.assert_allclose(
+        image.linear[on], np.broadcast_to([a, 0.5 * a, 0.25], (on.sum(), 3)), rtol=1e-12
+    )
     np.testing.assert_array_equal(image.linear[off], 1.0)
 
 
@@ -155,8 +161,14 @@ def test_furnace_inside_glowing_sphere_converges_to_le_over_one_minus_rho(nee):
     scene = Scene([sphere])
     camera = Camera(Vec3(0.3, -0.2, 0.1), Vec3(0, 0, -1), vfov=100, aspect_ratio=1.0, width=12)
     image = rtpy.render(
-        scene, camera=camera, integrator="path", nee=nee, spp=32, max_depth=200,
-        russian_roulette=3, seed=11,
+        scene,
+        camera=camera,
+        integrator="path",
+        nee=nee,
+        spp=32,
+        max_depth=200,
+        russian_roulette=3,
+        seed=11,
     )
     pixels = image.linear[..., 0].ravel()
     mean = pixels.mean()
@@ -179,7 +191,9 @@ def box_scene() -> tuple[Scene, list]:
         Sphere(Vec3(0.3, -0.6, -2.0), 0.4, Metal(Color(0.8, 0.8, 0.8), 0.3)),
         Sphere(Vec3(-0.4, -0.7, -1.6), 0.3, white),
         # a ceiling light facing down (u x v = -y)
-        Quad(Vec3(-0.4, 0.99, -1.6), Vec3(0, 0, -0.8), Vec3(0.8, 0, 0), DiffuseLight(Color(6, 6, 6))),
+        Quad(
+            Vec3(-0.4, 0.99, -1.6), Vec3(0, 0, -0.8), Vec3(0.8, 0, 0), DiffuseLight(Color(6, 6, 6))
+        ),
     ]
     scene = Scene(objects, [PointLight(Vec3(0.6, 0.5, -1.2), Color(0.5, 0.5, 0.5))])
     camera = Camera(Vec3(0, 0, 1.5), Vec3(0, -0.2, -2), vfov=60, aspect_ratio=1.0, width=40)
@@ -244,7 +258,7 @@ def test_mis_catches_light_counted_twice():
 
 
 def test_direct_equals_path_with_max_depth_2():
-    """"direct" is exactly "path" with max_depth 2: same seed, same numbers."""
+    """ "direct" is exactly "path" with max_depth 2: same seed, same numbers."""
     scene, _ = box_scene()
     camera = Camera(Vec3(0, 0, 1.5), Vec3(0, -0.2, -2), vfov=60, aspect_ratio=1.0, width=16)
     direct = rtpy.render(scene, camera=camera, integrator="direct", spp=4, seed=5)
@@ -257,8 +271,11 @@ def test_whitted_equals_direct_without_specular_materials():
     """Without mirrors or glass, Whitted ray tracing is direct lighting."""
     white = Lambertian(Color(0.7, 0.7, 0.7))
     scene = Scene(
-        [Sphere(Vec3(0, -100.5, -1), 100, white), Sphere(Vec3(0, 0, -1), 0.5, white),
-         Sphere(Vec3(0, 1.5, -1), 0.3, DiffuseLight(Color(5, 5, 5)))],
+        [
+            Sphere(Vec3(0, -100.5, -1), 100, white),
+            Sphere(Vec3(0, 0, -1), 0.5, white),
+            Sphere(Vec3(0, 1.5, -1), 0.3, DiffuseLight(Color(5, 5, 5))),
+        ],
         [PointLight(Vec3(1, 1, 0), Color(1, 1, 1))],
     )
     camera = Camera(Vec3(0, 0.5, 1), Vec3(0, 0, -1), vfov=60, width=16)
@@ -269,11 +286,15 @@ def test_whitted_equals_direct_without_specular_materials():
 
 def test_whitted_follows_perfect_mirror():
     """A mirror facing the camera shows what is behind the camera, scaled by its albedo."""
-    mirror = Quad(Vec3(-5, -5, -2), Vec3(10, 0, 0), Vec3(0, 10, 0), rtpy.Mirror(Color(0.5, 0.6, 0.7)))
+    mirror = Quad(
+        Vec3(-5, -5, -2), Vec3(10, 0, 0), Vec3(0, 10, 0), rtpy.Mirror(Color(0.5, 0.6, 0.7))
+    )
     scene = Scene([mirror], background=Color(2.0, 2.0, 2.0))
     camera = Camera(Vec3(0, 0, 0), Vec3(0, 0, -1), vfov=30, width=8)
     image = rtpy.render(scene, camera=camera, integrator="whitted", spp=1)
-    np.testing.assert_allclose(image.linear, np.broadcast_to([1.0, 1.2, 1.4], image.linear.shape), rtol=1e-12)
+    np.testing.assert_allclose(
+        image.linear, np.broadcast_to([1.0, 1.2, 1.4], image.linear.shape), rtol=1e-12
+    )
 
 
 def test_center_shows_albedo_emission_and_background():

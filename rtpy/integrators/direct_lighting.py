@@ -84,6 +84,8 @@ def direct_lighting(scene: Scene, ray_in: Ray, hit: HitInfo) -> Color:
     if next_hit.material.is_emitter:
         emitted = next_hit.material.emitting(next_hit)
         if not emitted.is_black():
-            w = emission_weight(scene, next_hit, hit.point, scatter.pdf, scatter.is_specular, len(lights))
+            w = emission_weight(
+                scene, next_hit, hit.point, scatter.pdf, scatter.is_specular, len(lights)
+            )
             result = result + scatter.attenuation * emitted * w
     return result

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from ..hit_info import HitInfo
-from ..onb import ONB
+from ..onb import local_to_world
 from ..ray import Ray, spawn_ray
 from ..sampling import random_cosine_direction
 from ..scatter_info import ScatterInfo
@@ -28,8 +28,10 @@ class Lambertian(Material):
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
         x, y, z = random_cosine_direction()
-        direction = ONB(hit.normal).to_world(x, y, z)
-        return ScatterInfo(spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), z * INV_PI)
+        direction = local_to_world(hit.normal, x, y, z)
+        return ScatterInfo(
+            spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), z * INV_PI
+        )
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
         n, wi = hit.normal, ray_light.direction

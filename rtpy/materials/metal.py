@@ -37,7 +37,9 @@ class Metal(Material):
             direction = unit_vector(direction)
             if dot(direction, hit.normal) <= 0.0:
                 return None  # pushed below the surface: absorbed
-        return ScatterInfo(spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), 0.0, True)
+        return ScatterInfo(
+            spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), 0.0, True
+        )
 
     def specular_rays(self, ray_in: Ray, hit: HitInfo) -> list[tuple[Ray, Color]]:
         # Whitted follows the perfect reflection and ignores fuzz.

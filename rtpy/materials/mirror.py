@@ -21,7 +21,9 @@ class Mirror(Material):
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
         direction = reflect(ray_in.direction, hit.normal)
-        return ScatterInfo(spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), 0.0, True)
+        return ScatterInfo(
+            spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), 0.0, True
+        )
 
     def specular_rays(self, ray_in: Ray, hit: HitInfo) -> list[tuple[Ray, Color]]:
         s = self.scattering(ray_in, hit)
