@@ -125,7 +125,7 @@ MAX_WIDTH = 16384
 MAX_SPP = 1_000_000
 
 
-def validate_overrides(overrides: dict) -> dict:
+def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
     """Check command-line overrides as strictly as the scene file's own values;
     returns them with background turned into a Color."""
     import math
@@ -133,7 +133,8 @@ def validate_overrides(overrides: dict) -> dict:
     from .vec3 import Color
 
     def fail(key: str, expected: str, value) -> UsageError:
-        return UsageError(f"--set {key}: expected {expected}, got {value!r}")
+        option = f"--{key.replace('_', '-')}" if as_flags else f"--set {key}"
+        return UsageError(f"{option}: expected {expected}, got {value!r}")
 
     def is_int(v) -> bool:
         return isinstance(v, int) and not isinstance(v, bool)
@@ -197,13 +198,16 @@ def command_render(args: argparse.Namespace) -> int:
     try:
         path = resolve_scene(args.scene)
         scene = load_scene(path)
-        overrides = parse_set(args.set)
-        for key in ("spp", "width", "integrator", "seed"):
-            if getattr(args, key) is not None:
-                overrides[key] = getattr(args, key)
-        if args.max_depth is not None:
-            overrides["max_depth"] = args.max_depth
-        overrides = validate_overrides(overrides)
+        overrides = validate_overrides(parse_set(args.set))
+        flags = {
+            "spp": args.spp,
+            "width": args.width,
+            "integrator": args.integrator,
+            "seed": args.seed,
+            "max_depth": args.max_depth,
+        }
+        given = {k: v for k, v in flags.items() if v is not None}
+        overrides.update(validate_overrides(given, as_flags=True))
         output = Path(args.output) if args.output else Path(f"{path.stem}.png")
         check_image_path(output)
         linear = check_linear_path(args.linear) if args.linear else None
