@@ -19,8 +19,10 @@ def parse_aspect_ratio(value: float | str) -> float:
     if isinstance(value, str):
         for sep in (":", "/"):
             if sep in value:
-                a, b = value.split(sep, 1)
-                return float(a) / float(b)
+                a, b = (float(part) for part in value.split(sep, 1))
+                if not b > 0.0:
+                    raise ValueError(f"aspect ratio {value!r} divides by {b}")
+                return a / b
         return float(value)
     return float(value)
 
@@ -63,10 +65,13 @@ class Camera:
             raise ValueError(f"focus_distance must be > 0, got {focus_distance}")
         if not 0.0 <= self.defocus_angle < 180.0:
             raise ValueError(f"defocus_angle must be in [0, 180), got {defocus_angle}")
-        self.height = max(1, int(self.width / self.aspect_ratio))
+        height = self.width / self.aspect_ratio
+        if not height < 1e9:
+            raise ValueError(f"aspect_ratio {aspect_ratio} makes the image {height} pixels high")
+        self.height = max(1, int(height))
 
         view = look_from - look_at
-        if view.near_zero(0.0):
+        if view.length_squared() == 0.0:
             raise ValueError("look_from and look_at are the same point")
         self.w = unit_vector(view)  # points backward, away from the scene
         side = cross(vup, self.w)

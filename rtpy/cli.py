@@ -142,7 +142,7 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
     checked = {}
     for key, value in overrides.items():
         if key in ("spp", "width", "max_depth"):
-            limit = {"spp": MAX_SPP, "width": MAX_WIDTH, "max_depth": 10_000}[key]
+            limit = {"spp": MAX_SPP, "width": MAX_WIDTH, "max_depth": 500}[key]
             if not is_int(value) or not 1 <= value <= limit:
                 raise fail(key, f"a whole number from 1 to {limit}", value)
         elif key in ("russian_roulette", "seed"):

@@ -761,6 +761,8 @@ class _Loader:
             raise self.expected(w, "path", "the path of a PNG or JPEG file", rel)
         try:
             resolved = self.path.parent / rel
+            if resolved.is_dir():
+                raise self.fail(w, "path", f"{resolved} is a directory, not an image file")
             if not resolved.is_file():
                 raise self.fail(w, "path", f"image file not found: {resolved}")
             from PIL import Image
