@@ -77,4 +77,5 @@ def power_heuristic(pdf_a: float, pdf_b: float) -> float:
     """Veach's power heuristic (beta = 2): MIS weight of a sample drawn with pdf_a
     when the same direction could also have come from the strategy with pdf_b."""
     a2 = pdf_a * pdf_a
-    return a2 / (a2 + pdf_b * pdf_b)
+    total = a2 + pdf_b * pdf_b
+    return a2 / total if total > 0.0 else 0.0
