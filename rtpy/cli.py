@@ -14,6 +14,7 @@ from pathlib import Path
 
 from .image import OutputError, check_image_path, check_linear_path
 from .render_settings import INTEGRATOR_NAMES
+from .scene_file import MAX_MAX_DEPTH, MAX_SPP, MAX_WIDTH
 
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
@@ -121,10 +122,6 @@ def parse_set(items: list[str]) -> dict:
     return result
 
 
-MAX_WIDTH = 16384
-MAX_SPP = 1_000_000
-
-
 def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
     """Check command-line overrides as strictly as the scene file's own values;
     returns them with background turned into a Color."""
@@ -142,7 +139,7 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
     checked = {}
     for key, value in overrides.items():
         if key in ("spp", "width", "max_depth"):
-            limit = {"spp": MAX_SPP, "width": MAX_WIDTH, "max_depth": 500}[key]
+            limit = {"spp": MAX_SPP, "width": MAX_WIDTH, "max_depth": MAX_MAX_DEPTH}[key]
             if not is_int(value) or not 1 <= value <= limit:
                 raise fail(key, f"a whole number from 1 to {limit}", value)
         elif key in ("russian_roulette", "seed"):
