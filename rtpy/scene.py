@@ -48,20 +48,23 @@ class Scene:
         self.settings = settings
         self.name = name
         self.area_lights: list[AreaLight] = []
+        self.lights: list[Light] = []
         self.update_lights()
 
     def add(self, obj: Hittable) -> None:
         self.objects.append(obj)
         self.update_lights()
 
+    def add_light(self, light: PointLight) -> None:
+        self.point_lights.append(light)
+        self.update_lights()
+
     def update_lights(self) -> None:
+        """Rebuild the light lists; call it after changing objects or point_lights."""
         self.area_lights = [
             AreaLight(o) for o in self.objects if getattr(o.material, "is_emitter", False)
         ]
-
-    @property
-    def lights(self) -> list[Light]:
-        return [*self.point_lights, *self.area_lights]
+        self.lights = [*self.point_lights, *self.area_lights]
 
     def find_intersection(self, ray: Ray, interval: Interval) -> HitInfo | None:
         """The closest hit with t in (interval.min, interval.max), or None."""
