@@ -75,8 +75,8 @@ class Camera:
             raise ValueError("look_from and look_at are the same point")
         self.w = unit_vector(view)  # points backward, away from the scene
         side = cross(vup, self.w)
-        if side.length() < 1e-9 * vup.length():
-            raise ValueError("vup is parallel to the view direction")
+        if not side.length() > 1e-9 * vup.length():
+            raise ValueError("vup is zero or parallel to the view direction")
         self.u = unit_vector(side)  # camera right
         self.v = cross(self.w, self.u)  # camera up
 

@@ -22,10 +22,13 @@ class HitInfo:
     material    the object's material
     u, v        surface coordinates in [0, 1]; computed on first access, because only
                 textures that need them should pay for them
+    tangent     unit vector in the surface along increasing u, perpendicular to the
+                normal (the first axis of anisotropic materials' frame); computed
+                on first access
     obj         the object that was hit
     """
 
-    __slots__ = ("point", "normal", "t", "front_face", "material", "obj", "_u", "_v")
+    __slots__ = ("point", "normal", "t", "front_face", "material", "obj", "_u", "_v", "_tangent")
 
     def __init__(
         self,
@@ -46,6 +49,7 @@ class HitInfo:
         self.obj = obj
         self._u = u
         self._v = v
+        self._tangent = None
 
     def _compute_uv(self) -> None:
         if self.obj is None:
@@ -64,6 +68,20 @@ class HitInfo:
         if self._v is None:
             self._compute_uv()
         return self._v
+
+    @property
+    def tangent(self) -> Vec3:
+        if self._tangent is None:
+            self._tangent = self.obj.surface_tangent(self) if self.obj is not None else None
+            if self._tangent is None:
+                from .onb import ONB
+
+                self._tangent = ONB(self.normal).u
+        return self._tangent
+
+    @tangent.setter
+    def tangent(self, value: Vec3) -> None:
+        self._tangent = value
 
     def __repr__(self) -> str:
         return (

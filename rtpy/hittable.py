@@ -34,7 +34,7 @@ class Hittable:
         raise NotImplementedError
 
     def intersect(self, ray: Ray, interval: Interval) -> HitInfo | None:
-        """The closest hit with t inside [interval.min, interval.max], or None."""
+        """The closest hit with interval.min < t < interval.max, or None."""
         t = self.hit_t(ray, interval.min, interval.max)
         if t is None:
             return None
@@ -43,6 +43,11 @@ class Hittable:
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
         """Surface coordinates (u, v) of a hit on this object."""
         return 0.0, 0.0
+
+    def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
+        """Unit tangent along increasing u at the hit, or None when the surface has
+        no u direction there (then HitInfo.tangent picks any perpendicular)."""
+        return None
 
     # --- as an area light ---------------------------------------------------
     # An object with an emitting material is also a light. Light sampling picks

@@ -24,6 +24,7 @@ class Quad(Hittable):
         self.d = dot(self.normal, q)  # plane: dot(normal, p) = d
         self.w = n / dot(n, n)  # turns a planar vector into (a, b) coordinates
         self._area = n_len
+        self._tangent = u / u.length()
 
     def _coords(self, p: Vec3) -> tuple[float, float]:
         q, w = self.q, self.w
@@ -63,6 +64,9 @@ class Quad(Hittable):
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
         a, b = self._coords(hit.point)
         return min(1.0, max(0.0, a)), min(1.0, max(0.0, b))
+
+    def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
+        return self._tangent
 
     def area(self) -> float:
         return self._area

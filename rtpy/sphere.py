@@ -80,6 +80,15 @@ class Sphere(Hittable):
         phi = math.atan2(-z, x) + math.pi
         return phi / (2.0 * math.pi), theta / math.pi
 
+    def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
+        """d(point)/du: along the circle of latitude, toward increasing phi."""
+        c = self.center
+        x, z = hit.point.e0 - c.e0, hit.point.e2 - c.e2
+        length = math.hypot(x, z)
+        if length < 1e-12 * self.radius:
+            return None  # at a pole u has no direction
+        return Vec3(z / length, 0.0, -x / length)
+
     def area(self) -> float:
         return 4.0 * math.pi * self.radius * self.radius
 

@@ -29,6 +29,7 @@ class Triangle(Hittable):
         self.normal = n / n_len
         self.material = material
         self._area = 0.5 * n_len
+        self._tangent = self.e1 / self.e1.length()  # u runs from a toward b
 
     def _barycentric(self, ray: Ray) -> tuple[float, float, float] | None:
         """Moller-Trumbore: (t, u, v) of the ray's hit with the triangle's plane
@@ -81,6 +82,9 @@ class Triangle(Hittable):
         u = (d11 * d20 - d01 * d21) / denom
         v = (d00 * d21 - d01 * d20) / denom
         return min(1.0, max(0.0, u)), min(1.0, max(0.0, v))
+
+    def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
+        return self._tangent
 
     def area(self) -> float:
         return self._area

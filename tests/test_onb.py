@@ -1,0 +1,106 @@
+"""Tests for rtpy.onb: the frame is orthonormal and right-handed for every unit normal."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from rtpy.onb import ONB, local_to_world
+from rtpy.vec3 import Vec3, cross, dot
+
+TOL = 1e-12
+
+
+def check_frame(w: Vec3) -> None:
+    f = ONB(w)
+    u, v = f.u, f.v
+    assert f.w is w
+    for a in (u, v):
+        assert math.isclose(a.length(), 1.0, abs_tol=TOL)
+    assert abs(dot(u, v)) < TOL
+    assert abs(dot(u, w)) < TOL
+    assert abs(dot(v, w)) < TOL
+    # Right-handed: u x v = w.
+    c = cross(u, v)
+    assert abs(c.e0 - w.e0) < TOL and abs(c.e1 - w.e1) < TOL and abs(c.e2 - w.e2) < TOL
+    # to_world maps the local axes to (u, v, w) and is linear.
+    assert f.to_world(0.0, 0.0, 1.0).tolist() == pytest.approx(w.tolist(), abs=1e-15)
+    x = f.to_world(0.3, -0.4, 0.5)
+    expected = u * 0.3 + v * -0.4 + w * 0.5
+    assert x.tolist() == pytest.approx(expected.tolist(), abs=1e-15)
+    # Lengths are preserved (orthonormal).
+    assert math.isclose(x.length(), math.sqrt(0.5), abs_tol=TOL)
+
+
+@pytest.mark.parametrize(
+    "w",
+    [
+        (0.0, 0.0, 1.0),
+        (0.0, 0.0, -1.0),
+        (0.0, 0.0, -0.0),  # not unit; skipped below
+        (1.0, 0.0, 0.0),
+        (-1.0, 0.0, 0.0),
+        (0.0, 1.0, 0.0),
+        (0.0, -1.0, 0.0),
+        (1.0, 0.0, -0.0),
+        (0.0, 1.0, -0.0),
+    ],
+)
+def test_axis_normals(w):
+    v = Vec3(*w)
+    if v.length() == 0.0:
+        return
+    check_frame(v)
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+@pytest.mark.parametrize("eps", [1e-3, 1e-8, 1e-12, 1e-16])
+def test_near_the_poles(sign, eps):
+    for ax, ay in ((eps, 0.0), (0.0, eps), (eps, -eps), (-eps, eps)):
+        z = sign * math.sqrt(1.0 - ax * ax - ay * ay)
+        check_frame(Vec3(ax, ay, z))
+    # Slightly on the other side of the equator of z, too.
+    s = math.sqrt(1.0 - eps * eps)
+    check_frame(Vec3(s, 0.0, sign * eps))
+
+
+@settings(deadline=None, max_examples=150)
+@given(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.floats(-1.0, 1.0))
+def test_random_unit_normals(x, y, z):
+    n = math.sqrt(x * x + y * y + z * z)
+    assume(n > 1e-3)
+    check_frame(Vec3(x / n, y / n, z / n))
+
+
+@settings(deadline=None, max_examples=100)
+@given(
+    st.floats(-1.0, 1.0),
+    st.floats(-1.0, 1.0),
+    st.floats(-1.0, 1.0),
+    st.tuples(st.floats(-2, 2), st.floats(-2, 2), st.floats(-2, 2)),
+)
+def test_local_to_world_is_x_u_plus_y_v_plus_z_w(x, y, z, local):
+    n = math.sqrt(x * x + y * y + z * z)
+    assume(n > 1e-3)
+    w = Vec3(x / n, y / n, z / n)
+    f = ONB(w)
+    a, b, c = local
+    got = local_to_world(w, a, b, c)
+    expected = f.u * a + f.v * b + w * c
+    assert got.tolist() == pytest.approx(expected.tolist(), abs=1e-14)
+    # Lengths are preserved and the local z axis is the normal.
+    assert got.length() == pytest.approx(math.sqrt(a * a + b * b + c * c), abs=1e-12)
+    assert dot(got, w) == pytest.approx(c, abs=1e-12)
+
+
+@pytest.mark.parametrize("w", [(0.0, 0.0, 1.0), (0.0, 0.0, -1.0), (1e-9, 0.0, -1.0)])
+def test_local_to_world_at_the_poles(w):
+    v = Vec3(*w)
+    got = local_to_world(v, 0.0, 0.0, 1.0)
+    assert got.tolist() == pytest.approx(list(w), abs=1e-15)
+    got = local_to_world(v, 0.6, 0.8, 0.0)
+    assert abs(dot(got, v)) < 1e-12
+    assert got.length() == pytest.approx(1.0, abs=1e-12)
