@@ -24,6 +24,36 @@ class ONB:
         self.v = Vec3(b, sign + w.e1 * w.e1 * a, -w.e1)
         self.w = w
 
+    @classmethod
+    def from_normal_tangent(cls, normal: Vec3, tangent: Vec3) -> ONB:
+        """Frame with w = normal and u = the tangent made perpendicular to it
+        (Gram-Schmidt); v = w x u."""
+        frame = cls.__new__(cls)
+        k = tangent.e0 * normal.e0 + tangent.e1 * normal.e1 + tangent.e2 * normal.e2
+        ux = tangent.e0 - k * normal.e0
+        uy = tangent.e1 - k * normal.e1
+        uz = tangent.e2 - k * normal.e2
+        length = math.sqrt(ux * ux + uy * uy + uz * uz)
+        if length < 1e-9:  # tangent along the normal: any frame will do
+            return cls(normal)
+        u = Vec3(ux / length, uy / length, uz / length)
+        w = normal
+        frame.u = u
+        frame.v = Vec3(
+            w.e1 * u.e2 - w.e2 * u.e1, w.e2 * u.e0 - w.e0 * u.e2, w.e0 * u.e1 - w.e1 * u.e0
+        )
+        frame.w = w
+        return frame
+
+    def to_local(self, d: Vec3) -> tuple[float, float, float]:
+        """Coordinates (x, y, z) of the world vector d in this frame (z along w)."""
+        u, v, w = self.u, self.v, self.w
+        return (
+            d.e0 * u.e0 + d.e1 * u.e1 + d.e2 * u.e2,
+            d.e0 * v.e0 + d.e1 * v.e1 + d.e2 * v.e2,
+            d.e0 * w.e0 + d.e1 * w.e1 + d.e2 * w.e2,
+        )
+
     def to_world(self, x: float, y: float, z: float) -> Vec3:
         u, v, w = self.u, self.v, self.w
         return Vec3(
