@@ -46,13 +46,18 @@ def random_double(lo: float = 0.0, hi: float = 1.0) -> float:
     return lo + (hi - lo) * _generator.random()
 
 
+def uniform_sphere(r1: float, r2: float) -> tuple[float, float, float]:
+    """Maps two uniform numbers in [0, 1) to a point uniform on the unit sphere."""
+    z = 1.0 - 2.0 * r1
+    s = math.sqrt(max(0.0, 1.0 - z * z))
+    phi = 2.0 * math.pi * r2
+    return s * math.cos(phi), s * math.sin(phi), z
+
+
 def random_unit_vector() -> Vec3:
     """Uniform on the unit sphere (pdf 1 / (4 pi) per steradian)."""
     r = _generator.random
-    z = 1.0 - 2.0 * r()
-    s = math.sqrt(max(0.0, 1.0 - z * z))
-    phi = 2.0 * math.pi * r()
-    return Vec3(s * math.cos(phi), s * math.sin(phi), z)
+    return Vec3(*uniform_sphere(r(), r()))
 
 
 def random_in_unit_disk() -> Vec3:

@@ -8,6 +8,7 @@ from .hit_info import HitInfo
 from .hittable import Hittable
 from .onb import local_to_world
 from .ray import Ray
+from .sampling import uniform_sphere
 from .vec3 import Vec3
 
 
@@ -93,10 +94,7 @@ class Sphere(Hittable):
         return 4.0 * math.pi * self.radius * self.radius
 
     def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:
-        z = 1.0 - 2.0 * r1
-        s = math.sqrt(max(0.0, 1.0 - z * z))
-        phi = 2.0 * math.pi * r2
-        n = Vec3(s * math.cos(phi), s * math.sin(phi), z)
+        n = Vec3(*uniform_sphere(r1, r2))
         return self.center + n * self.radius, n
 
     # Sphere lights seen from outside are sampled uniformly in the cone of

@@ -21,7 +21,7 @@ import math
 from ..hit_info import HitInfo
 from ..onb import ONB
 from ..ray import Ray, spawn_ray
-from ..sampling import generator
+from ..sampling import generator, random_cosine_direction
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import BLACK, Color
@@ -104,9 +104,7 @@ class GlossyMaterial(Material):
         p_diffuse = self.diffuse_probability(albedo)
         r = generator().random
         if r() < p_diffuse:
-            phi, r2 = 2.0 * math.pi * r(), r()
-            s = math.sqrt(r2)
-            wi = (s * math.cos(phi), s * math.sin(phi), math.sqrt(max(0.0, 1.0 - r2)))
+            wi = random_cosine_direction()
         else:
             wi = self.sample_specular(wo, r(), r())
         if wi is None or wi[2] <= 0.0:
