@@ -221,9 +221,12 @@ azimuths = st.floats(min_value=0.0, max_value=2.0 * math.pi)
 @settings(deadline=None, max_examples=60)
 @given(vectors, angles, azimuths)
 def test_reflect_preserves_length_and_flips_normal_component(v, theta, phi):
+    # Below ~1e-150 the squared length underflows into subnormal floats and the
+    # identity can only hold to the subnormal spacing: outside the tested domain.
+    assume(norm(v) > 1e-100)
     n = random_unit(theta, phi)
     r = reflect(v, n)
-    scale = max(norm(v), 1e-300)
+    scale = norm(v)
     assert math.isclose(r.length(), v.length(), rel_tol=1e-12, abs_tol=1e-12 * scale)
     assert math.isclose(dot(r, n), -dot(v, n), rel_tol=1e-12, abs_tol=1e-12 * scale)
     # The tangential part is unchanged: r - v is along n.
