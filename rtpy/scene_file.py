@@ -63,11 +63,24 @@ MAX_TEXTURE_PIXELS = 2048 * 2048  # image textures are kept as Python Colors
 
 TOP_LEVEL_TABLES = ("camera", "render", "textures", "materials", "objects", "lights")
 CAMERA_KEYS = (
-    "look_from", "look_at", "vup", "vfov", "aspect_ratio", "width", "defocus_angle",
+    "look_from",
+    "look_at",
+    "vup",
+    "vfov",
+    "aspect_ratio",
+    "width",
+    "defocus_angle",
     "focus_distance",
 )
 RENDER_KEYS = (
-    "integrator", "spp", "max_depth", "nee", "russian_roulette", "seed", "background", "sky",
+    "integrator",
+    "spp",
+    "max_depth",
+    "nee",
+    "russian_roulette",
+    "seed",
+    "background",
+    "sky",
     "gamma",
 )
 TEXTURE_KEYS = {
@@ -477,7 +490,9 @@ class _Loader:
                 listed = ", ".join(valid)
                 for_what = f" for {what}" if what else ""
                 raise self.fail(
-                    where, key, f"unknown key{for_what}; valid keys: {listed}",
+                    where,
+                    key,
+                    f"unknown key{for_what}; valid keys: {listed}",
                     _suggest(key, valid),
                 )
 
@@ -505,7 +520,8 @@ class _Loader:
         what = f"an integer {rng.text()}".rstrip() + limit
         if isinstance(v, float) and math.isfinite(v) and v.is_integer():
             raise self.fail(
-                where, key,
+                where,
+                key,
                 f"expected {what}, found {v!r} (write {int(v)} without the decimal point)",
             )
         if not isinstance(v, int) or isinstance(v, bool):
@@ -540,7 +556,8 @@ class _Loader:
             if not _is_number(x):
                 why = " (booleans are not numbers)" if isinstance(x, bool) else ""
                 raise self.fail(
-                    where, key,
+                    where,
+                    key,
                     f"expected {what}, found {_describe(x)} as component {i + 1}{why}",
                 )
             try:
@@ -549,7 +566,8 @@ class _Loader:
                 f = math.inf
             if not math.isfinite(f) or f not in rng:
                 raise self.fail(
-                    where, key,
+                    where,
+                    key,
                     f"expected {what}, found {_describe(v)} (component {i + 1} is {_describe(x)})",
                 )
             out.append(f)
@@ -574,7 +592,8 @@ class _Loader:
             if not isinstance(value, dict):
                 where = _Where.table(name)
                 raise self.fail(
-                    where, sub,
+                    where,
+                    sub,
                     f"expected a table [{name}.{_quote_key(sub)}] with a `type` key, "
                     f"found {_describe(value)}",
                 )
@@ -584,7 +603,8 @@ class _Loader:
         v = data.get(name, [])
         if not isinstance(v, list):
             raise self.fail(
-                _Where(f"[[{name}]]", (name,)), None,
+                _Where(f"[[{name}]]", (name,)),
+                None,
                 f"expected an array of tables, found {_describe(v)} "
                 f"(write [[{name}]] before each one, not [{name}])",
             )
@@ -607,7 +627,8 @@ class _Loader:
             raise self.expected(where, "type", f"a {what} type: one of {listed}", v)
         if v not in kinds:
             raise self.fail(
-                where, "type",
+                where,
+                "type",
                 f"unknown {what} type {json.dumps(v, ensure_ascii=False)}; "
                 f"expected one of {listed}",
                 _suggest(v, kinds),
@@ -620,7 +641,8 @@ class _Loader:
             if name not in TOP_LEVEL_TABLES:
                 raise SceneError(
                     "unknown table; the tables are " + ", ".join(TOP_LEVEL_TABLES),
-                    file=self.file, table=f"[{_quote_key(name)}]",
+                    file=self.file,
+                    table=f"[{_quote_key(name)}]",
                     line=self.lines.locate((), None, name),
                     suggestion=_suggest(name, TOP_LEVEL_TABLES),
                 )
@@ -639,8 +661,13 @@ class _Loader:
             for i, t in enumerate(self.array_of_tables(data, "lights"))
         ]
         return Scene(
-            objects=objects, point_lights=lights, background=background, sky=sky,
-            camera=camera, settings=settings, name=self.path.stem,
+            objects=objects,
+            point_lights=lights,
+            background=background,
+            sky=sky,
+            camera=camera,
+            settings=settings,
+            name=self.path.stem,
         )
 
     def camera(self, t: dict) -> Camera:
@@ -652,7 +679,10 @@ class _Loader:
         vfov = self.number(w, "vfov", t.get("vfov", 90), _Range(0, 180, True, True))
         aspect = self.aspect_ratio(w, t.get("aspect_ratio", 16.0 / 9.0))
         width = self.integer(
-            w, "width", t.get("width", 400), _Range(1, MAX_WIDTH),
+            w,
+            "width",
+            t.get("width", 400),
+            _Range(1, MAX_WIDTH),
             " (larger images are refused)",
         )
         defocus = self.number(
@@ -663,15 +693,19 @@ class _Loader:
         height = width / aspect
         if not height < MAX_HEIGHT + 1:
             raise self.fail(
-                w, "aspect_ratio",
+                w,
+                "aspect_ratio",
                 f"width {width} / aspect_ratio {_num_text(aspect)} gives an image height of "
                 f"{_num_text(int(height)) if math.isfinite(height) else 'inf'} pixels; "
                 f"the most is {MAX_HEIGHT}",
             )
         view = look_from - look_at
         if view.is_black():
-            raise self.fail(w, "look_at", "look_at must differ from look_from (both are "
-                            f"{_describe(list(look_from))})")
+            raise self.fail(
+                w,
+                "look_at",
+                f"look_at must differ from look_from (both are {_describe(list(look_from))})",
+            )
         if not math.isfinite(view.length()):
             raise self.fail(w, "look_at", "look_from and look_at are too far apart")
         if vup.is_black() or not math.isfinite(vup.length()):
@@ -681,7 +715,8 @@ class _Loader:
         side = cross(vup, view / view.length())
         if not side.length() >= 1e-9 * vup.length():
             raise self.fail(
-                w, "vup",
+                w,
+                "vup",
                 f"vup {_describe(list(vup))} is parallel to the view direction "
                 "(look_at - look_from); choose an up vector across it",
             )
@@ -722,7 +757,10 @@ class _Loader:
             )
         if "max_depth" in t:
             kwargs["max_depth"] = self.integer(
-                w, "max_depth", t["max_depth"], _Range(1, MAX_MAX_DEPTH),
+                w,
+                "max_depth",
+                t["max_depth"],
+                _Range(1, MAX_MAX_DEPTH),
                 " (deeper paths are refused)",
             )
         if "nee" in t:
@@ -771,16 +809,16 @@ class _Loader:
                 size = im.size
             if size[0] * size[1] > MAX_TEXTURE_PIXELS:
                 raise self.fail(
-                    w, "path", f"image {resolved} has {size[0]} x {size[1]} pixels; "
+                    w,
+                    "path",
+                    f"image {resolved} has {size[0]} x {size[1]} pixels; "
                     f"the most for a texture is {MAX_TEXTURE_PIXELS}",
                 )
             return ImageTexture.from_file(resolved)
         except SceneError:
             raise
         except Exception as e:  # PIL raises many kinds for unreadable files
-            raise self.fail(
-                w, "path", f"cannot read image {self.path.parent / rel}: {e}"
-            ) from None
+            raise self.fail(w, "path", f"cannot read image {self.path.parent / rel}: {e}") from None
 
     def material(self, w: _Where, t: dict) -> Any:
         kind = self.type_of(w, t, MATERIALS, "material")
@@ -791,9 +829,7 @@ class _Loader:
         for p in params.values():
             if p.name not in t:
                 if p.required:
-                    raise self.fail(
-                        w, p.name, f'missing required key of a "{kind}" material'
-                    )
+                    raise self.fail(w, p.name, f'missing required key of a "{kind}" material')
                 continue
             kwargs[p.name] = self.material_value(w, p, t[p.name])
         try:
@@ -808,7 +844,8 @@ class _Loader:
                 if v not in self.textures:
                     defined = ", ".join(self.textures) or "none"
                     raise self.fail(
-                        w, p.name,
+                        w,
+                        p.name,
                         f"no texture named {json.dumps(v, ensure_ascii=False)} "
                         f"([textures.{_quote_key(v)}]); "
                         f"textures defined: {defined}",
@@ -842,7 +879,8 @@ class _Loader:
         if name not in self.materials:
             defined = ", ".join(self.materials) or "none"
             raise self.fail(
-                w, "material",
+                w,
+                "material",
                 f"no material named {json.dumps(name, ensure_ascii=False)} "
                 f"([materials.{_quote_key(name)}]); "
                 f"materials defined: {defined}",
@@ -865,16 +903,25 @@ class _Loader:
             return self.build(w, "radius", lambda m: Sphere(center, radius, m), material)
         if kind == "quad":
             q, u, v = point("q"), point("u"), point("v")
-            return self.build(w, "u", lambda m: Quad(q, u, v, m), self.reference(w, t),
-                              f" (u = {_describe(list(u))}, v = {_describe(list(v))})")
+            return self.build(
+                w,
+                "u",
+                lambda m: Quad(q, u, v, m),
+                self.reference(w, t),
+                f" (u = {_describe(list(u))}, v = {_describe(list(v))})",
+            )
         a, b, c = point("a"), point("b"), point("c")
         return self.build(
-            w, "a", lambda m: Triangle(a, b, c, m), self.reference(w, t),
+            w,
+            "a",
+            lambda m: Triangle(a, b, c, m),
+            self.reference(w, t),
             f" (a = {_describe(list(a))}, b = {_describe(list(b))}, c = {_describe(list(c))})",
         )
 
-    def build(self, w: _Where, key: str, make: Callable[[Any], Any], material: Any,
-              found: str = "") -> Any:
+    def build(
+        self, w: _Where, key: str, make: Callable[[Any], Any], material: Any, found: str = ""
+    ) -> Any:
         try:
             return make(material)
         except (ValueError, ArithmeticError) as e:
@@ -885,7 +932,9 @@ class _Loader:
         self.check_keys(w, t, LIGHT_KEYS[kind], f'type "{kind}"')
         position = self.vec3(w, "position", self.require(w, t, "position", "an array of 3 numbers"))
         intensity = self.color(
-            w, "intensity", self.require(w, t, "intensity", "a colour, each component >= 0"),
+            w,
+            "intensity",
+            self.require(w, t, "intensity", "a colour, each component >= 0"),
             NON_NEGATIVE,
         )
         return PointLight(position, intensity)
@@ -923,7 +972,7 @@ def _syntax_error(message: str, text: str, path: Path) -> SceneError:
     m = re.search(r"\s*\(at line (\d+), column (\d+)\)", message)
     if m:
         line, column = int(m.group(1)), int(m.group(2))
-        message = message[: m.start()] + message[m.end():]
+        message = message[: m.start()] + message[m.end() :]
     elif "(at end of document)" in message:
         line = max(1, len(text.splitlines()))
         message = message.replace(" (at end of document)", " at the end of the file")

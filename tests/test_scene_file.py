@@ -194,7 +194,13 @@ def test_minimal_scene_loads_with_contract_defaults():
     assert scene.settings == RenderSettings()
     s = scene.settings
     assert (s.integrator, s.spp, s.max_depth, s.nee, s.russian_roulette, s.seed, s.gamma) == (
-        "path", 16, 8, True, 5, 0, 2.0
+        "path",
+        16,
+        8,
+        True,
+        5,
+        0,
+        2.0,
     )
     assert scene.background == Color(0, 0, 0)
     assert scene.sky is False
@@ -228,15 +234,20 @@ type = "dielectric"
 type = "diffuse_light"
 emit = [1, 2, 3]
 """
-    scene = load(text + "".join(
-        f'[[objects]]\ntype = "sphere"\ncenter = [0, 0, {-i}]\nradius = 1\nmaterial = "{m}"\n'
-        for i, m in enumerate("lmtge")
-    ))
+    scene = load(
+        text
+        + "".join(
+            f'[[objects]]\ntype = "sphere"\ncenter = [0, 0, {-i}]\nradius = 1\nmaterial = "{m}"\n'
+            for i, m in enumerate("lmtge")
+        )
+    )
     mats = [o.material for o in scene.objects]
     assert isinstance(mats[0], Lambertian) and mats[0].albedo.color == Color(0.5, 0.5, 0.5)
     assert isinstance(mats[1], Mirror) and mats[1].albedo.color == Color(1, 1, 1)
-    assert isinstance(mats[2], Metal) and mats[2].fuzz == 0 and mats[2].albedo.color == Color(
-        0.5, 0.5, 0.5
+    assert (
+        isinstance(mats[2], Metal)
+        and mats[2].fuzz == 0
+        and mats[2].albedo.color == Color(0.5, 0.5, 0.5)
     )
     assert isinstance(mats[3], Dielectric) and mats[3].ior == 1.5
     assert isinstance(mats[4], DiffuseLight) and mats[4].two_sided is False
@@ -385,20 +396,20 @@ def test_unknown_key_in_material_uses_constructor_signature():
 
 
 def test_unknown_key_in_object_and_light():
-    err = error_of(MINIMAL + 'radiu = 2\n')
+    err = error_of(MINIMAL + "radiu = 2\n")
     assert_names(err, "[[objects]] #1", "radiu", "radius")
     err = error_of('[[lights]]\ntype = "point"\nposition = [0, 0, 0]\nintensty = [1, 1, 1]\n')
     assert_names(err, "[[lights]] #1", "intensty", "intensity")
 
 
 def test_wrong_type():
-    err = error_of("[camera]\nvfov = \"wide\"\n")
+    err = error_of('[camera]\nvfov = "wide"\n')
     assert_names(err, "[camera]", "vfov")
     assert "expected a number" in str(err) and '"wide"' in str(err)
     err = error_of("[camera]\nlook_from = [1, 2]\n")
     assert_names(err, "[camera]", "look_from")
     assert "3" in str(err)
-    err = error_of("[render]\nsky = \"yes\"\n")
+    err = error_of('[render]\nsky = "yes"\n')
     assert_names(err, "[render]", "sky")
     assert "true or false" in str(err)
     err = error_of("[render]\nnee = 1\n")
@@ -454,10 +465,16 @@ def test_nan_and_infinity_are_refused(value):
         ('[materials.m]\ntype = "dielectric"\nior = 0\n', "[materials.m]", "ior"),
         ('[materials.m]\ntype = "metal"\nfuzz = -0.5\n', "[materials.m]", "fuzz"),
         ('[materials.m]\ntype = "diffuse_light"\nemit = [1, -1, 1]\n', "[materials.m]", "emit"),
-        ('[textures.t]\ntype = "checker"\nscale = -1\neven = [0, 0, 0]\nodd = [1, 1, 1]\n',
-         "[textures.t]", "scale"),
-        ('[[lights]]\ntype = "point"\nposition = [0, 0, 0]\nintensity = [1, 1, -1]\n',
-         "[[lights]] #1", "intensity"),
+        (
+            '[textures.t]\ntype = "checker"\nscale = -1\neven = [0, 0, 0]\nodd = [1, 1, 1]\n',
+            "[textures.t]",
+            "scale",
+        ),
+        (
+            '[[lights]]\ntype = "point"\nposition = [0, 0, 0]\nintensity = [1, 1, -1]\n',
+            "[[lights]] #1",
+            "intensity",
+        ),
     ],
 )
 def test_out_of_range(text, table, key):
@@ -475,14 +492,23 @@ def test_negative_radius_is_refused():
 @pytest.mark.parametrize(
     ("text", "table", "key"),
     [
-        ('[[objects]]\ntype = "sphere"\ncenter = [0, 0, 0]\nmaterial = "m"\n',
-         "[[objects]] #1", "radius"),
-        ('[[objects]]\ntype = "quad"\nq = [0, 0, 0]\nu = [1, 0, 0]\nmaterial = "m"\n',
-         "[[objects]] #1", "v"),
-        ('[[objects]]\ntype = "triangle"\na = [0, 0, 0]\nb = [1, 0, 0]\nc = [0, 1, 0]\n',
-         "[[objects]] #1", "material"),
-        ('[[objects]]\ncenter = [0, 0, 0]\n', "[[objects]] #1", "type"),
-        ('[materials.m]\nalbedo = [1, 1, 1]\n', "[materials.m]", "type"),
+        (
+            '[[objects]]\ntype = "sphere"\ncenter = [0, 0, 0]\nmaterial = "m"\n',
+            "[[objects]] #1",
+            "radius",
+        ),
+        (
+            '[[objects]]\ntype = "quad"\nq = [0, 0, 0]\nu = [1, 0, 0]\nmaterial = "m"\n',
+            "[[objects]] #1",
+            "v",
+        ),
+        (
+            '[[objects]]\ntype = "triangle"\na = [0, 0, 0]\nb = [1, 0, 0]\nc = [0, 1, 0]\n',
+            "[[objects]] #1",
+            "material",
+        ),
+        ("[[objects]]\ncenter = [0, 0, 0]\n", "[[objects]] #1", "type"),
+        ("[materials.m]\nalbedo = [1, 1, 1]\n", "[materials.m]", "type"),
         ('[materials.m]\ntype = "diffuse_light"\n', "[materials.m]", "emit"),
         ('[textures.t]\ntype = "solid"\n', "[textures.t]", "color"),
         ('[textures.t]\ntype = "checker"\neven = [0, 0, 0]\n', "[textures.t]", "odd"),
@@ -563,8 +589,22 @@ def test_look_from_equal_to_look_at():
     assert_names(err, "[camera]", "look_at")
 
 
-@pytest.mark.parametrize("value", ['"16x9"', '"16:"', '":9"', '"a:b"', '"16:0"', '"0:9"',
-                                   '"nan:1"', '"inf:1"', '""', "[16, 9]", "true"])
+@pytest.mark.parametrize(
+    "value",
+    [
+        '"16x9"',
+        '"16:"',
+        '":9"',
+        '"a:b"',
+        '"16:0"',
+        '"0:9"',
+        '"nan:1"',
+        '"inf:1"',
+        '""',
+        "[16, 9]",
+        "true",
+    ],
+)
 def test_bad_aspect_ratio(value):
     err = error_of(f"[camera]\naspect_ratio = {value}\n")
     assert_names(err, "[camera]", "aspect_ratio")
@@ -629,8 +669,10 @@ def test_line_numbers_for_a_semantic_error():
     text = (
         "# comment\n\n[camera]\nwidth = 100\n\n"
         + MINIMAL
-        + "\n" + MINIMAL.split("\n\n", 1)[1]
-        + "\n" + MINIMAL.split("\n\n", 1)[1].replace("radius = 0.5", "radius = -2")
+        + "\n"
+        + MINIMAL.split("\n\n", 1)[1]
+        + "\n"
+        + MINIMAL.split("\n\n", 1)[1].replace("radius = 0.5", "radius = -2")
     )
     err = error_of(text)
     assert_names(err, "[[objects]] #3", "radius")
@@ -639,13 +681,13 @@ def test_line_numbers_for_a_semantic_error():
 
 
 def test_line_number_falls_back_to_the_header_for_missing_keys():
-    text = MINIMAL + '\n[materials.x]\n# nothing here\n'
+    text = MINIMAL + "\n[materials.x]\n# nothing here\n"
     err = error_of(text)
     assert err.key == "type" and err.line == line_of(text, "[materials.x]")
 
 
 def test_line_number_for_inline_tables():
-    text = 'camera = { width = 10, vfov = 400 }\n'
+    text = "camera = { width = 10, vfov = 400 }\n"
     err = error_of(text)
     assert_names(err, "[camera]", "vfov")
     assert err.line == 1
@@ -700,8 +742,10 @@ def test_materials_registered_later_load_without_changing_the_loader(monkeypatch
     monkeypatch.setitem(materials.MATERIALS, "shiny", Shiny)
     head = '[textures.t]\ntype = "solid"\ncolor = [1, 1, 1]\n[materials.s]\ntype = "shiny"\n'
     obj = '[[objects]]\ntype = "sphere"\ncenter = [0, 0, -1]\nradius = 1\nmaterial = "s"\n'
-    m = load(head + 'albedo = "t"\nks = 1\nexponent = 20.5\nsamples = 8\n'
-             'distribution = "beckmann"\nf0 = [0.9, 0.8, 0.7]\nfancy = true\n' + obj)
+    m = load(
+        head + 'albedo = "t"\nks = 1\nexponent = 20.5\nsamples = 8\n'
+        'distribution = "beckmann"\nf0 = [0.9, 0.8, 0.7]\nfancy = true\n' + obj
+    )
     m = m.objects[0].material
     assert isinstance(m.albedo, SolidColor)
     assert (m.ks, m.exponent, m.samples, m.distribution, m.fancy) == (1, 20.5, 8, "beckmann", True)
@@ -712,7 +756,7 @@ def test_materials_registered_later_load_without_changing_the_loader(monkeypatch
         ("ks = -1", "ks"),  # range table
         ("kd = true", "kd"),
         ("samples = 2.5", "samples"),  # annotated int
-        ('distribution = 3', "distribution"),
+        ("distribution = 3", "distribution"),
         ("fancy = 1", "fancy"),
         ("f0 = [1, 1]", "f0"),
         ("f0 = [2, 0, 0]", "f0"),
@@ -810,8 +854,11 @@ SCALARS = st.one_of(
 VALUES = st.one_of(
     SCALARS,
     st.lists(SCALARS, max_size=4),
-    st.lists(st.floats(allow_nan=False, allow_infinity=False, min_value=-10, max_value=10),
-             min_size=3, max_size=3),
+    st.lists(
+        st.floats(allow_nan=False, allow_infinity=False, min_value=-10, max_value=10),
+        min_size=3,
+        max_size=3,
+    ),
     st.lists(st.sampled_from([0, 1, 0.0, 1.0, 0.5]), min_size=3, max_size=3),
     st.dictionaries(st.sampled_from(["type", "a", "x"]), SCALARS, max_size=2),
 )
@@ -840,9 +887,11 @@ def test_random_perturbations_load_or_raise_scene_error(data):
         table = data.draw(st.sampled_from(tables))
         action = data.draw(st.sampled_from(["replace", "replace", "delete", "add"]))
         if action == "add" or not table:
-            key = data.draw(st.sampled_from(
-                ["type", "albedo", "radius", "width", "spp", "emit", "material", "zzz", "sky"]
-            ))
+            key = data.draw(
+                st.sampled_from(
+                    ["type", "albedo", "radius", "width", "spp", "emit", "material", "zzz", "sky"]
+                )
+            )
         else:
             key = data.draw(st.sampled_from(sorted(table)))
         if action == "delete":

@@ -7,14 +7,26 @@
 | "metal"         | Metal        | albedo ([0.5, 0.5, 0.5]), fuzz (0)              |
 | "dielectric"    | Dielectric   | ior (1.5), albedo ([1, 1, 1])                   |
 | "diffuse_light" | DiffuseLight | emit (required), two_sided (false)             |
+| "phong"         | Phong        | albedo ([0.5, 0.5, 0.5]), kd (1), ks (0), exponent (1) |
+| "blinn_phong"   | BlinnPhong   | albedo ([0.5, 0.5, 0.5]), kd (1), ks (0), exponent (1) |
+| "oren_nayar"    | OrenNayar    | albedo ([0.5, 0.5, 0.5]), sigma (20, degrees, < 90) |
+| "cook_torrance" | CookTorrance | albedo ([0.5, 0.5, 0.5]), kd (1), ks (0), roughness (0.5), |
+|                 |              | distribution ("ggx"; or "beckmann"), ior (1.5), f0 (from ior) |
+| "ward"          | Ward         | albedo ([0.5, 0.5, 0.5]), kd (1), ks (0), alpha_x (0.2), |
+|                 |              | alpha_y (= alpha_x)                            |
 """
 
+from .blinn_phong import BlinnPhong
+from .cook_torrance import CookTorrance
 from .dielectric import Dielectric, schlick
 from .diffuse_light import DiffuseLight
 from .lambertian import Lambertian
 from .material import Material
 from .metal import Metal
 from .mirror import Mirror
+from .oren_nayar import OrenNayar
+from .phong import Phong
+from .ward import Ward
 
 MATERIALS: dict[str, type[Material]] = {
     "lambertian": Lambertian,
@@ -22,6 +34,11 @@ MATERIALS: dict[str, type[Material]] = {
     "metal": Metal,
     "dielectric": Dielectric,
     "diffuse_light": DiffuseLight,
+    "phong": Phong,
+    "blinn_phong": BlinnPhong,
+    "oren_nayar": OrenNayar,
+    "cook_torrance": CookTorrance,
+    "ward": Ward,
 }
 
 
@@ -38,12 +55,17 @@ def register_material(name: str):
 
 __all__ = [
     "MATERIALS",
+    "BlinnPhong",
+    "CookTorrance",
     "Dielectric",
     "DiffuseLight",
     "Lambertian",
     "Material",
     "Metal",
     "Mirror",
+    "OrenNayar",
+    "Phong",
+    "Ward",
     "register_material",
     "schlick",
 ]
