@@ -1,0 +1,68 @@
+"""HitBatch: N surface hits as arrays, the batched twin of the scalar HitInfo."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..hit_info import HitInfo
+from ..vec3 import Vec3
+
+
+@dataclass
+class HitBatch:
+    """N surface hits as float64 arrays, with the conventions of the scalar HitInfo.
+
+    point       (N, 3) world positions
+    normal      (N, 3) unit normals facing the arriving ray: dot(normal, wo) >= 0
+    wo          (N, 3) unit directions toward the viewer, -(arriving ray's direction)
+    t           (N,) ray parameters of the hits
+    front_face  (N,) bool: the ray hit the side the geometric normal points to
+    u, v        (N,) surface coordinates
+    tangent     (N, 3) unit vectors in the surface along increasing u (what the scalar
+                hit.tangent gives: the x axis of the shading frame)
+    """
+
+    point: np.ndarray
+    normal: np.ndarray
+    wo: np.ndarray
+    t: np.ndarray
+    front_face: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    tangent: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def take(self, mask_or_index: np.ndarray) -> HitBatch:
+        """The hits selected by a boolean mask or an integer index array."""
+        k = mask_or_index
+        return HitBatch(
+            self.point[k],
+            self.normal[k],
+            self.wo[k],
+            self.t[k],
+            self.front_face[k],
+            self.u[k],
+            self.v[k],
+            self.tangent[k],
+        )
+
+    def hit_info(self, i: int, material=None) -> HitInfo:
+        """Hit i as a scalar HitInfo (for scalar fallbacks and tests); its tangent is
+        this batch's tangent, its (u, v) this batch's."""
+        p, n, s = self.point[i], self.normal[i], self.tangent[i]
+        hit = HitInfo(
+            Vec3(float(p[0]), float(p[1]), float(p[2])),
+            Vec3(float(n[0]), float(n[1]), float(n[2])),
+            float(self.t[i]),
+            bool(self.front_face[i]),
+            material,
+            None,
+            float(self.u[i]),
+            float(self.v[i]),
+        )
+        hit.tangent = Vec3(float(s[0]), float(s[1]), float(s[2]))
+        return hit
