@@ -1,0 +1,862 @@
+"""Scene geometry as arrays: closest hits and occlusion for many rays at once.
+
+The objects of a scene are split by kind into structure-of-arrays sets (spheres,
+quads, triangles), each intersected against a whole batch of rays in a few numpy
+calls. A set with few primitives tests every ray against every primitive (an
+(N, K) array of ray parameters); a set with many builds a bounding volume
+hierarchy (binned SAH over axis-aligned boxes) and traverses it for all rays at
+once, level by level, so a scene with hundreds of spheres costs only the boxes
+and spheres each ray comes near. Shapes rtpy does not know (a student's
+Hittable subclass) are intersected by their scalar methods, one ray at a time.
+
+Conventions are the scalar classes' (rtpy/sphere.py, quad.py, triangle.py):
+rays are (N, 3) origins and unit directions, hits have t in (t_min, t_max),
+normals of a HitBatch face the arriving ray, `front_face` says whether that is
+the geometric outside, (u, v) and tangents are the scalar surface_uv and
+HitInfo.tangent. Spheres use the scalar's cancellation-free root formula, op for
+op, so their t is bit-identical; quads and triangles use an algebraically equal
+form that turns the work into small matrix products (t agrees to ~1e-15).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from ..hit_info import HitInfo
+from ..hittable import Hittable
+from ..quad import Quad
+from ..ray import Ray
+from ..sphere import Sphere
+from ..triangle import Triangle
+from ..vec3 import Vec3
+from .hits import HitBatch
+
+# Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
+BVH_THRESHOLD = 24
+BVH_LEAF_SIZE = 4
+# Rays are intersected in chunks of this many, so (chunk, K) temporaries stay in cache.
+RAY_CHUNK = 2048
+
+INF = math.inf
+
+
+def _v(v: Vec3) -> list[float]:
+    return [float(v.e0), float(v.e1), float(v.e2)]
+
+
+def onb_u(w: np.ndarray) -> np.ndarray:
+    """First axis of the scalar ONB(w) (Duff et al. 2017) for (N, 3) unit vectors w."""
+    w0, w1, w2 = w[:, 0], w[:, 1], w[:, 2]
+    sign = np.copysign(1.0, w2)
+    a = -1.0 / (sign + w2)
+    b = w0 * w1 * a
+    return np.stack([1.0 + sign * w0 * w0 * a, sign * b, -sign * w0], axis=1)
+
+
+def offset_scale(p: np.ndarray) -> np.ndarray:
+    """rtpy.ray.offset_scale for (N, 3) points: how far a spawned ray starts off p."""
+    from ..ray import SPAWN_ABSOLUTE_OFFSET, SPAWN_RELATIVE_OFFSET
+
+    return SPAWN_ABSOLUTE_OFFSET + SPAWN_RELATIVE_OFFSET * np.abs(p).max(axis=1)
+
+
+def spawn_origins(point: np.ndarray, normal: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Origins of rtpy.ray.spawn_ray(point, normal, direction) for (N, 3) arrays: the
+    point pushed off the surface along the normal to the side the direction goes."""
+    eps = offset_scale(point)
+    below = np.einsum("ij,ij->i", direction, normal) < 0.0
+    eps = np.where(below, -eps, eps)
+    return point + eps[:, None] * normal
+
+
+# --------------------------------------------------------------------------------------
+# Bounding volume hierarchy over the primitives of one set
+
+
+class BVH:
+    """A binary BVH over K axis-aligned boxes (binned SAH), stored as arrays.
+
+    Node i has box lo[i], hi[i]; an inner node has children left[i], right[i]; a
+    leaf (count[i] > 0) holds primitives order[start[i] : start[i] + count[i]].
+    """
+
+    def __init__(self, lo: np.ndarray, hi: np.ndarray, leaf_size: int = BVH_LEAF_SIZE) -> None:
+        k = len(lo)
+        centroid = 0.5 * (lo + hi)
+        nodes_lo, nodes_hi, left, right, start, count = [], [], [], [], [], []
+        order: list[int] = []
+
+        def build(idx: np.ndarray) -> int:
+            node = len(nodes_lo)
+            nodes_lo.append(lo[idx].min(axis=0))
+            nodes_hi.append(hi[idx].max(axis=0))
+            left.append(-1)
+            right.append(-1)
+            start.append(0)
+            count.append(0)
+            split = None if len(idx) <= leaf_size else self._sah_split(idx, lo, hi, centroid)
+            if split is None:
+                start[node] = len(order)
+                count[node] = len(idx)
+                order.extend(idx.tolist())
+                return node
+            a, b = split
+            left[node] = build(a)
+            right[node] = build(b)
+            return node
+
+        build(np.arange(k))
+        self.lo = np.array(nodes_lo)
+        self.hi = np.array(nodes_hi)
+        self.left = np.array(left, dtype=np.int64)
+        self.right = np.array(right, dtype=np.int64)
+        self.start = np.array(start, dtype=np.int64)
+        self.count = np.array(count, dtype=np.int64)
+        self.order = np.array(order, dtype=np.int64)
+
+    @staticmethod
+    def _sah_split(idx, lo, hi, centroid, bins: int = 16):
+        """Split idx in two by the cheapest of `bins` planes per axis (surface area
+        heuristic), or None when keeping a leaf is cheaper."""
+
+        def area(a, b):
+            e = np.maximum(b - a, 0.0)
+            return 2.0 * (e[..., 0] * e[..., 1] + e[..., 1] * e[..., 2] + e[..., 2] * e[..., 0])
+
+        c = centroid[idx]
+        best = (area(lo[idx].min(0), hi[idx].max(0)) * len(idx), None)
+        for axis in range(3):
+            cmin, cmax = c[:, axis].min(), c[:, axis].max()
+            if not cmax > cmin:
+                continue
+            b = np.minimum(((c[:, axis] - cmin) / (cmax - cmin) * bins).astype(int), bins - 1)
+            for plane in range(1, bins):
+                m = b < plane
+                n_left = int(m.sum())
+                if n_left == 0 or n_left == len(idx):
+                    continue
+                il, ir = idx[m], idx[~m]
+                cost = area(lo[il].min(0), hi[il].max(0)) * len(il) + area(
+                    lo[ir].min(0), hi[ir].max(0)
+                ) * len(ir)
+                if cost < best[0]:
+                    best = (cost, (il, ir))
+        if best[1] is None and len(idx) > 4 * BVH_LEAF_SIZE:
+            # All centroids together (or no better split): halve by index.
+            half = len(idx) // 2
+            return idx[:half], idx[half:]
+        return best[1]
+
+    def traverse(
+        self,
+        o: np.ndarray,
+        d: np.ndarray,
+        t_min: float,
+        t_max: np.ndarray,
+        test: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
+        any_hit: bool = False,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Closest (or any) hit of every ray among the primitives.
+
+        test(ray_index, prim_index, t_max_pairs) -> t of each (ray, primitive) pair
+        (inf for a miss). Returns (t, prim) per ray: t_max and -1 where nothing is
+        hit before t_max. All rays descend the tree together, one level per
+        iteration; leaves found at a level are tested at once and shrink the rays'
+        t_max, which prunes the boxes of later levels.
+        """
+        n = len(o)
+        best_t = np.array(t_max, dtype=np.float64, copy=True)
+        best_p = np.full(n, -1, dtype=np.int64)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            safe = np.where(np.abs(d) < 1e-300, np.copysign(1e-300, d), d)
+            inv = 1.0 / safe
+        ray = np.arange(n)
+        node = np.zeros(n, dtype=np.int64)
+        done = np.zeros(n, dtype=bool)
+        while ray.size:
+            ro, ri = o[ray], inv[ray]
+            with np.errstate(invalid="ignore", over="ignore"):
+                t0 = (self.lo[node] - ro) * ri
+                t1 = (self.hi[node] - ro) * ri
+            near = np.minimum(t0, t1).max(axis=1)
+            far = np.maximum(t0, t1).min(axis=1)
+            keep = (near <= far) & (far > t_min) & (near < best_t[ray])
+            if any_hit:
+                keep &= ~done[ray]
+            ray, node = ray[keep], node[keep]
+            leaf = self.count[node] > 0
+            if leaf.any():
+                lr, ln = ray[leaf], node[leaf]
+                cnt = self.count[ln]
+                pr = np.repeat(lr, cnt)
+                first = np.repeat(self.start[ln] - (np.cumsum(cnt) - cnt), cnt)
+                pp = self.order[first + np.arange(len(pr))]
+                t = test(pr, pp, best_t[pr])
+                hit = t < best_t[pr]
+                if hit.any():
+                    pr, pp, t = pr[hit], pp[hit], t[hit]
+                    if any_hit:
+                        done[pr] = True
+                        best_t[pr] = t
+                        best_p[pr] = pp
+                    else:
+                        np.minimum.at(best_t, pr, t)
+                        win = t == best_t[pr]
+                        best_p[pr[win]] = pp[win]
+                inner = ~leaf
+                ray, node = ray[inner], node[inner]
+            ray = np.concatenate([ray, ray])
+            node = np.concatenate([self.left[node], self.right[node]])
+        return best_t, best_p
+
+
+# --------------------------------------------------------------------------------------
+# Primitive sets
+
+
+class PrimitiveSet:
+    """Primitives of one kind. Subclasses give the intersection kernels.
+
+    objects  the scalar objects (for fallbacks and tests); index = local index
+    """
+
+    objects: list[Hittable]
+    bvh: BVH | None = None
+
+    def __len__(self) -> int:
+        return len(self.objects)
+
+    # ray parameter of (ray, primitive) pairs; arrays broadcast; inf where missed
+    def pair_t(self, o, d, k, t_min, t_max) -> np.ndarray:
+        raise NotImplementedError
+
+    def all_t(self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray) -> np.ndarray:
+        """(N, K) ray parameters of every ray against every primitive (inf: miss)."""
+        k = np.arange(len(self))[None, :]
+        return self.pair_t(o[:, None, :], d[:, None, :], k, t_min, t_max[:, None])
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+    def build_bvh(self) -> None:
+        if len(self) > BVH_THRESHOLD:
+            self.bvh = BVH(*self.bounds())
+
+    def closest(
+        self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray, any_hit: bool = False
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(t, local index) of each ray's closest hit before t_max (t_max, -1 if none)."""
+        if self.bvh is not None:
+
+            def test(r, p, tm):
+                return self.pair_t(o[r], d[r], p, t_min, tm)
+
+            return self.bvh.traverse(o, d, t_min, t_max, test, any_hit)
+        t_best = np.array(t_max, dtype=np.float64, copy=True)
+        idx = np.full(len(o), -1, dtype=np.int64)
+        for s in range(0, len(o), RAY_CHUNK):
+            e = min(s + RAY_CHUNK, len(o))
+            t = self.all_t(o[s:e], d[s:e], t_min, t_max[s:e])
+            j = np.argmin(t, axis=1)
+            tj = t[np.arange(e - s), j]
+            hit = tj < t_best[s:e]
+            t_best[s:e][hit] = tj[hit]
+            idx[s:e][hit] = j[hit]
+        return t_best, idx
+
+    # --- hit records ---------------------------------------------------------
+    def geometric(self, k, o, d, t) -> tuple[np.ndarray, np.ndarray]:
+        """(point, geometric unit normal) of hits on primitives k along rays at t."""
+        raise NotImplementedError
+
+    def uv(self, k, point) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+    def tangent(self, k, point) -> tuple[np.ndarray, np.ndarray]:
+        """(tangent (N, 3), valid (N,) bool): the scalar surface_tangent; invalid
+        where it returns None (then HitInfo falls back to ONB(normal).u)."""
+        raise NotImplementedError
+
+    # --- as area lights ------------------------------------------------------
+    def area(self, k) -> np.ndarray:
+        raise NotImplementedError
+
+    def sample_point(self, k, r1, r2) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a.b over the last axis, summed in the scalar order x, y, z."""
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+
+
+def area_direction(
+    p: np.ndarray, point: np.ndarray, normal: np.ndarray, area: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Hittable.sample_direction after sample_point: (direction, pdf, valid) for the
+    direction from p to a point sampled by area, pdf = dist^2 / (|cos_light| area)."""
+    dv = point - p
+    dist2 = _dot(dv, dv)
+    valid = dist2 != 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = 1.0 / np.sqrt(dist2)
+        direction = dv * k[:, None]
+        cos_light = np.abs(_dot(direction, normal))
+        valid &= cos_light >= 1e-12
+        pdf = dist2 / (cos_light * area)
+    return direction, np.where(valid, pdf, 0.0), valid
+
+
+def area_direction_pdf(p: np.ndarray, q: np.ndarray, n: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """Hittable.direction_pdf: solid-angle density at p of area sampling picking q
+    (normal n, either side)."""
+    dv = q - p
+    dist2 = _dot(dv, dv)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cos_light = np.abs(_dot(dv, n)) / np.sqrt(dist2)
+        pdf = dist2 / (cos_light * area)
+    return np.where((dist2 == 0.0) | ~(cos_light >= 1e-12), 0.0, pdf)
+
+
+class SphereSet(PrimitiveSet):
+    """Spheres: center (K, 3), radius (K,). Geometric normal outward."""
+
+    def __init__(self, spheres: Sequence[Sphere]) -> None:
+        self.objects = list(spheres)
+        self.center = np.array([_v(s.center) for s in spheres], dtype=np.float64).reshape(-1, 3)
+        self.radius = np.array([float(s.radius) for s in spheres], dtype=np.float64)
+        self.r2 = self.radius * self.radius
+        self.build_bvh()
+
+    def bounds(self):
+        r = self.radius[:, None]
+        return self.center - r, self.center + r
+
+    def pair_t(self, o, d, k, t_min, t_max):
+        # Sphere.hit_t, operation for operation (see rtpy/sphere.py for the maths).
+        c, r, r2 = self.center[k], self.radius[k], self.r2[k]
+        dx, dy, dz = d[..., 0], d[..., 1], d[..., 2]
+        ocx = c[..., 0] - o[..., 0]
+        ocy = c[..., 1] - o[..., 1]
+        ocz = c[..., 2] - o[..., 2]
+        h = dx * ocx + dy * ocy + dz * ocz
+        c_term = ocx * ocx + ocy * ocy + ocz * ocz - r2
+        a = dx * dx + dy * dy + dz * dz
+        kk = h / a
+        fx = ocx - kk * dx
+        fy = ocy - kk * dy
+        fz = ocz - kk * dz
+        f2 = fx * fx + fy * fy + fz * fz
+        miss = ((h < 0.0) & (c_term > 0.0)) | (f2 > r2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            f = np.sqrt(f2)
+            disc = a * (r - f) * (r + f)
+            q = h + np.copysign(np.sqrt(disc), h)
+            t0 = c_term / q
+            t1 = q / a
+        miss |= q == 0.0
+        lo = np.minimum(t0, t1)
+        hi = np.maximum(t0, t1)
+        t = np.where((t_min < hi) & (hi < t_max), hi, INF)
+        t = np.where((t_min < lo) & (lo < t_max), lo, t)
+        return np.where(miss, INF, t)
+
+    def geometric(self, k, o, d, t):
+        c, r = self.center[k], self.radius[k]
+        p = o + t[:, None] * d
+        nv = p - c
+        inv = 1.0 / np.sqrt(_dot(nv, nv))
+        n = nv * inv[:, None]
+        # Back onto the surface: removes the rounding of o + t d (as Sphere.hit_info).
+        p = c + r[:, None] * n
+        return p, n
+
+    def uv(self, k, point):
+        c, r = self.center[k], self.radius[k]
+        x = (point[:, 0] - c[:, 0]) / r
+        y = (point[:, 1] - c[:, 1]) / r
+        z = (point[:, 2] - c[:, 2]) / r
+        theta = np.arccos(np.clip(-y, -1.0, 1.0))
+        phi = np.arctan2(-z, x) + math.pi
+        return phi / (2.0 * math.pi), theta / math.pi
+
+    def tangent(self, k, point):
+        c = self.center[k]
+        x = point[:, 0] - c[:, 0]
+        z = point[:, 2] - c[:, 2]
+        length = np.hypot(x, z)
+        valid = ~(length < 1e-12 * self.radius[k])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tan = np.stack([z / length, np.zeros_like(x), -x / length], axis=1)
+        return tan, valid
+
+    def area(self, k):
+        r = self.radius[k]
+        return 4.0 * math.pi * r * r
+
+    def sample_point(self, k, r1, r2):
+        # sampling.uniform_sphere, then center + n * radius.
+        z = 1.0 - 2.0 * r1
+        s = np.sqrt(np.maximum(0.0, 1.0 - z * z))
+        phi = 2.0 * math.pi * r2
+        n = np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
+        return self.center[k] + n * self.radius[k][:, None], n
+
+    def cone(self, k, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Sphere._cone: (outside (N,) bool, cos_max, 1 - cos_max) of the cone the
+        sphere subtends at p; only meaningful where outside."""
+        dv = self.center[k] - p
+        d2 = _dot(dv, dv)
+        r2 = self.r2[k]
+        outside = ~(d2 <= r2 * 1.0000001)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sin2 = r2 / d2
+            cos_max = np.sqrt(1.0 - sin2)
+            return outside, cos_max, sin2 / (1.0 + cos_max)
+
+    def sample_direction(self, k, p, r1, r2):
+        """Sphere.sample_direction: by solid angle inside the cone seen from outside,
+        by area from inside. Returns (direction, pdf, valid)."""
+        outside, _, omc = self.cone(k, p)
+        direction = np.empty_like(p)
+        pdf = np.zeros(len(p))
+        valid = np.zeros(len(p), dtype=bool)
+        o = np.flatnonzero(outside)
+        if o.size:
+            om = omc[o]
+            cos_t = 1.0 - r1[o] * om
+            sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+            phi = 2.0 * math.pi * r2[o]
+            axis = self.center[k[o]] - p[o]
+            axis = axis * (1.0 / np.sqrt(_dot(axis, axis)))[:, None]
+            x, y = sin_t * np.cos(phi), sin_t * np.sin(phi)
+            # onb.local_to_world(axis, x, y, cos_t)
+            w0, w1, w2 = axis[:, 0], axis[:, 1], axis[:, 2]
+            sign = np.copysign(1.0, w2)
+            a = -1.0 / (sign + w2)
+            b = w0 * w1 * a
+            direction[o, 0] = x * (1.0 + sign * w0 * w0 * a) + y * b + cos_t * w0
+            direction[o, 1] = x * sign * b + y * (sign + w1 * w1 * a) + cos_t * w1
+            direction[o, 2] = -x * sign * w0 - y * w1 + cos_t * w2
+            pdf[o] = 1.0 / (2.0 * math.pi * om)
+            valid[o] = True
+        i = np.flatnonzero(~outside)
+        if i.size:
+            q, n = self.sample_point(k[i], r1[i], r2[i])
+            direction[i], pdf[i], valid[i] = area_direction(p[i], q, n, self.area(k[i]))
+        return direction, pdf, valid
+
+    def direction_pdf(self, k, p, q, n):
+        outside, _, omc = self.cone(k, p)
+        with np.errstate(divide="ignore"):
+            cone_pdf = 1.0 / (2.0 * math.pi * omc)
+        if outside.all():
+            return cone_pdf
+        return np.where(outside, cone_pdf, area_direction_pdf(p, q, n, self.area(k)))
+
+
+class PlanarSet(PrimitiveSet):
+    """Quads and triangles: a plane with unit normal n and two edge vectors. The
+    all-pairs test is written as (N, 3) x (3, K) matrix products."""
+
+    normal: np.ndarray
+    origin: np.ndarray  # q or a
+    tan: np.ndarray  # unit tangent (along u)
+    _area: np.ndarray
+
+    def tangent(self, k, point):
+        return self.tan[k], np.ones(len(k), dtype=bool)
+
+    def area(self, k):
+        return self._area[k]
+
+    def geometric(self, k, o, d, t):
+        return o + t[:, None] * d, self.normal[k]
+
+    def sample_direction(self, k, p, r1, r2):
+        """Hittable.sample_direction: a point uniform by area, converted to solid angle.
+        Returns (direction, pdf, valid)."""
+        q, n = self.sample_point(k, r1, r2)
+        return area_direction(p, q, n, self.area(k))
+
+    def direction_pdf(self, k, p, q, n):
+        return area_direction_pdf(p, q, n, self.area(k))
+
+
+class QuadSet(PlanarSet):
+    """Quads q + a u + b v, a, b in [0, 1]; geometric normal normalize(u x v).
+
+    With w = n / (n . n) for n = u x v, the scalar coordinates of a point p are
+    a = w . ((p - q) x v) = (p - q) . (v x w) and b = w . (u x (p - q)) = (p - q) . (w x u),
+    so for p = o + t d: a = o . A + t (d . A) - q . A with A = v x w (B = w x u likewise).
+    """
+
+    def __init__(self, quads: Sequence[Quad]) -> None:
+        self.objects = list(quads)
+        f = np.float64
+        self.q = np.array([_v(s.q) for s in quads], dtype=f).reshape(-1, 3)
+        self.u = np.array([_v(s.u) for s in quads], dtype=f).reshape(-1, 3)
+        self.v = np.array([_v(s.v) for s in quads], dtype=f).reshape(-1, 3)
+        self.w = np.array([_v(s.w) for s in quads], dtype=f).reshape(-1, 3)
+        self.normal = np.array([_v(s.normal) for s in quads], dtype=f).reshape(-1, 3)
+        self.plane_d = np.array([float(s.d) for s in quads], dtype=f)
+        self.tan = np.array([_v(s._tangent) for s in quads], dtype=f).reshape(-1, 3)
+        self._area = np.array([float(s.area()) for s in quads], dtype=f)
+        self.origin = self.q
+        self.A = np.cross(self.v, self.w)
+        self.B = np.cross(self.w, self.u)
+        self.qA = _dot(self.q, self.A)
+        self.qB = _dot(self.q, self.B)
+        self.M = np.concatenate([self.normal, self.A, self.B], axis=0).T.copy()  # (3, 3K)
+        self.build_bvh()
+
+    def bounds(self):
+        corners = np.stack([self.q, self.q + self.u, self.q + self.v, self.q + self.u + self.v])
+        return corners.min(axis=0), corners.max(axis=0)
+
+    def all_t(self, o, d, t_min, t_max):
+        k = len(self)
+        od = o @ self.M  # (N, 3K): o.n, o.A, o.B
+        dd = d @ self.M
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (self.plane_d - od[:, :k]) / dd[:, :k]
+            a = od[:, k : 2 * k] - self.qA + t * dd[:, k : 2 * k]
+            b = od[:, 2 * k :] - self.qB + t * dd[:, 2 * k :]
+        ok = (t > t_min) & (t < t_max[:, None])
+        ok &= (a >= 0.0) & (a <= 1.0) & (b >= 0.0) & (b <= 1.0)
+        return np.where(ok, t, INF)
+
+    def pair_t(self, o, d, k, t_min, t_max):
+        n = self.normal[k]
+        A, B = self.A[k], self.B[k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (self.plane_d[k] - _dot(n, o)) / _dot(n, d)
+            a = _dot(o, A) - self.qA[k] + t * _dot(d, A)
+            b = _dot(o, B) - self.qB[k] + t * _dot(d, B)
+        ok = (t > t_min) & (t < t_max) & (a >= 0.0) & (a <= 1.0) & (b >= 0.0) & (b <= 1.0)
+        return np.where(ok, t, INF)
+
+    def uv(self, k, point):
+        # Quad._coords, then clamped to [0, 1].
+        q, w, u, v = self.q[k], self.w[k], self.u[k], self.v[k]
+        px, py, pz = point[:, 0] - q[:, 0], point[:, 1] - q[:, 1], point[:, 2] - q[:, 2]
+        a = (
+            w[:, 0] * (py * v[:, 2] - pz * v[:, 1])
+            + w[:, 1] * (pz * v[:, 0] - px * v[:, 2])
+            + w[:, 2] * (px * v[:, 1] - py * v[:, 0])
+        )
+        b = (
+            w[:, 0] * (u[:, 1] * pz - u[:, 2] * py)
+            + w[:, 1] * (u[:, 2] * px - u[:, 0] * pz)
+            + w[:, 2] * (u[:, 0] * py - u[:, 1] * px)
+        )
+        return np.clip(a, 0.0, 1.0), np.clip(b, 0.0, 1.0)
+
+    def sample_point(self, k, r1, r2):
+        p = self.q[k] + r1[:, None] * self.u[k] + r2[:, None] * self.v[k]
+        return p, self.normal[k]
+
+
+class TriangleSet(PlanarSet):
+    """Triangles a, b, c; geometric normal normalize((b - a) x (c - a)).
+
+    Moller-Trumbore in Plucker form: with e1 = b - a, e2 = c - a, m = o x d and
+    N = e1 x e2, det = -(d . N), u det = e2 . m - d . (e2 x a),
+    v det = -(e1 . m) - d . (a x e1), t det = o . N - a . N (all K-sided factors
+    are precomputed; the ray-sided ones are (N, 3) x (3, K) products).
+    """
+
+    def __init__(self, triangles: Sequence[Triangle]) -> None:
+        self.objects = list(triangles)
+        f = np.float64
+        self.a = np.array([_v(s.a) for s in triangles], dtype=f).reshape(-1, 3)
+        self.e1 = np.array([_v(s.e1) for s in triangles], dtype=f).reshape(-1, 3)
+        self.e2 = np.array([_v(s.e2) for s in triangles], dtype=f).reshape(-1, 3)
+        self.normal = np.array([_v(s.normal) for s in triangles], dtype=f).reshape(-1, 3)
+        self.tan = np.array([_v(s._tangent) for s in triangles], dtype=f).reshape(-1, 3)
+        self._area = np.array([float(s.area()) for s in triangles], dtype=f)
+        self.origin = self.a
+        self.N = np.cross(self.e1, self.e2)
+        self.e2xa = np.cross(self.e2, self.a)
+        self.axe1 = np.cross(self.a, self.e1)
+        self.aN = _dot(self.a, self.N)
+        # o-side: [N]; d-side: [N, e2 x a, a x e1]; m-side: [e2, e1]
+        self.Mo = self.N.T.copy()
+        self.Md = np.concatenate([self.N, self.e2xa, self.axe1], axis=0).T.copy()
+        self.Mm = np.concatenate([self.e2, self.e1], axis=0).T.copy()
+        self.build_bvh()
+
+    def bounds(self):
+        corners = np.stack([self.a, self.a + self.e1, self.a + self.e2])
+        return corners.min(axis=0), corners.max(axis=0)
+
+    def _finish(self, det, u_num, v_num, t_num, t_min, t_max):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = 1.0 / det
+            u = u_num * inv
+            v = v_num * inv
+            t = t_num * inv
+        ok = (det != 0.0) & (u >= 0.0) & (u <= 1.0) & (v >= 0.0) & (u + v <= 1.0)
+        ok &= (t > t_min) & (t < t_max)
+        return np.where(ok, t, INF)
+
+    def all_t(self, o, d, t_min, t_max):
+        k = len(self)
+        m = np.cross(o, d)
+        on = o @ self.Mo
+        dd = d @ self.Md
+        mm = m @ self.Mm
+        det = -dd[:, :k]
+        u_num = mm[:, :k] - dd[:, k : 2 * k]
+        v_num = -mm[:, k:] - dd[:, 2 * k :]
+        t_num = on - self.aN
+        return self._finish(det, u_num, v_num, t_num, t_min, t_max[:, None])
+
+    def pair_t(self, o, d, k, t_min, t_max):
+        m = np.cross(o, d)
+        nn = self.N[k]
+        det = -_dot(d, nn)
+        u_num = _dot(self.e2[k], m) - _dot(d, self.e2xa[k])
+        v_num = -_dot(self.e1[k], m) - _dot(d, self.axe1[k])
+        t_num = _dot(o, nn) - self.aN[k]
+        return self._finish(det, u_num, v_num, t_num, t_min, t_max)
+
+    def uv(self, k, point):
+        # Triangle.surface_uv: barycentric coordinates from dot products.
+        p = point - self.a[k]
+        e1, e2 = self.e1[k], self.e2[k]
+        d00, d01, d11 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
+        d20, d21 = _dot(p, e1), _dot(p, e2)
+        denom = d00 * d11 - d01 * d01
+        u = (d11 * d20 - d01 * d21) / denom
+        v = (d00 * d21 - d01 * d20) / denom
+        return np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
+
+    def sample_point(self, k, r1, r2):
+        s = np.sqrt(r1)
+        wb, wc = s * (1.0 - r2), s * r2
+        p = self.a[k] + wb[:, None] * self.e1[k] + wc[:, None] * self.e2[k]
+        return p, self.normal[k]
+
+
+class ScalarSet(PrimitiveSet):
+    """Shapes without a batched twin, intersected by their scalar methods per ray."""
+
+    def __init__(self, objects: Sequence[Hittable]) -> None:
+        self.objects = list(objects)
+
+    def _rays(self, o, d):
+        return [
+            Ray(Vec3(*map(float, oi)), Vec3(*map(float, di))) for oi, di in zip(o, d, strict=True)
+        ]
+
+    def closest(self, o, d, t_min, t_max, any_hit=False):
+        t_best = np.array(t_max, dtype=np.float64, copy=True)
+        idx = np.full(len(o), -1, dtype=np.int64)
+        for i, ray in enumerate(self._rays(o, d)):
+            for j, obj in enumerate(self.objects):
+                t = obj.hit_t(ray, t_min, float(t_best[i]))
+                if t is not None:
+                    t_best[i], idx[i] = t, j
+                    if any_hit:
+                        break
+        return t_best, idx
+
+    def pair_t(self, o, d, k, t_min, t_max):
+        o, d = np.broadcast_arrays(o, d)
+        k, t_max = np.broadcast_to(k, o.shape[:-1]), np.broadcast_to(t_max, o.shape[:-1])
+        out = np.full(o.shape[:-1], INF)
+        for i in np.ndindex(out.shape):
+            ray = Ray(Vec3(*map(float, o[i])), Vec3(*map(float, d[i])))
+            t = self.objects[int(k[i])].hit_t(ray, t_min, float(t_max[i]))
+            out[i] = INF if t is None else t
+        return out
+
+    def _infos(self, k, o, d, t) -> list[HitInfo]:
+        return [
+            self.objects[int(ki)].hit_info(ray, float(ti))
+            for ki, ray, ti in zip(k, self._rays(o, d), t, strict=True)
+        ]
+
+    def geometric(self, k, o, d, t):
+        infos = self._infos(k, o, d, t)
+        p = np.array([_v(h.point) for h in infos]).reshape(-1, 3)
+        n = np.array([_v(h.normal) for h in infos]).reshape(-1, 3)
+        # Back to the geometric side: HitInfo's normal faces the ray.
+        flip = np.array([not h.front_face for h in infos], dtype=bool)
+        n[flip] *= -1.0
+        return p, n
+
+    def _hit(self, ki, point) -> HitInfo:
+        return HitInfo(Vec3(*map(float, point)), Vec3(0.0, 0.0, 1.0), 0.0, True, None, None)
+
+    def uv(self, k, point):
+        pairs = zip(k, point, strict=True)
+        uv = [self.objects[int(ki)].surface_uv(self._hit(ki, p)) for ki, p in pairs]
+        uv = np.array(uv, dtype=np.float64).reshape(-1, 2)
+        return uv[:, 0], uv[:, 1]
+
+    def tangent(self, k, point):
+        tan = np.zeros((len(k), 3))
+        valid = np.zeros(len(k), dtype=bool)
+        for i, (ki, p) in enumerate(zip(k, point, strict=True)):
+            s = self.objects[int(ki)].surface_tangent(self._hit(ki, p))
+            if s is not None:
+                tan[i], valid[i] = _v(s), True
+        return tan, valid
+
+    def area(self, k):
+        return np.array([self.objects[int(ki)].area() for ki in k], dtype=np.float64)
+
+    def sample_direction(self, k, p, r1, r2):
+        direction = np.zeros((len(k), 3))
+        pdf = np.zeros(len(k))
+        valid = np.zeros(len(k), dtype=bool)
+        for i in range(len(k)):
+            s = self.objects[int(k[i])].sample_direction(
+                Vec3(*map(float, p[i])), float(r1[i]), float(r2[i])
+            )
+            if s is not None:
+                direction[i], pdf[i], valid[i] = _v(s[0]), s[1], True
+        return direction, pdf, valid
+
+    def direction_pdf(self, k, p, q, n):
+        out = np.zeros(len(k))
+        for i in range(len(k)):
+            hit = HitInfo(Vec3(*map(float, q[i])), Vec3(*map(float, n[i])), 0.0, True, None)
+            out[i] = self.objects[int(k[i])].direction_pdf(Vec3(*map(float, p[i])), hit)
+        return out
+
+
+# --------------------------------------------------------------------------------------
+# The whole scene
+
+
+SPHERE, QUAD, TRIANGLE, OTHER = 0, 1, 2, 3
+
+
+class Geometry:
+    """All objects of a scene as primitive sets.
+
+    Object i (index into `objects`) is primitive local[i] of set sets[kind[i]];
+    `material_id[i]` is its material's index in `materials` (distinct materials
+    in first-use order, the ids a MaterialTable gets).
+    """
+
+    def __init__(self, objects: Sequence[Hittable]) -> None:
+        self.objects = list(objects)
+        n = len(self.objects)
+        self.kind = np.empty(n, dtype=np.int64)
+        self.local = np.empty(n, dtype=np.int64)
+        groups: list[list[int]] = [[], [], [], []]
+        for i, obj in enumerate(self.objects):
+            # Exact types: a subclass may override hit_t (tests do), so it goes scalar.
+            kind = {Sphere: SPHERE, Quad: QUAD, Triangle: TRIANGLE}.get(type(obj), OTHER)
+            self.kind[i] = kind
+            self.local[i] = len(groups[kind])
+            groups[kind].append(i)
+        self.members = [np.array(g, dtype=np.int64) for g in groups]  # set -> object index
+        makers = (SphereSet, QuadSet, TriangleSet, ScalarSet)
+        self.sets: list[PrimitiveSet | None] = [
+            makers[kd]([self.objects[i] for i in g]) if g else None for kd, g in enumerate(groups)
+        ]
+        self.materials: list = []
+        ids: dict[int, int] = {}
+        self.material_id = np.empty(n, dtype=np.int64)
+        for i, obj in enumerate(self.objects):
+            key = id(obj.material)
+            if key not in ids:
+                ids[key] = len(self.materials)
+                self.materials.append(obj.material)
+            self.material_id[i] = ids[key]
+
+    def _order(self):
+        # Brute-force sets first: their hits give the BVH traversals a t_max to prune with.
+        return sorted(
+            (kd for kd in range(4) if self.sets[kd] is not None),
+            key=lambda kd: (self.sets[kd].bvh is not None, kd == OTHER),
+        )
+
+    def closest_hit(
+        self, o: np.ndarray, d: np.ndarray, t_max: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(object index (N,), -1 for a miss; t (N,)) of each ray's closest hit with
+        0 < t < t_max (default inf), as Scene.find_intersection(ray, FORWARD)."""
+        n = len(o)
+        t_best = np.full(n, INF) if t_max is None else np.array(t_max, dtype=np.float64)
+        obj = np.full(n, -1, dtype=np.int64)
+        for kd in self._order():
+            t, k = self.sets[kd].closest(o, d, 0.0, t_best)
+            hit = k >= 0
+            t_best[hit] = t[hit]
+            obj[hit] = self.members[kd][k[hit]]
+        return obj, t_best
+
+    def occluded(self, o: np.ndarray, d: np.ndarray, t_max: np.ndarray) -> np.ndarray:
+        """(N,) bool: something (glass included) lies on the ray with 0 < t < t_max,
+        as Scene.find_occlusion(ray, Interval(0, t_max))."""
+        blocked = np.zeros(len(o), dtype=bool)
+        for kd in self._order():
+            live = np.flatnonzero(~blocked)
+            if live.size == 0:
+                break
+            _, k = self.sets[kd].closest(o[live], d[live], 0.0, t_max[live], any_hit=True)
+            blocked[live[k >= 0]] = True
+        return blocked
+
+    def hit_batch(
+        self,
+        obj: np.ndarray,
+        o: np.ndarray,
+        d: np.ndarray,
+        t: np.ndarray,
+        need_uv: bool = True,
+        need_tangent: bool = True,
+    ) -> HitBatch:
+        """The HitBatch of rays (o, d) hitting objects obj at t (all hits, obj >= 0).
+        Without need_uv / need_tangent those fields are zeros (nothing reads them)."""
+        n = len(obj)
+        point = np.empty((n, 3))
+        geo = np.empty((n, 3))
+        kinds = self.kind[obj]
+        local = self.local[obj]
+        groups = [(kd, np.flatnonzero(kinds == kd)) for kd in range(4)]
+        groups = [(kd, i) for kd, i in groups if i.size]
+        if len(groups) == 1:
+            kd, _ = groups[0]
+            point, geo = self.sets[kd].geometric(local, o, d, t)
+        else:
+            for kd, i in groups:
+                point[i], geo[i] = self.sets[kd].geometric(local[i], o[i], d[i], t[i])
+        front = _dot(geo, d) < 0.0
+        normal = np.where(front[:, None], geo, -geo)
+        if need_uv:
+            u, v = np.empty(n), np.empty(n)
+            for kd, i in groups:
+                u[i], v[i] = self.sets[kd].uv(local[i], point[i])
+        else:
+            u = v = np.zeros(n)
+        if need_tangent:
+            tangent = np.empty((n, 3))
+            valid = np.empty(n, dtype=bool)
+            for kd, i in groups:
+                tangent[i], valid[i] = self.sets[kd].tangent(local[i], point[i])
+            if not valid.all():
+                bad = ~valid
+                tangent[bad] = onb_u(normal[bad])
+        else:
+            tangent = np.zeros((n, 3))
+        return HitBatch(point, normal, -d, t, front, u, v, tangent)
+
+    def set_of(self, obj: np.ndarray):
+        """[(set, local indices, positions in obj)] grouping objects by kind."""
+        kinds = self.kind[obj]
+        out = []
+        for kd in range(4):
+            i = np.flatnonzero(kinds == kd)
+            if i.size:
+                out.append((self.sets[kd], self.local[obj[i]], i))
+        return out

@@ -1,0 +1,159 @@
+"""Batched light sampling: the twin of rtpy/light.py and the shapes' sample_direction.
+
+A light sample from a receiving point p gives the unit direction wi toward the
+light, the distance to the point on the light, the radiance arriving along wi,
+its solid-angle pdf and whether the light is a delta light:
+
+- a point light: the one direction, pdf 1, radiance I / d^2 (falls off as 1/r^2);
+- an area light (an object whose material emits): a direction from the shape's
+  sample_direction (spheres seen from outside by the cone they subtend, else
+  uniformly by area with pdf = pdf_area * d^2 / |cos theta_light|), traced to the
+  shape itself from p to find the point and its emission (AreaLight.sample).
+
+Lights are chosen uniformly (index min(int(u n), n - 1)); the pdf returned does
+not include the 1 / n of that choice.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..scene import Scene
+from .geometry import INF, Geometry
+
+
+@dataclass
+class LightSamples:
+    """N light samples; where `valid` is False the sample contributes nothing."""
+
+    direction: np.ndarray  # (N, 3) unit, from the receiving point toward the light
+    distance: np.ndarray  # (N,)
+    radiance: np.ndarray  # (N, 3)
+    pdf: np.ndarray  # (N,) solid-angle density (1 for point lights)
+    delta: np.ndarray  # (N,) bool: point light
+    point: np.ndarray  # (N, 3) the point on the light
+    valid: np.ndarray  # (N,) bool
+
+
+class LightTable:
+    """The lights of a scene: point lights first, then area lights in object order
+    (Scene.lights' order).
+
+    geometry   the scene's Geometry (area lights are its objects)
+    materials  a MaterialTable over geometry.materials (for the emission)
+    need_uv, need_tangent  what the emission's HitBatch must carry
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        geometry: Geometry,
+        materials,
+        need_uv: bool = False,
+        need_tangent: bool = False,
+    ) -> None:
+        self.geometry = geometry
+        self.materials = materials
+        self.need_uv, self.need_tangent = need_uv, need_tangent
+        pl = scene.point_lights
+        self.point_position = np.array(
+            [[p.position.e0, p.position.e1, p.position.e2] for p in pl], dtype=np.float64
+        ).reshape(-1, 3)
+        self.point_intensity = np.array(
+            [[p.intensity.e0, p.intensity.e1, p.intensity.e2] for p in pl], dtype=np.float64
+        ).reshape(-1, 3)
+        index = {id(obj): i for i, obj in enumerate(geometry.objects)}
+        self.area_object = np.array([index[id(a.shape)] for a in scene.area_lights], dtype=np.int64)
+        self.n_point = len(pl)
+        self.n_area = len(self.area_object)
+        self.n = self.n_point + self.n_area
+
+    def count(self, include_area: bool = True) -> int:
+        return self.n if include_area else self.n_point
+
+    def sample(
+        self, p: np.ndarray, rng: np.random.Generator, include_area: bool = True
+    ) -> LightSamples:
+        """One light sample per receiving point p (N, 3): a light chosen uniformly
+        among all lights (or only the point lights), then a direction toward it."""
+        n = len(p)
+        n_lights = self.count(include_area)
+        u = rng.random(n)
+        choice = np.minimum((u * n_lights).astype(np.int64), n_lights - 1)
+        out = LightSamples(
+            np.zeros((n, 3)),
+            np.zeros(n),
+            np.zeros((n, 3)),
+            np.zeros(n),
+            choice < self.n_point,
+            np.zeros((n, 3)),
+            np.zeros(n, dtype=bool),
+        )
+        pt = np.flatnonzero(out.delta)
+        if pt.size:
+            self._sample_point_lights(p, choice, pt, out)
+        ar = np.flatnonzero(~out.delta)
+        if ar.size:
+            r = rng.random((2, ar.size))
+            obj = self.area_object[choice[ar] - self.n_point]
+            self.sample_area(p[ar], obj, r[0], r[1], out, ar)
+        return out
+
+    def _sample_point_lights(self, p, choice, idx, out: LightSamples) -> None:
+        q = self.point_position[choice[idx]]
+        dv = q - p[idx]
+        dist2 = dv[:, 0] * dv[:, 0] + dv[:, 1] * dv[:, 1] + dv[:, 2] * dv[:, 2]
+        ok = dist2 != 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dist = np.sqrt(dist2)
+            out.direction[idx] = dv / dist[:, None]
+            out.radiance[idx] = self.point_intensity[choice[idx]] * (1.0 / dist2)[:, None]
+        out.distance[idx] = dist
+        out.pdf[idx] = 1.0
+        out.point[idx] = q
+        out.valid[idx] = ok
+
+    def sample_area(
+        self,
+        p: np.ndarray,
+        obj: np.ndarray,
+        r1: np.ndarray,
+        r2: np.ndarray,
+        out: LightSamples,
+        idx: np.ndarray,
+    ) -> None:
+        """AreaLight.sample for points p toward objects obj with uniforms r1, r2;
+        writes rows idx of out."""
+        g = self.geometry
+        direction = np.zeros_like(p)
+        pdf = np.zeros(len(p))
+        valid = np.zeros(len(p), dtype=bool)
+        t = np.full(len(p), INF)
+        for prims, local, i in g.set_of(obj):
+            direction[i], pdf[i], valid[i] = prims.sample_direction(local, p[i], r1[i], r2[i])
+            # Trace from p itself (not offset) to the shape, as AreaLight.sample.
+            t[i] = prims.pair_t(p[i], direction[i], local, 0.0, INF)
+        valid &= (t < INF) & (pdf > 0.0)
+        ok = np.flatnonzero(valid)
+        if ok.size == 0:
+            out.valid[idx] = False
+            return
+        hits = g.hit_batch(obj[ok], p[ok], direction[ok], t[ok], self.need_uv, self.need_tangent)
+        radiance = self.materials.emitted(g.material_id[obj[ok]], hits)
+        j = idx[ok]
+        out.direction[j] = direction[ok]
+        out.distance[j] = t[ok]
+        out.radiance[j] = radiance
+        out.pdf[j] = pdf[ok]
+        out.point[j] = hits.point
+        out.valid[idx] = valid
+
+    def direction_pdf(self, obj: np.ndarray, p: np.ndarray, q: np.ndarray, n: np.ndarray):
+        """AreaLight.pdf: solid-angle density of sampling the direction from p to the
+        point q (normal n, either side) on the emitting objects obj."""
+        out = np.zeros(len(obj))
+        for prims, local, i in self.geometry.set_of(obj):
+            out[i] = prims.direction_pdf(local, p[i], q[i], n[i])
+        return out

@@ -1,0 +1,170 @@
+"""Batched light sampling against rtpy/light.py and the shapes' sample_direction /
+direction_pdf, with the same uniform numbers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rtpy import Color, DiffuseLight, Lambertian, PointLight, Quad, Scene, Sphere, Triangle, Vec3
+from rtpy.hit_info import HitInfo
+from rtpy.numpy_backend.geometry import Geometry
+from rtpy.numpy_backend.lights import LightSamples, LightTable
+from rtpy.sampling import use_generator
+
+coord = st.floats(-4.0, 4.0, allow_nan=False)
+vec = st.tuples(coord, coord, coord)
+# Away from 0 and 1: a sample exactly on a quad's or triangle's edge may hit or miss
+# it by rounding, differently in the two implementations.
+unit = st.floats(1e-6, 1.0 - 1e-6)
+LIGHT = DiffuseLight(Color(3.0, 2.0, 1.0))
+
+
+class EmissionTable:
+    """A minimal stand-in for the material table: emission by the scalar emitting()."""
+
+    def __init__(self, materials) -> None:
+        self.materials = materials
+
+    def emitted(self, ids, hits):
+        return np.array(
+            [
+                list(self.materials[m].emitting(hits.hit_info(i, self.materials[m])))
+                for i, m in enumerate(ids)
+            ],
+            dtype=np.float64,
+        ).reshape(-1, 3)
+
+
+class Replay:
+    def __init__(self, values) -> None:
+        self.values = list(map(float, values))
+
+    def random(self) -> float:
+        return self.values.pop(0)
+
+
+def V(a) -> Vec3:
+    return Vec3(*map(float, a))
+
+
+def arr(v: Vec3) -> np.ndarray:
+    return np.array([v.e0, v.e1, v.e2])
+
+
+def shapes(center, size, a, b):
+    """A sphere, and a quad and a triangle when a, b span a usable parallelogram."""
+    c, s = np.array(center), size
+    out = [Sphere(V(c), s, LIGHT)]
+    ua, ub = np.array(a) * s, np.array(b) * s
+    if np.linalg.norm(np.cross(ua, ub)) > 1e-2 * (1 + np.linalg.norm(ua) * np.linalg.norm(ub)):
+        out.append(Quad(V(c), V(ua), V(ub), LIGHT))
+        out.append(Triangle(V(c), V(c + ua), V(c + ub), LIGHT))
+    return out
+
+
+def table(shape, two_sided=False):
+    scene = Scene([shape])
+    geo = Geometry(scene.objects)
+    return LightTable(scene, geo, EmissionTable(geo.materials), True, True), geo
+
+
+@settings(max_examples=150)
+@given(vec, st.floats(0.1, 2.0), vec, vec, vec, unit, unit)
+def test_area_light_sample_matches_area_light(center, size, a, b, p, r1, r2):
+    for shape in shapes(center, size, a, b):
+        lights, geo = table(shape)
+        pp = np.array([p], dtype=np.float64)
+        # The shape's own sample_direction, then the full AreaLight.sample.
+        prims, local, _ = geo.set_of(np.array([0]))[0]
+        d, pdf, valid = prims.sample_direction(local, pp, np.array([r1]), np.array([r2]))
+        ref = shape.sample_direction(V(p), r1, r2)
+        assert bool(valid[0]) == (ref is not None)
+        if ref is not None:
+            np.testing.assert_allclose(d[0], arr(ref[0]), rtol=1e-12, atol=1e-12)
+            assert pdf[0] == pytest.approx(ref[1], rel=1e-12)
+        out = empty_samples(1)
+        lights.sample_area(pp, np.array([0]), np.array([r1]), np.array([r2]), out, np.array([0]))
+        with use_generator(Replay([r1, r2])):
+            s = scene_light(shape).sample(V(p))
+        if s is None:
+            assert not out.valid[0] or not out.pdf[0] > 0
+            continue
+        if not out.valid[0]:  # a grazing direction rounding moved off the shape
+            assert abs(np.dot(arr(s.direction), shape_normal(shape, s))) < 1e-6
+            continue
+        np.testing.assert_allclose(out.direction[0], arr(s.direction), rtol=1e-12, atol=1e-12)
+        assert out.distance[0] == pytest.approx(s.distance, rel=1e-9)
+        assert out.pdf[0] == pytest.approx(s.pdf, rel=1e-12)
+        np.testing.assert_allclose(out.radiance[0], arr(s.radiance))
+        np.testing.assert_allclose(out.point[0], arr(s.point), rtol=1e-9, atol=1e-9)
+
+
+def shape_normal(shape, s):
+    if isinstance(shape, Sphere):
+        n = arr(s.point) - arr(shape.center)
+        return n / np.linalg.norm(n)
+    return arr(shape.normal)
+
+
+def scene_light(shape):
+    return Scene([shape]).area_lights[0]
+
+
+def empty_samples(n):
+    z = np.zeros
+    return LightSamples(z((n, 3)), z(n), z((n, 3)), z(n), z(n, bool), z((n, 3)), z(n, bool))
+
+
+@settings(max_examples=150)
+@given(vec, st.floats(0.1, 2.0), vec, vec, vec, unit, unit)
+def test_direction_pdf_matches_scalar(center, size, a, b, p, r1, r2):
+    for shape in shapes(center, size, a, b):
+        lights, geo = table(shape)
+        q, n = shape.sample_point(r1, r2)
+        hit = HitInfo(q, n, 1.0, True, LIGHT, shape)
+        ref = shape.direction_pdf(V(p), hit)
+        got = lights.direction_pdf(np.array([0]), np.array([p]), arr(q)[None], arr(n)[None])[0]
+        assert got == pytest.approx(ref, rel=1e-12)
+
+
+def test_light_choice_and_point_lights():
+    scene = Scene(
+        [Sphere(Vec3(0, 3, 0), 0.5, LIGHT), Sphere(Vec3(0, -1, 0), 0.5, Lambertian())],
+        point_lights=[
+            PointLight(Vec3(1, 2, 3), Color(4, 5, 6)),
+            PointLight(Vec3(-1, 0, 0), Color(1, 1, 1)),
+        ],
+    )
+    geo = Geometry(scene.objects)
+    lights = LightTable(scene, geo, EmissionTable(geo.materials))
+    assert (lights.n_point, lights.n_area, lights.n) == (2, 1, 3)
+    n = 30000
+    p = np.tile([0.0, 0.0, 0.0], (n, 1))
+    s = lights.sample(p, np.random.default_rng(2))
+    assert s.valid.all()
+    frac = [np.mean(s.delta & (s.point[:, 0] == x)) for x in (1, -1)]
+    np.testing.assert_allclose(frac, 1 / 3, atol=4 * math.sqrt(2 / 9 / n))
+    ref = scene.point_lights[0].sample(Vec3(0, 0, 0))
+    k = np.flatnonzero(s.delta & (s.point[:, 0] == 1))[0]
+    np.testing.assert_array_equal(s.direction[k], arr(ref.direction))
+    np.testing.assert_array_equal(s.radiance[k], arr(ref.radiance))
+    assert s.distance[k] == ref.distance and s.pdf[k] == 1.0
+    only_points = lights.sample(p[:1000], np.random.default_rng(3), include_area=False)
+    assert only_points.delta.all()
+
+
+def test_one_sided_light_seen_from_behind_gives_no_radiance():
+    quad = Quad(Vec3(-1, 2, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), LIGHT)  # normal -y... or +y
+    lights, _ = table(quad)
+    above = np.array([[0.0, 5.0, 0.0]]) if arr(quad.normal)[1] > 0 else np.array([[0.0, -5.0, 0.0]])
+    below = -above + np.array([[0.0, 4.0, 0.0]])
+    for p, lit in ((above, True), (below, False)):
+        out = empty_samples(1)
+        lights.sample_area(p, np.array([0]), np.array([0.3]), np.array([0.6]), out, np.array([0]))
+        assert out.valid[0]
+        assert (out.radiance[0].max() > 0) == lit
