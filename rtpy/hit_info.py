@@ -9,6 +9,7 @@ from .vec3 import Vec3
 if TYPE_CHECKING:
     from .hittable import Hittable
     from .materials.material import Material
+    from .onb import ONB
 
 
 class HitInfo:
@@ -25,10 +26,24 @@ class HitInfo:
     tangent     unit vector in the surface along increasing u, perpendicular to the
                 normal (the first axis of anisotropic materials' frame); computed
                 on first access
+    frame       the shading frame ONB.from_normal_tangent(normal, tangent): z along
+                the normal, x along the tangent; computed on first access and shared
+                by the BRDF(), pdf() and scattering() calls at this hit
     obj         the object that was hit
     """
 
-    __slots__ = ("point", "normal", "t", "front_face", "material", "obj", "_u", "_v", "_tangent")
+    __slots__ = (
+        "point",
+        "normal",
+        "t",
+        "front_face",
+        "material",
+        "obj",
+        "_u",
+        "_v",
+        "_tangent",
+        "_frame",
+    )
 
     def __init__(
         self,
@@ -50,6 +65,7 @@ class HitInfo:
         self._u = u
         self._v = v
         self._tangent = None
+        self._frame = None
 
     def _compute_uv(self) -> None:
         if self.obj is None:
@@ -82,6 +98,15 @@ class HitInfo:
     @tangent.setter
     def tangent(self, value: Vec3) -> None:
         self._tangent = value
+        self._frame = None
+
+    @property
+    def frame(self) -> ONB:
+        if self._frame is None:
+            from .onb import ONB
+
+            self._frame = ONB.from_normal_tangent(self.normal, self.tangent)
+        return self._frame
 
     def __repr__(self) -> str:
         return (

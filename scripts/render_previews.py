@@ -23,6 +23,10 @@ SETTINGS = {
     "week05_point_light": (320, 32),
     "week07_textures": (320, 32),
     "week08_three_balls": (320, 64),
+    "week08_phong": (320, 32),
+    "week08_blinn": (320, 32),
+    "week08_cook_torrance": (320, 32),
+    "material_gallery": (400, 32),
 }
 
 

@@ -60,7 +60,7 @@ class GlossyMaterial(Material):
 
     # --- shared machinery -------------------------------------------------------
     def frame(self, hit: HitInfo) -> ONB:
-        return ONB.from_normal_tangent(hit.normal, hit.tangent)
+        return hit.frame
 
     def diffuse_probability(self, albedo: Color) -> float:
         diffuse = self.kd * max(albedo.e0, albedo.e1, albedo.e2)

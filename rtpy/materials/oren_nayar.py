@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 
 from ..hit_info import HitInfo
-from ..onb import ONB
 from ..ray import Ray, spawn_ray
 from ..sampling import random_cosine_direction
 from ..scatter_info import ScatterInfo
@@ -79,7 +78,7 @@ class OrenNayar(Material):
         return self.A + self.B * cos_phi_sin_sin / cos_beta
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
-        frame = ONB.from_normal_tangent(hit.normal, hit.tangent)
+        frame = hit.frame
         wo = frame.to_local(-ray_view.direction)
         wi = frame.to_local(ray_light.direction)
         if wo[2] <= 0.0 or wi[2] <= 0.0:
@@ -93,7 +92,7 @@ class OrenNayar(Material):
         return max(0.0, n.e0 * wi.e0 + n.e1 * wi.e1 + n.e2 * wi.e2) * INV_PI
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
-        frame = ONB.from_normal_tangent(hit.normal, hit.tangent)
+        frame = hit.frame
         wo = frame.to_local(-ray_in.direction)
         if wo[2] <= 0.0:
             return None
