@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..hit_info import HitInfo
 from ..vec3 import Vec3
+
+if TYPE_CHECKING:
+    from ..materials.material import Material
 
 
 @dataclass
@@ -50,7 +54,7 @@ class HitBatch:
             self.tangent[k],
         )
 
-    def hit_info(self, i: int, material=None) -> HitInfo:
+    def hit_info(self, i: int, material: Material | None = None) -> HitInfo:
         """Hit i as a scalar HitInfo (for scalar fallbacks and tests); its tangent is
         this batch's tangent, its (u, v) this batch's."""
         p, n, s = self.point[i], self.normal[i], self.tangent[i]

@@ -236,37 +236,27 @@ exponents = st.one_of(st.sampled_from([0.0, 0.5, 1.0, 8.0, 100.0, 1e4]), st.floa
 widths = st.one_of(st.sampled_from([1e-6, 1e-4, 1e-3, 0.05, 1.0]), st.floats(1e-3, 1.0))
 
 
-@st.composite
-def kd_ks(draw):
-    return draw(st.sampled_from([0.0, 1.0]) | unit_floats), draw(
-        st.sampled_from([0.0, 1.0]) | unit_floats
-    )
-
-
-@st.composite
-def cook_torrance(draw):
-    kd, ks = draw(kd_ks())
-    f0 = draw(st.none() | colors)
-    ior = draw(st.floats(1.0, 3.0))
-    return CookTorrance(
-        draw(albedos()),
-        kd,
-        ks,
-        draw(widths),
-        draw(st.sampled_from(["ggx", "beckmann"])),
-        ior,
-        f0,
-    )
+strengths = st.sampled_from([0.0, 1.0]) | unit_floats
+kd_ks = st.tuples(strengths, strengths)
+cook_torrance = st.builds(
+    lambda a, k, alpha, distribution, ior, f0: CookTorrance(a, *k, alpha, distribution, ior, f0),
+    albedos(),
+    kd_ks,
+    widths,
+    st.sampled_from(["ggx", "beckmann"]),
+    st.floats(1.0, 3.0),
+    st.none() | colors,
+)
 
 
 MATERIALS = {
     "lambertian": albedos().map(Lambertian),
     "oren_nayar": st.builds(OrenNayar, albedos(), st.sampled_from([0.0, 89.9]) | st.floats(0, 89)),
-    "phong": st.builds(lambda a, k, n: Phong(a, *k, n), albedos(), kd_ks(), exponents),
-    "blinn_phong": st.builds(lambda a, k, n: BlinnPhong(a, *k, n), albedos(), kd_ks(), exponents),
-    "cook_torrance": cook_torrance(),
+    "phong": st.builds(lambda a, k, n: Phong(a, *k, n), albedos(), kd_ks, exponents),
+    "blinn_phong": st.builds(lambda a, k, n: BlinnPhong(a, *k, n), albedos(), kd_ks, exponents),
+    "cook_torrance": cook_torrance,
     "ward": st.builds(
-        lambda a, k, ax, ay: Ward(a, *k, ax, ay), albedos(), kd_ks(), widths, st.none() | widths
+        lambda a, k, ax, ay: Ward(a, *k, ax, ay), albedos(), kd_ks, widths, st.none() | widths
     ),
     "mirror": albedos().map(Mirror),
     "metal": st.builds(Metal, albedos(), st.sampled_from([0.0, 0.3, 1.0, 2.0])),
