@@ -38,9 +38,14 @@ from .hits import HitBatch
 BVH_THRESHOLD = 24
 BVH_LEAF_SIZE = 4
 # Rays are intersected in chunks of this many, so (chunk, K) temporaries stay in cache.
-RAY_CHUNK = 2048
+RAY_CHUNK = 1024
 
 INF = math.inf
+# Quads accept hits this little outside their edges (in units of the edge length):
+# rounding differs from the scalar formula's, and without the margin a ray exactly
+# along the shared edge of two quads (a corner of a closed box) could slip between.
+EDGE_A = 1e-9
+EDGE = 1.0 + 2.0 * EDGE_A  # the same margin for |2a - 1| <= 1
 
 
 def _v(v: Vec3) -> list[float]:
@@ -233,10 +238,11 @@ class PrimitiveSet:
     def pair_t(self, o, d, k, t_min, t_max) -> np.ndarray:
         raise NotImplementedError
 
-    def all_t(self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray) -> np.ndarray:
-        """(N, K) ray parameters of every ray against every primitive (inf: miss)."""
+    def all_t(self, o: np.ndarray, d: np.ndarray, t_min: float) -> np.ndarray:
+        """(N, K) ray parameters of every ray against every primitive with t > t_min
+        (inf: miss). The caller compares the smallest with each ray's t_max."""
         k = np.arange(len(self))[None, :]
-        return self.pair_t(o[:, None, :], d[:, None, :], k, t_min, t_max[:, None])
+        return self.pair_t(o[:, None, :], d[:, None, :], k, t_min, INF)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
@@ -246,20 +252,34 @@ class PrimitiveSet:
             self.bvh = BVH(*self.bounds())
 
     def closest(
-        self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray, any_hit: bool = False
+        self,
+        o: np.ndarray,
+        d: np.ndarray,
+        t_min: float,
+        t_max: np.ndarray,
+        any_hit: bool = False,
+        skip: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """(t, local index) of each ray's closest hit before t_max (t_max, -1 if none)."""
+        """(t, local index) of each ray's closest hit before t_max (t_max, -1 if none).
+        any_hit: any hit will do (occlusion). skip: per ray, a primitive to ignore (-1:
+        none)."""
         if self.bvh is not None:
 
             def test(r, p, tm):
-                return self.pair_t(o[r], d[r], p, t_min, tm)
+                t = self.pair_t(o[r], d[r], p, t_min, tm)
+                if skip is not None:
+                    t[p == skip[r]] = INF
+                return t
 
             return self.bvh.traverse(o, d, t_min, t_max, test, any_hit)
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(len(o), -1, dtype=np.int64)
         for s in range(0, len(o), RAY_CHUNK):
             e = min(s + RAY_CHUNK, len(o))
-            t = self.all_t(o[s:e], d[s:e], t_min, t_max[s:e])
+            t = self.all_t(o[s:e], d[s:e], t_min)
+            if skip is not None:
+                r = np.flatnonzero(skip[s:e] >= 0)
+                t[r, skip[s:e][r]] = INF
             j = np.argmin(t, axis=1)
             tj = t[np.arange(e - s), j]
             hit = tj < t_best[s:e]
@@ -510,23 +530,37 @@ class QuadSet(PlanarSet):
         self.B = np.cross(self.w, self.u)
         self.qA = _dot(self.q, self.A)
         self.qB = _dot(self.q, self.B)
-        self.M = np.concatenate([self.normal, self.A, self.B], axis=0).T.copy()  # (3, 3K)
+        # Products for all_t: (4, K) for homogeneous origins, (3, K) for directions.
+        self.Mo_n = np.vstack([-self.normal.T, self.plane_d])
+        self.Mo_a = np.vstack([2.0 * self.A.T, -2.0 * self.qA - 1.0])
+        self.Mo_b = np.vstack([2.0 * self.B.T, -2.0 * self.qB - 1.0])
+        self.Md_n = self.normal.T.copy()
+        self.Md_a = 2.0 * self.A.T
+        self.Md_b = 2.0 * self.B.T
         self.build_bvh()
 
     def bounds(self):
         corners = np.stack([self.q, self.q + self.u, self.q + self.v, self.q + self.u + self.v])
         return corners.min(axis=0), corners.max(axis=0)
 
-    def all_t(self, o, d, t_min, t_max):
-        k = len(self)
-        od = o @ self.M  # (N, 3K): o.n, o.A, o.B
-        dd = d @ self.M
+    def all_t(self, o, d, t_min):
+        # Homogeneous o: one product gives d - o.n and 2 (o.A - q.A) - 1 (and for B),
+        # so a' = 2a - 1 and b' = 2b - 1 need one multiply-add each and the test
+        # 0 <= a, b <= 1 becomes max(|a'|, |b'|) <= 1.
+        oh = np.empty((len(o), 4))
+        oh[:, :3] = o
+        oh[:, 3] = 1.0
         with np.errstate(divide="ignore", invalid="ignore"):
-            t = (self.plane_d - od[:, :k]) / dd[:, :k]
-            a = od[:, k : 2 * k] - self.qA + t * dd[:, k : 2 * k]
-            b = od[:, 2 * k :] - self.qB + t * dd[:, 2 * k :]
-        ok = (t > t_min) & (t < t_max[:, None])
-        ok &= (a >= 0.0) & (a <= 1.0) & (b >= 0.0) & (b <= 1.0)
+            t = (oh @ self.Mo_n) / (d @ self.Md_n)
+            a = oh @ self.Mo_a
+            a += t * (d @ self.Md_a)
+            b = oh @ self.Mo_b
+            b += t * (d @ self.Md_b)
+            np.abs(a, out=a)
+            np.abs(b, out=b)
+            np.maximum(a, b, out=a)
+            ok = a <= EDGE
+            ok &= t > t_min
         return np.where(ok, t, INF)
 
     def pair_t(self, o, d, k, t_min, t_max):
@@ -536,7 +570,8 @@ class QuadSet(PlanarSet):
             t = (self.plane_d[k] - _dot(n, o)) / _dot(n, d)
             a = _dot(o, A) - self.qA[k] + t * _dot(d, A)
             b = _dot(o, B) - self.qB[k] + t * _dot(d, B)
-        ok = (t > t_min) & (t < t_max) & (a >= 0.0) & (a <= 1.0) & (b >= 0.0) & (b <= 1.0)
+        ok = (t > t_min) & (t < t_max) & (a >= -EDGE_A) & (a <= 1.0 + EDGE_A)
+        ok &= (b >= -EDGE_A) & (b <= 1.0 + EDGE_A)
         return np.where(ok, t, INF)
 
     def uv(self, k, point):
@@ -603,7 +638,7 @@ class TriangleSet(PlanarSet):
         ok &= (t > t_min) & (t < t_max)
         return np.where(ok, t, INF)
 
-    def all_t(self, o, d, t_min, t_max):
+    def all_t(self, o, d, t_min):
         k = len(self)
         m = np.cross(o, d)
         on = o @ self.Mo
@@ -613,7 +648,7 @@ class TriangleSet(PlanarSet):
         u_num = mm[:, :k] - dd[:, k : 2 * k]
         v_num = -mm[:, k:] - dd[:, 2 * k :]
         t_num = on - self.aN
-        return self._finish(det, u_num, v_num, t_num, t_min, t_max[:, None])
+        return self._finish(det, u_num, v_num, t_num, t_min, INF)
 
     def pair_t(self, o, d, k, t_min, t_max):
         m = np.cross(o, d)
@@ -653,11 +688,13 @@ class ScalarSet(PrimitiveSet):
             Ray(Vec3(*map(float, oi)), Vec3(*map(float, di))) for oi, di in zip(o, d, strict=True)
         ]
 
-    def closest(self, o, d, t_min, t_max, any_hit=False):
+    def closest(self, o, d, t_min, t_max, any_hit=False, skip=None):
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(len(o), -1, dtype=np.int64)
         for i, ray in enumerate(self._rays(o, d)):
             for j, obj in enumerate(self.objects):
+                if skip is not None and skip[i] == j:
+                    continue
                 t = obj.hit_t(ray, t_min, float(t_best[i]))
                 if t is not None:
                     t_best[i], idx[i] = t, j
@@ -795,15 +832,30 @@ class Geometry:
             obj[hit] = self.members[kd][k[hit]]
         return obj, t_best
 
-    def occluded(self, o: np.ndarray, d: np.ndarray, t_max: np.ndarray) -> np.ndarray:
+    def occluded(
+        self,
+        o: np.ndarray,
+        d: np.ndarray,
+        t_max: np.ndarray,
+        skip: np.ndarray | None = None,
+    ) -> np.ndarray:
         """(N,) bool: something (glass included) lies on the ray with 0 < t < t_max,
-        as Scene.find_occlusion(ray, Interval(0, t_max))."""
+        as Scene.find_occlusion(ray, Interval(0, t_max)); skip: per ray, an object
+        index to ignore (-1: none)."""
         blocked = np.zeros(len(o), dtype=bool)
         for kd in self._order():
             live = np.flatnonzero(~blocked)
             if live.size == 0:
                 break
-            _, k = self.sets[kd].closest(o[live], d[live], 0.0, t_max[live], any_hit=True)
+            local_skip = None
+            if skip is not None:
+                sk = skip[live]
+                local_skip = np.where((sk >= 0) & (self.kind[sk] == kd), self.local[sk], -1)
+                if not (local_skip >= 0).any():
+                    local_skip = None
+            _, k = self.sets[kd].closest(
+                o[live], d[live], 0.0, t_max[live], any_hit=True, skip=local_skip
+            )
             blocked[live[k >= 0]] = True
         return blocked
 

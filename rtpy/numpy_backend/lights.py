@@ -35,6 +35,7 @@ class LightSamples:
     delta: np.ndarray  # (N,) bool: point light
     point: np.ndarray  # (N, 3) the point on the light
     valid: np.ndarray  # (N,) bool
+    obj: np.ndarray | None = None  # (N,) the area light's object index, -1 for point lights
 
 
 class LightTable:
@@ -90,6 +91,7 @@ class LightTable:
             choice < self.n_point,
             np.zeros((n, 3)),
             np.zeros(n, dtype=bool),
+            np.full(n, -1, dtype=np.int64),
         )
         pt = np.flatnonzero(out.delta)
         if pt.size:
@@ -127,6 +129,8 @@ class LightTable:
         """AreaLight.sample for points p toward objects obj with uniforms r1, r2;
         writes rows idx of out."""
         g = self.geometry
+        if out.obj is not None:
+            out.obj[idx] = obj
         direction = np.zeros_like(p)
         pdf = np.zeros(len(p))
         valid = np.zeros(len(p), dtype=bool)
