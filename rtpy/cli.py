@@ -84,6 +84,12 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--seed", type=non_negative_int)
     r.add_argument("--workers", type=positive_int, default=1, help="processes (default 1)")
     r.add_argument(
+        "--backend",
+        choices=("scalar", "numpy"),
+        default="scalar",
+        help="scalar: the readable reference (default); numpy: vectorized, many times faster",
+    )
+    r.add_argument(
         "--set",
         action="append",
         default=[],
@@ -212,7 +218,7 @@ def command_render(args: argparse.Namespace) -> int:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
 
-    image = render(scene, workers=args.workers, quiet=args.quiet, **overrides)
+    image = render(scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides)
 
     # A second Ctrl-C while the partial image is written ends at once; writes
     # are atomic, so no half-written file is left.

@@ -1,0 +1,154 @@
+"""The numpy backend's renderer: tiles of camera samples traced as arrays.
+
+The image is cut into square tiles and each pixel's samples into batches, as in
+rtpy/renderer.py, but a unit of work (batch, tile) is large: all samples of the
+batch for every pixel of the tile, traced together as one wavefront of at most
+MAX_RAYS paths. So memory is bounded by the unit size, not by image size times
+spp. Units run batch by batch (an interrupted render covers the whole image
+with fewer samples); each draws from its own numpy Generator seeded by
+(seed, tile, batch), and sums are combined in a fixed order, so the same seed
+gives the same image, bit for bit, with any number of worker processes.
+(The scalar and numpy backends draw different random numbers: their images
+agree up to Monte Carlo noise, not bit for bit.)
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+import resource
+import signal
+import sys
+import time
+
+import numpy as np
+from tqdm import tqdm
+
+from ..camera import Camera
+from ..image import RenderedImage
+from ..render_settings import RenderSettings
+from ..renderer import Renderer, Unit
+from ..scene import Scene
+from .camera import CameraRays
+from .integrators import BatchIntegrator, Tracer, make_integrator
+
+TILE_SIZE = 32
+MAX_RAYS = 16384  # camera samples per unit of work
+
+
+def plan_units(width: int, height: int, spp: int) -> list[Unit]:
+    """All units of work, batch-major: each tile's spp split into the fewest batches
+    that keep a unit at or under MAX_RAYS samples."""
+    tile_px = TILE_SIZE * TILE_SIZE
+    n_batches = max(1, math.ceil(spp * tile_px / MAX_RAYS))
+    n_batches = min(n_batches, spp)
+    batch_spp = [spp // n_batches + (1 if b < spp % n_batches else 0) for b in range(n_batches)]
+    tiles = [
+        (x0, y0, min(x0 + TILE_SIZE, width), min(y0 + TILE_SIZE, height))
+        for y0 in range(0, height, TILE_SIZE)
+        for x0 in range(0, width, TILE_SIZE)
+    ]
+    return [
+        Unit(t, b, *tiles[t], batch_spp[b]) for b in range(n_batches) for t in range(len(tiles))
+    ]
+
+
+def unit_generator(seed: int, unit: Unit) -> np.random.Generator:
+    return np.random.default_rng([int(seed), unit.tile, unit.batch])
+
+
+def render_unit(
+    tracer: Tracer, rays: CameraRays, integrator: BatchIntegrator, seed: int, unit: Unit
+) -> np.ndarray:
+    """Sum of unit.spp radiance samples per pixel of the unit's tile: (h, w, 3)."""
+    rng = unit_generator(seed, unit)
+    h, w = unit.y1 - unit.y0, unit.x1 - unit.x0
+    j, i = np.divmod(np.arange(h * w), w)
+    i = np.repeat(i + unit.x0, unit.spp)
+    j = np.repeat(j + unit.y0, unit.spp)
+    if integrator.uses_center_ray:
+        o, d = rays.center_rays(i, j, rng)
+    else:
+        o, d = rays.jittered_rays(i, j, rng)
+    radiance = integrator.radiance(tracer, o, d, rng)
+    return radiance.reshape(h, w, unit.spp, 3).sum(axis=2)
+
+
+# --- worker processes -------------------------------------------------------
+_worker_state: tuple | None = None
+
+
+def _init_worker(scene: Scene, camera: Camera, settings: RenderSettings) -> None:
+    global _worker_state
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
+    _worker_state = (Tracer(scene), CameraRays(camera), make_integrator(settings), settings.seed)
+
+
+def _run_unit(unit: Unit) -> tuple[Unit, np.ndarray]:
+    tracer, rays, integrator, seed = _worker_state
+    return unit, render_unit(tracer, rays, integrator, seed, unit)
+
+
+def peak_rss_mb() -> float:
+    """Peak resident memory in MB of this process and of its finished children (the
+    largest of them; Linux reports kilobytes)."""
+    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return max(own, children) / 1024.0
+
+
+class NumpyRenderer(Renderer):
+    """Renders with the numpy backend; the interface and the result are those of
+    rtpy.renderer.Renderer (stats also hold "backend" and "peak_rss_mb")."""
+
+    def render(self) -> RenderedImage:
+        settings, camera = self.settings, self.camera
+        spp = 1 if make_integrator(settings).uses_center_ray else settings.spp
+        units = plan_units(camera.width, camera.height, spp)
+        results: dict[tuple[int, int], np.ndarray] = {}
+        bar = tqdm(
+            total=camera.width * camera.height * spp,
+            unit="path",
+            unit_scale=True,
+            file=sys.stderr,
+            disable=self.quiet,
+            desc=f"{self.scene.name} ({settings.integrator}, numpy)",
+            dynamic_ncols=True,
+        )
+        start = time.perf_counter()
+        interrupted = False
+        work = self._run(units)
+        try:
+            for unit, sums in work:
+                results[(unit.tile, unit.batch)] = sums
+                bar.update(sums.shape[0] * sums.shape[1] * unit.spp)
+        except KeyboardInterrupt:
+            interrupted = True
+        finally:
+            work.close()
+            bar.close()
+        seconds = time.perf_counter() - start
+        image = self._assemble(units, results, spp, interrupted, seconds)
+        image.stats["backend"] = "numpy"
+        image.stats["peak_rss_mb"] = peak_rss_mb()
+        return image
+
+    def _run(self, units: list[Unit]):
+        if self.workers == 1:
+            tracer = Tracer(self.scene)
+            rays = CameraRays(self.camera)
+            integrator = make_integrator(self.settings)
+            for unit in units:
+                yield unit, render_unit(tracer, rays, integrator, self.settings.seed, unit)
+            return
+        pool = multiprocessing.get_context().Pool(
+            self.workers, _init_worker, (self.scene, self.camera, self.settings)
+        )
+        try:
+            yield from pool.imap_unordered(_run_unit, units, chunksize=1)
+            pool.close()
+        except BaseException:
+            pool.terminate()
+            raise
+        finally:
+            pool.join()
