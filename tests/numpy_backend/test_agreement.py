@@ -1,0 +1,174 @@
+"""The numpy backend renders the scalar backend's images, up to Monte Carlo noise.
+
+For every bundled scene and integrator, each backend renders the scene R times
+with different seeds (small images, moderate spp; the numpy backend, being cheap,
+with NUMPY_FACTOR times the spp). The images are cut into 8 x 8 blocks and the
+mean of each block compared by a z-test against the noise the renders measure:
+
+- a pixel's per-sample variance s2 is estimated from the spread of its R values
+  (variance across renders times spp), pooled over both backends, which under
+  the hypothesis being tested (the same estimator) have the same s2. Pooling
+  keeps a rare bright sample (a firefly) that one backend happened to draw
+  equally often in every render from hiding the noise;
+- the mean over R renders of a block of n pixels then has variance
+  sum(s2) / (spp R n^2) per backend;
+- a block differs significantly when |mean_numpy - mean_scalar| over the square
+  root of the summed variances exceeds the normal quantile of a two-sided test at
+  level ALPHA / (blocks x channels) (Bonferroni): the chance that any block of a
+  correct backend is flagged is below ALPHA. The seeds are fixed, so the test is
+  deterministic.
+
+The "center" integrator draws no random numbers without a lens: its images must
+be equal. test_a_biased_kernel_is_flagged shows that the comparison has the power
+to catch a real mistake (light counted twice by a wrong MIS weight).
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from statistics import NormalDist
+
+import numpy as np
+import pytest
+
+import rtpy
+from rtpy.bundled import bundled_scenes
+from rtpy.numpy_backend.integrators import Tracer
+
+ALPHA = 1e-3
+BLOCK = 8
+WIDTH = 32
+SCENES = [name for name, _ in bundled_scenes()]
+# Scalar spp per integrator (the numpy backend uses NUMPY_FACTOR times more: it is cheap).
+SPP = {"jittered": 2, "direct": 3, "whitted": 2, "path": 3}
+NUMPY_FACTOR = 4
+SEEDS = (11, 12, 13, 14)
+
+
+@cache
+def render(name: str, integrator: str, backend: str, seed: int, spp: int) -> np.ndarray:
+    scene = rtpy.load_scene(name)
+    workers = 2 if backend == "scalar" else 1
+    image = rtpy.render(
+        scene,
+        width=WIDTH,
+        spp=spp,
+        integrator=integrator,
+        seed=seed,
+        workers=workers,
+        backend=backend,
+    )
+    return image.linear
+
+
+def blocks(image: np.ndarray) -> np.ndarray:
+    """Sums over 8 x 8 blocks (partial at the edges) of (..., H, W, 3) -> (..., blocks, 3),
+    and the pixel count of each block."""
+    h, w = image.shape[-3:-1]
+    out, counts = [], []
+    for y in range(0, h, BLOCK):
+        for x in range(0, w, BLOCK):
+            part = image[..., y : y + BLOCK, x : x + BLOCK, :]
+            out.append(part.sum(axis=(-3, -2)))
+            counts.append(part.shape[-3] * part.shape[-2])
+    return np.stack(out, axis=-2), np.array(counts)[:, None]
+
+
+def compare(renders_a, spp_a, renders_b, spp_b, alpha: float = ALPHA):
+    """(z per block and channel, the Bonferroni-corrected threshold, block means a, b)
+    for two stacks of R independent renders (R, H, W, 3) at spp_a and spp_b."""
+    a, b = np.asarray(renders_a), np.asarray(renders_b)
+    # Per-sample variance of each pixel, pooled over both backends.
+    s2 = 0.5 * (a.var(axis=0, ddof=1) * spp_a + b.var(axis=0, ddof=1) * spp_b)
+    s2_blocks, n = blocks(s2)
+    mean_a = blocks(a.mean(axis=0))[0] / n
+    mean_b = blocks(b.mean(axis=0))[0] / n
+    var = s2_blocks / (n * n) * (1.0 / (spp_a * len(a)) + 1.0 / (spp_b * len(b)))
+    # A floor for blocks without noise (a constant background): rounding only.
+    floor = (1e-9 * np.maximum(1.0, np.abs(mean_a))) ** 2
+    z = np.abs(mean_a - mean_b) / np.sqrt(var + floor)
+    threshold = NormalDist().inv_cdf(1.0 - alpha / (2 * z.size))
+    return z, threshold, mean_a, mean_b
+
+
+def renders(name: str, integrator: str, backend: str, spp: int) -> list[np.ndarray]:
+    return [render(name, integrator, backend, s, spp) for s in SEEDS]
+
+
+def check(name: str, integrator: str, spp: int) -> None:
+    numpy_spp = spp * NUMPY_FACTOR
+    z, threshold, ms, mn = compare(
+        renders(name, integrator, "scalar", spp),
+        spp,
+        renders(name, integrator, "numpy", numpy_spp),
+        numpy_spp,
+    )
+    worst = np.unravel_index(np.argmax(z), z.shape)
+    assert z.max() < threshold, (
+        f"block {worst[0]} channel {worst[1]}: z = {z.max():.2f} > {threshold:.2f}; "
+        f"scalar {ms[worst]:.4f}, numpy {mn[worst]:.4f}"
+    )
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_center_images_agree(name):
+    if rtpy.load_scene(name).camera.defocus_angle > 0:
+        check(name, "center", 1)  # the lens is sampled: compare as noise
+        return
+    a = render(name, "center", "scalar", 0, 1)
+    b = render(name, "center", "numpy", 0, 1)
+    # A pixel centre on the exact edge of a quad may round to either side.
+    close = np.isclose(a, b, rtol=1e-9, atol=1e-12).all(axis=2)
+    assert close.mean() > 0.99, f"{(~close).sum()} pixels differ"
+
+
+# The scalar backend's shadow rays can be blocked by the very light they were sent
+# to: sample_one_light stops them offset_scale(light point) + offset_scale(hit point)
+# short of the light, but the spawned origin moves the light's surface along the
+# ray by eps cos(theta_i) / cos(theta_light), which is more than that margin where
+# the light is seen at a slant. So the scalar direct light from area lights is too
+# dark near them (here: the gallery's floor near its quad light, 9 % in a block;
+# from a sphere light's samples near its silhouette, 6 % in
+# test_integrators.test_sphere_light_nee_gives_the_analytic_irradiance). The numpy
+# backend does not let a light block its own shadow ray and matches the analytic
+# value. Until the scalar backend does the same, these comparisons fail.
+SCALAR_SELF_SHADOW = pytest.mark.xfail(
+    reason="scalar shadow rays blocked by their own light (see SCALAR_SELF_SHADOW)",
+    strict=False,
+)
+CASES = [
+    pytest.param(
+        name,
+        integrator,
+        marks=SCALAR_SELF_SHADOW if name == "material_gallery" and integrator != "jittered" else (),
+    )
+    for name in SCENES
+    for integrator in SPP
+]
+
+
+@pytest.mark.parametrize("name,integrator", CASES)
+def test_block_means_agree(name, integrator):
+    check(name, integrator, SPP[integrator])
+
+
+def test_a_biased_kernel_is_flagged(monkeypatch):
+    """Counting light twice (emission found by BRDF sampling kept at weight 1 while
+    lights are also sampled) brightens every lit block: the comparison flags it."""
+    name, integrator, spp = "cornell", "path", SPP["path"]
+    scalar = renders(name, integrator, "scalar", spp)
+    monkeypatch.setattr(Tracer, "emission_weight", lambda self, obj, *args: np.ones(len(obj)))
+    biased = [
+        rtpy.render(
+            rtpy.load_scene(name),
+            width=WIDTH,
+            spp=spp * NUMPY_FACTOR,
+            integrator=integrator,
+            seed=s,
+            backend="numpy",
+        ).linear
+        for s in SEEDS
+    ]
+    z, threshold, _, _ = compare(scalar, spp, biased, spp * NUMPY_FACTOR)
+    assert z.max() > threshold
+    assert (z > threshold).any(axis=1).mean() > 0.25  # many blocks, not one
