@@ -28,7 +28,7 @@ import numpy as np
 from ..hit_info import HitInfo
 from ..hittable import Hittable
 from ..quad import Quad
-from ..ray import Ray
+from ..ray import SPAWN_ABSOLUTE_OFFSET, SPAWN_RELATIVE_OFFSET, Ray
 from ..sphere import Sphere
 from ..triangle import Triangle
 from ..vec3 import Vec3
@@ -52,6 +52,12 @@ def _v(v: Vec3) -> list[float]:
     return [float(v.e0), float(v.e1), float(v.e2)]
 
 
+def max3(a: np.ndarray) -> np.ndarray:
+    """Largest of the three components of (N, 3) a: a.max(axis=1), but a reduction over
+    an axis of length 3 is several times slower than two elementwise maxima."""
+    return np.maximum(np.maximum(a[:, 0], a[:, 1]), a[:, 2])
+
+
 def onb_u(w: np.ndarray) -> np.ndarray:
     """First axis of the scalar ONB(w) (Duff et al. 2017) for (N, 3) unit vectors w."""
     w0, w1, w2 = w[:, 0], w[:, 1], w[:, 2]
@@ -63,9 +69,8 @@ def onb_u(w: np.ndarray) -> np.ndarray:
 
 def offset_scale(p: np.ndarray) -> np.ndarray:
     """rtpy.ray.offset_scale for (N, 3) points: how far a spawned ray starts off p."""
-    from ..ray import SPAWN_ABSOLUTE_OFFSET, SPAWN_RELATIVE_OFFSET
-
-    return SPAWN_ABSOLUTE_OFFSET + SPAWN_RELATIVE_OFFSET * np.abs(p).max(axis=1)
+    a = np.abs(p)
+    return SPAWN_ABSOLUTE_OFFSET + SPAWN_RELATIVE_OFFSET * max3(a)
 
 
 def spawn_origins(point: np.ndarray, normal: np.ndarray, direction: np.ndarray) -> np.ndarray:
@@ -186,8 +191,9 @@ class BVH:
             with np.errstate(invalid="ignore", over="ignore"):
                 t0 = (self.lo[node] - ro) * ri
                 t1 = (self.hi[node] - ro) * ri
-            near = np.minimum(t0, t1).max(axis=1)
-            far = np.maximum(t0, t1).min(axis=1)
+            near = max3(np.minimum(t0, t1))
+            lo = np.maximum(t0, t1)
+            far = np.minimum(np.minimum(lo[:, 0], lo[:, 1]), lo[:, 2])
             keep = (near <= far) & (far > t_min) & (near < best_t[ray])
             if any_hit:
                 keep &= ~done[ray]
@@ -224,6 +230,10 @@ class BVH:
 
 class PrimitiveSet:
     """Primitives of one kind. Subclasses give the intersection kernels.
+
+    As area lights, sample_light(k, p, r1, r2) gives AreaLight.sample's geometry:
+    (direction, pdf, valid, t, point, geometric normal); by default the direction
+    of sample_direction traced from p to the shape itself, as the scalar code.
 
     objects  the scalar objects (for fallbacks and tests); index = local index
     """
@@ -286,6 +296,14 @@ class PrimitiveSet:
             t_best[s:e][hit] = tj[hit]
             idx[s:e][hit] = j[hit]
         return t_best, idx
+
+    def sample_light(self, k, p, r1, r2):
+        direction, pdf, valid = self.sample_direction(k, p, r1, r2)
+        # Trace from p itself (not offset) to the shape, as AreaLight.sample.
+        t = self.pair_t(p, direction, k, 0.0, INF)
+        valid &= t < INF
+        point, geo = self.geometric(k, p, direction, np.where(valid, t, 0.0))
+        return direction, pdf, valid, t, point, geo
 
     # --- hit records ---------------------------------------------------------
     def geometric(self, k, o, d, t) -> tuple[np.ndarray, np.ndarray]:
@@ -501,6 +519,16 @@ class PlanarSet(PrimitiveSet):
         Returns (direction, pdf, valid)."""
         q, n = self.sample_point(k, r1, r2)
         return area_direction(p, q, n, self.area(k))
+
+    def sample_light(self, k, p, r1, r2):
+        """AreaLight.sample's geometry: (direction, pdf, valid, t, point, geometric
+        normal). The sampled point is where the ray from p along the direction meets
+        the plane, so it is not traced again (the scalar code traces it and gets the
+        same point up to rounding)."""
+        q, n = self.sample_point(k, r1, r2)
+        direction, pdf, valid = area_direction(p, q, n, self.area(k))
+        dv = q - p
+        return direction, pdf, valid, np.sqrt(_dot(dv, dv)), q, n
 
     def direction_pdf(self, k, p, q, n):
         return area_direction_pdf(p, q, n, self.area(k))
@@ -859,6 +887,16 @@ class Geometry:
             blocked[live[k >= 0]] = True
         return blocked
 
+    def _groups(self, obj: np.ndarray) -> tuple[np.ndarray, list[tuple[int, np.ndarray | slice]]]:
+        """(local indices, [(kind, positions in obj)]) with a slice for a single kind."""
+        kinds = self.kind[obj]
+        local = self.local[obj]
+        present = [kd for kd in range(4) if self.sets[kd] is not None]
+        if len(present) == 1:
+            return local, [(present[0], slice(None))]
+        groups = [(kd, np.flatnonzero(kinds == kd)) for kd in present]
+        return local, [(kd, i) for kd, i in groups if i.size]
+
     def hit_batch(
         self,
         obj: np.ndarray,
@@ -870,21 +908,34 @@ class Geometry:
     ) -> HitBatch:
         """The HitBatch of rays (o, d) hitting objects obj at t (all hits, obj >= 0).
         Without need_uv / need_tangent those fields are zeros (nothing reads them)."""
-        n = len(obj)
-        point = np.empty((n, 3))
-        geo = np.empty((n, 3))
-        kinds = self.kind[obj]
-        local = self.local[obj]
-        groups = [(kd, np.flatnonzero(kinds == kd)) for kd in range(4)]
-        groups = [(kd, i) for kd, i in groups if i.size]
+        local, groups = self._groups(obj)
         if len(groups) == 1:
             kd, _ = groups[0]
             point, geo = self.sets[kd].geometric(local, o, d, t)
         else:
+            n = len(obj)
+            point, geo = np.empty((n, 3)), np.empty((n, 3))
             for kd, i in groups:
                 point[i], geo[i] = self.sets[kd].geometric(local[i], o[i], d[i], t[i])
+        return self.hits_at(obj, point, geo, d, t, need_uv, need_tangent, (local, groups))
+
+    def hits_at(
+        self,
+        obj: np.ndarray,
+        point: np.ndarray,
+        geo: np.ndarray,
+        d: np.ndarray,
+        t: np.ndarray,
+        need_uv: bool = True,
+        need_tangent: bool = True,
+        grouped=None,
+    ) -> HitBatch:
+        """The HitBatch of rays with directions d reaching `point` (geometric normal
+        `geo`) on objects obj after distance t."""
+        n = len(obj)
+        local, groups = grouped if grouped is not None else self._groups(obj)
         front = _dot(geo, d) < 0.0
-        normal = np.where(front[:, None], geo, -geo)
+        normal = geo * np.where(front, 1.0, -1.0)[:, None]
         if need_uv:
             u, v = np.empty(n), np.empty(n)
             for kd, i in groups:
@@ -904,8 +955,11 @@ class Geometry:
         return HitBatch(point, normal, -d, t, front, u, v, tangent)
 
     def set_of(self, obj: np.ndarray):
-        """[(set, local indices, positions in obj)] grouping objects by kind."""
+        """[(set, local indices, positions in obj)] grouping objects by kind; the
+        positions are slice(None) when all objects are of one kind."""
         kinds = self.kind[obj]
+        if len(kinds) and (kinds == kinds[0]).all():
+            return [(self.sets[kinds[0]], self.local[obj], slice(None))]
         out = []
         for kd in range(4):
             i = np.flatnonzero(kinds == kd)

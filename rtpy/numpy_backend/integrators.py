@@ -27,7 +27,7 @@ import numpy as np
 from ..render_settings import RenderSettings
 from ..scene import Scene
 from ..texture import CheckerTexture, SolidColor
-from .geometry import Geometry, offset_scale, spawn_origins
+from .geometry import Geometry, max3, offset_scale, spawn_origins
 from .hits import HitBatch
 from .lights import LightTable
 from .materials import MaterialTable
@@ -108,14 +108,14 @@ class Tracer:
         n_lights = self.lights.count(include_area)
         s = self.lights.sample(hits.point, rng, include_area)
         cos_i = _dot(hits.normal, s.direction)
-        ok = s.valid & (s.radiance.max(axis=1) > 0.0) & (cos_i > 0.0)
+        ok = s.valid & (max3(s.radiance) > 0.0) & (cos_i > 0.0)
         idx = np.flatnonzero(ok)
         if idx.size == 0:
             return out
         part = hits if idx.size == n else hits.take(idx)
         wi = s.direction[idx]
         f, brdf_pdf = self.materials.eval(ids[idx], part, wi)
-        lit = f.max(axis=1) > 0.0
+        lit = max3(f) > 0.0
         if not lit.all():
             idx, wi, f, brdf_pdf = idx[lit], wi[lit], f[lit], brdf_pdf[lit]
             part = part.take(lit)
@@ -217,7 +217,7 @@ class FlatIntegrator(BatchIntegrator):
         em = np.flatnonzero(tracer.materials.emitter[ids])
         if em.size:
             emitted = tracer.materials.emitted(ids[em], hits.take(em))
-            glowing = emitted.max(axis=1) > 0.0  # not black (emission is >= 0)
+            glowing = max3(emitted) > 0.0  # not black (emission is >= 0)
             color[em[glowing]] = emitted[glowing]
             flat[em[glowing]] = False
         f = np.flatnonzero(flat)
@@ -289,7 +289,7 @@ class PathIntegrator(BatchIntegrator):
                     result[rows[ns]] += beta[ns] * direct
             sc = materials.sample(ids, hits, rng)
             beta = beta * sc.weight
-            bmax = beta.max(axis=1)
+            bmax = max3(beta)
             alive = sc.alive & (bmax > 0.0)
             if rr_start and segment >= rr_start:
                 survive = np.minimum(0.95, bmax)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import Scene
-from .geometry import INF, Geometry
+from .geometry import Geometry
 
 
 @dataclass
@@ -131,28 +131,33 @@ class LightTable:
         g = self.geometry
         if out.obj is not None:
             out.obj[idx] = obj
-        direction = np.zeros_like(p)
-        pdf = np.zeros(len(p))
-        valid = np.zeros(len(p), dtype=bool)
-        t = np.full(len(p), INF)
-        for prims, local, i in g.set_of(obj):
-            direction[i], pdf[i], valid[i] = prims.sample_direction(local, p[i], r1[i], r2[i])
-            # Trace from p itself (not offset) to the shape, as AreaLight.sample.
-            t[i] = prims.pair_t(p[i], direction[i], local, 0.0, INF)
-        valid &= (t < INF) & (pdf > 0.0)
+        groups = g.set_of(obj)
+        if len(groups) == 1:
+            prims, local, _ = groups[0]
+            direction, pdf, valid, t, point, geo = prims.sample_light(local, p, r1, r2)
+        else:
+            n = len(p)
+            direction, point, geo = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+            pdf, t = np.zeros(n), np.zeros(n)
+            valid = np.zeros(n, dtype=bool)
+            for prims, local, i in groups:
+                direction[i], pdf[i], valid[i], t[i], point[i], geo[i] = prims.sample_light(
+                    local, p[i], r1[i], r2[i]
+                )
+        valid &= pdf > 0.0
         ok = np.flatnonzero(valid)
-        if ok.size == 0:
-            out.valid[idx] = False
-            return
-        hits = g.hit_batch(obj[ok], p[ok], direction[ok], t[ok], self.need_uv, self.need_tangent)
-        radiance = self.materials.emitted(g.material_id[obj[ok]], hits)
-        j = idx[ok]
-        out.direction[j] = direction[ok]
-        out.distance[j] = t[ok]
-        out.radiance[j] = radiance
-        out.pdf[j] = pdf[ok]
-        out.point[j] = hits.point
         out.valid[idx] = valid
+        if ok.size == 0:
+            return
+        if ok.size < len(p):
+            obj, direction, t, point, geo = obj[ok], direction[ok], t[ok], point[ok], geo[ok]
+        hits = g.hits_at(obj, point, geo, direction, t, self.need_uv, self.need_tangent)
+        j = idx[ok]
+        out.direction[j] = direction
+        out.distance[j] = t
+        out.radiance[j] = self.materials.emitted(g.material_id[obj], hits)
+        out.pdf[j] = pdf[ok]
+        out.point[j] = point
 
     def direction_pdf(self, obj: np.ndarray, p: np.ndarray, q: np.ndarray, n: np.ndarray):
         """AreaLight.pdf: solid-angle density of sampling the direction from p to the
