@@ -32,6 +32,7 @@ from ..ray import SPAWN_ABSOLUTE_OFFSET, SPAWN_RELATIVE_OFFSET, Ray
 from ..sphere import Sphere
 from ..triangle import Triangle
 from ..vec3 import Vec3
+from .arrays import axpy, scale
 from .hits import HitBatch
 
 # Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
@@ -77,9 +78,9 @@ def spawn_origins(point: np.ndarray, normal: np.ndarray, direction: np.ndarray) 
     """Origins of rtpy.ray.spawn_ray(point, normal, direction) for (N, 3) arrays: the
     point pushed off the surface along the normal to the side the direction goes."""
     eps = offset_scale(point)
-    below = np.einsum("ij,ij->i", direction, normal) < 0.0
-    eps = np.where(below, -eps, eps)
-    return point + eps[:, None] * normal
+    below = _dot(direction, normal) < 0.0
+    np.negative(eps, out=eps, where=below)
+    return axpy(eps, normal, point)
 
 
 # --------------------------------------------------------------------------------------
@@ -341,7 +342,7 @@ def area_direction(
     valid = dist2 != 0.0
     with np.errstate(divide="ignore", invalid="ignore"):
         k = 1.0 / np.sqrt(dist2)
-        direction = dv * k[:, None]
+        direction = scale(dv, k)
         cos_light = np.abs(_dot(direction, normal))
         valid &= cos_light >= 1e-12
         pdf = dist2 / (cos_light * area)
@@ -403,13 +404,13 @@ class SphereSet(PrimitiveSet):
         return np.where(miss, INF, t)
 
     def geometric(self, k, o, d, t):
-        c, r = self.center[k], self.radius[k]
-        p = o + t[:, None] * d
+        c, r = self.center.take(k, axis=0), self.radius.take(k)
+        p = axpy(t, d, o)
         nv = p - c
         inv = 1.0 / np.sqrt(_dot(nv, nv))
-        n = nv * inv[:, None]
+        n = scale(nv, inv)
         # Back onto the surface: removes the rounding of o + t d (as Sphere.hit_info).
-        p = c + r[:, None] * n
+        p = axpy(r, n, c)
         return p, n
 
     def uv(self, k, point):
@@ -509,10 +510,10 @@ class PlanarSet(PrimitiveSet):
         return self.tan[k], np.ones(len(k), dtype=bool)
 
     def area(self, k):
-        return self._area[k]
+        return self._area.take(k)
 
     def geometric(self, k, o, d, t):
-        return o + t[:, None] * d, self.normal[k]
+        return axpy(t, d, o), self.normal.take(k, axis=0)
 
     def sample_direction(self, k, p, r1, r2):
         """Hittable.sample_direction: a point uniform by area, converted to solid angle.
@@ -619,8 +620,11 @@ class QuadSet(PlanarSet):
         return np.clip(a, 0.0, 1.0), np.clip(b, 0.0, 1.0)
 
     def sample_point(self, k, r1, r2):
-        p = self.q[k] + r1[:, None] * self.u[k] + r2[:, None] * self.v[k]
-        return p, self.normal[k]
+        # q + r1 u + r2 v, column by column
+        p = axpy(r1, self.u.take(k, axis=0), self.q.take(k, axis=0))
+        for c, vc in enumerate(self.v.take(k, axis=0).T):
+            p[:, c] += r2 * vc
+        return p, self.normal.take(k, axis=0)
 
 
 class TriangleSet(PlanarSet):
@@ -935,7 +939,7 @@ class Geometry:
         n = len(obj)
         local, groups = grouped if grouped is not None else self._groups(obj)
         front = _dot(geo, d) < 0.0
-        normal = geo * np.where(front, 1.0, -1.0)[:, None]
+        normal = scale(geo, np.where(front, 1.0, -1.0))
         if need_uv:
             u, v = np.empty(n), np.empty(n)
             for kd, i in groups:

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..hit_info import HitInfo
 from ..vec3 import Vec3
+from .arrays import rows
 
 if TYPE_CHECKING:
     from ..materials.material import Material
@@ -43,15 +44,17 @@ class HitBatch:
     def take(self, mask_or_index: np.ndarray) -> HitBatch:
         """The hits selected by a boolean mask or an integer index array."""
         k = mask_or_index
+        if k.dtype == np.bool_:
+            k = np.flatnonzero(k)
         return HitBatch(
-            self.point[k],
-            self.normal[k],
-            self.wo[k],
-            self.t[k],
-            self.front_face[k],
-            self.u[k],
-            self.v[k],
-            self.tangent[k],
+            rows(self.point, k),
+            rows(self.normal, k),
+            rows(self.wo, k),
+            self.t.take(k),
+            self.front_face.take(k),
+            self.u.take(k),
+            self.v.take(k),
+            rows(self.tangent, k),
         )
 
     def hit_info(self, i: int, material: Material | None = None) -> HitInfo:

@@ -27,6 +27,8 @@ import numpy as np
 from ..render_settings import RenderSettings
 from ..scene import Scene
 from ..texture import CheckerTexture, SolidColor
+from .arrays import add_rows, divide, put_rows, scale
+from .arrays import rows as rows_of
 from .geometry import Geometry, max3, offset_scale, spawn_origins
 from .hits import HitBatch
 from .lights import LightTable
@@ -112,13 +114,15 @@ class Tracer:
         idx = np.flatnonzero(ok)
         if idx.size == 0:
             return out
-        part = hits if idx.size == n else hits.take(idx)
-        wi = s.direction[idx]
-        f, brdf_pdf = self.materials.eval(ids[idx], part, wi)
+        whole = idx.size == n
+        part = hits if whole else hits.take(idx)
+        wi = s.direction if whole else rows_of(s.direction, idx)
+        f, brdf_pdf = self.materials.eval(ids if whole else ids.take(idx), part, wi)
         lit = max3(f) > 0.0
         if not lit.all():
-            idx, wi, f, brdf_pdf = idx[lit], wi[lit], f[lit], brdf_pdf[lit]
-            part = part.take(lit)
+            k = np.flatnonzero(lit)
+            idx, wi, f, brdf_pdf = idx.take(k), rows_of(wi, k), rows_of(f, k), brdf_pdf.take(k)
+            part = part.take(k)
         if idx.size == 0:
             return out
         origin = spawn_origins(part.point, part.normal, wi)
@@ -127,12 +131,17 @@ class Tracer:
         # sampled from, so the shadow ray can meet the light's surface a little
         # before `distance` (by far more than the offsets where it arrives at a
         # slant), and a convex light cannot hide its own sampled point.
-        t_max = s.distance[idx] - offset_scale(s.point[idx]) - offset_scale(part.point)
-        free = ~self.geometry.occluded(origin, wi, t_max, skip=s.obj[idx])
-        idx, f, brdf_pdf = idx[free], f[free], brdf_pdf[free]
-        pdf = s.pdf[idx] / n_lights
-        weight = np.where(s.delta[idx], 1.0, power_heuristic(pdf, brdf_pdf))
-        out[idx] = f * s.radiance[idx] * (cos_i[idx] * weight / pdf)[:, None]
+        t_max = (
+            s.distance.take(idx) - offset_scale(rows_of(s.point, idx)) - offset_scale(part.point)
+        )
+        blocked = self.geometry.occluded(origin, wi, t_max, skip=s.obj.take(idx))
+        if blocked.any():
+            k = np.flatnonzero(~blocked)
+            idx, f, brdf_pdf = idx.take(k), rows_of(f, k), brdf_pdf.take(k)
+        pdf = s.pdf.take(idx) / n_lights
+        weight = np.where(s.delta.take(idx), 1.0, power_heuristic(pdf, brdf_pdf))
+        contrib = scale(f * rows_of(s.radiance, idx), cos_i.take(idx) * weight / pdf)
+        put_rows(out, idx, contrib)
         return out
 
     def emission_weight(
@@ -150,32 +159,43 @@ class Tracer:
         if n_mis == 0 or prev_point is None:
             return w
         m = np.flatnonzero(~prev_specular)
+        if m.size == len(obj):
+            light_pdf = self.lights.direction_pdf(obj, prev_point, hits.point, hits.normal)
+            return power_heuristic(prev_pdf, light_pdf / n_mis)
         if m.size:
             light_pdf = self.lights.direction_pdf(
-                obj[m], prev_point[m], hits.point[m], hits.normal[m]
+                obj.take(m),
+                rows_of(prev_point, m),
+                rows_of(hits.point, m),
+                rows_of(hits.normal, m),
             )
-            w[m] = power_heuristic(prev_pdf[m], light_pdf / n_mis)
+            w[m] = power_heuristic(prev_pdf.take(m), light_pdf / n_mis)
         return w
 
     def add_emission(
         self, result, rows, beta, obj, ids, hits, prev_point, prev_pdf, prev_specular, n_mis
     ) -> None:
         """result[rows] += beta * emitted * MIS weight at the hits on emitters."""
-        em = self.materials.emitter[ids]
+        em = self.materials.emitter.take(ids)
         if not em.any():
             return
         e = np.flatnonzero(em)
-        part = hits if e.size == len(ids) else hits.take(e)
-        emitted = self.materials.emitted(ids[e], part)
+        if e.size == len(ids):
+            emitted = self.materials.emitted(ids, hits)
+            w = self.emission_weight(obj, hits, prev_point, prev_pdf, prev_specular, n_mis)
+            add_rows(result, rows, scale(beta * emitted, w))
+            return
+        part = hits.take(e)
+        emitted = self.materials.emitted(ids.take(e), part)
         w = self.emission_weight(
-            obj[e],
+            obj.take(e),
             part,
-            None if prev_point is None else prev_point[e],
-            prev_pdf[e],
-            prev_specular[e],
+            None if prev_point is None else rows_of(prev_point, e),
+            prev_pdf.take(e),
+            prev_specular.take(e),
             n_mis,
         )
-        result[rows[e]] += beta[e] * emitted * w[:, None]
+        add_rows(result, rows.take(e), scale(rows_of(beta, e) * emitted, w))
 
 
 # --------------------------------------------------------------------------------------
@@ -259,50 +279,58 @@ class PathIntegrator(BatchIntegrator):
             obj, t = geo.closest_hit(o, d)
             miss = obj < 0
             if miss.any():
-                result[rows[miss]] += beta[miss] * tracer.background(d[miss])
-                keep = ~miss
-                rows, obj, t, o, d, beta = (
-                    rows[keep],
-                    obj[keep],
-                    t[keep],
-                    o[keep],
-                    d[keep],
-                    beta[keep],
-                )
-                prev_pdf, prev_specular = prev_pdf[keep], prev_specular[keep]
+                m = np.flatnonzero(miss)
+                dm = rows_of(d, m)
+                add_rows(result, rows[m], beta.take(m, axis=0) * tracer.background(dm))
+                keep = np.flatnonzero(~miss)
+                rows, obj, t = rows.take(keep), obj.take(keep), t.take(keep)
+                o, d, beta = rows_of(o, keep), rows_of(d, keep), rows_of(beta, keep)
+                prev_pdf, prev_specular = prev_pdf.take(keep), prev_specular.take(keep)
                 if prev_point is not None:
-                    prev_point = prev_point[keep]
+                    prev_point = rows_of(prev_point, keep)
                 if rows.size == 0:
                     break
             hits = tracer.hits(obj, o, d, t)
-            ids = geo.material_id[obj]
+            ids = geo.material_id.take(obj)
             tracer.add_emission(
                 result, rows, beta, obj, ids, hits, prev_point, prev_pdf, prev_specular, n_mis
             )
             if segment >= max_depth:
                 break
             if n_lights:
-                ns = np.flatnonzero(~materials.specular[ids])
-                if ns.size:
-                    part = hits if ns.size == rows.size else hits.take(ns)
-                    direct = tracer.sample_one_light(part, ids[ns], rng, include_area=nee)
-                    result[rows[ns]] += beta[ns] * direct
+                ns = np.flatnonzero(~materials.specular.take(ids))
+                if ns.size == rows.size:
+                    direct = tracer.sample_one_light(hits, ids, rng, include_area=nee)
+                    direct *= beta
+                    add_rows(result, rows, direct)
+                elif ns.size:
+                    part = hits.take(ns)
+                    direct = tracer.sample_one_light(part, ids.take(ns), rng, include_area=nee)
+                    direct *= rows_of(beta, ns)
+                    add_rows(result, rows.take(ns), direct)
             sc = materials.sample(ids, hits, rng)
             beta = beta * sc.weight
             bmax = max3(beta)
             alive = sc.alive & (bmax > 0.0)
-            if rr_start and segment >= rr_start:
+            roulette = bool(rr_start and segment >= rr_start)
+            if roulette:
                 survive = np.minimum(0.95, bmax)
                 alive &= rng.random(rows.size) < survive
-                a = np.flatnonzero(alive)
-                beta = beta[a] / survive[a, None]
+            a = np.flatnonzero(alive)
+            if a.size == rows.size:  # nothing ended: no compaction
+                point, normal, d = hits.point, hits.normal, sc.direction
+                prev_pdf, prev_specular = sc.pdf, sc.specular
             else:
-                a = np.flatnonzero(alive)
-                beta = beta[a]
-            rows = rows[a]
-            point, normal, d = hits.point[a], hits.normal[a], sc.direction[a]
+                rows, beta = rows.take(a), rows_of(beta, a)
+                point, normal = rows_of(hits.point, a), rows_of(hits.normal, a)
+                d = rows_of(sc.direction, a)
+                prev_pdf, prev_specular = sc.pdf.take(a), sc.specular.take(a)
+                if roulette:
+                    survive = survive.take(a)
+            if roulette:
+                beta = divide(beta, survive)
             o = spawn_origins(point, normal, d)
-            prev_point, prev_pdf, prev_specular = point, sc.pdf[a], sc.specular[a]
+            prev_point = point
             segment += 1
         return result
 

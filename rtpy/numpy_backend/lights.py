@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import Scene
+from .arrays import put_rows, rows
 from .geometry import Geometry
 
 
@@ -96,11 +97,16 @@ class LightTable:
         pt = np.flatnonzero(out.delta)
         if pt.size:
             self._sample_point_lights(p, choice, pt, out)
-        ar = np.flatnonzero(~out.delta)
-        if ar.size:
-            r = rng.random((2, ar.size))
-            obj = self.area_object[choice[ar] - self.n_point]
-            self.sample_area(p[ar], obj, r[0], r[1], out, ar)
+        if pt.size == n:
+            return out
+        r = rng.random((2, n - pt.size))
+        if pt.size == 0:  # area lights only: no gathers
+            obj = self.area_object.take(choice - self.n_point)
+            self.sample_area(p, obj, r[0], r[1], out, slice(None))
+        else:
+            ar = np.flatnonzero(~out.delta)
+            obj = self.area_object.take(choice.take(ar) - self.n_point)
+            self.sample_area(rows(p, ar), obj, r[0], r[1], out, ar)
         return out
 
     def _sample_point_lights(self, p, choice, idx, out: LightSamples) -> None:
@@ -150,14 +156,20 @@ class LightTable:
         if ok.size == 0:
             return
         if ok.size < len(p):
-            obj, direction, t, point, geo = obj[ok], direction[ok], t[ok], point[ok], geo[ok]
+            obj, t, pdf = obj.take(ok), t.take(ok), pdf.take(ok)
+            direction, point, geo = rows(direction, ok), rows(point, ok), rows(geo, ok)
         hits = g.hits_at(obj, point, geo, direction, t, self.need_uv, self.need_tangent)
-        j = idx[ok]
-        out.direction[j] = direction
+        radiance = self.materials.emitted(g.material_id.take(obj), hits)
+        if isinstance(idx, slice) and ok.size == len(p):  # every row: no scatter
+            out.direction, out.distance, out.radiance = direction, t, radiance
+            out.pdf, out.point = pdf, point
+            return
+        j = np.arange(len(out.pdf))[idx].take(ok)
+        put_rows(out.direction, j, direction)
         out.distance[j] = t
-        out.radiance[j] = self.materials.emitted(g.material_id[obj], hits)
-        out.pdf[j] = pdf[ok]
-        out.point[j] = point
+        put_rows(out.radiance, j, radiance)
+        out.pdf[j] = pdf
+        put_rows(out.point, j, point)
 
     def direction_pdf(self, obj: np.ndarray, p: np.ndarray, q: np.ndarray, n: np.ndarray):
         """AreaLight.pdf: solid-angle density of sampling the direction from p to the
