@@ -72,6 +72,14 @@ def divide(a: np.ndarray, s: np.ndarray) -> np.ndarray:
     return out
 
 
+def where_rows(mask: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """np.where(mask[:, None], a, 0.0) for a (N, 3) and mask (N,), column by column."""
+    out = np.empty(a.shape)
+    for c in range(3):
+        np.copyto(out[:, c], np.where(mask, a[:, c], 0.0))
+    return out
+
+
 def axpy(s: np.ndarray, d: np.ndarray, o: np.ndarray) -> np.ndarray:
     """o + s[:, None] * d for o, d (N, 3) and s (N,), column by column (each
     component rounded as in the broadcast form)."""

@@ -91,9 +91,9 @@ class TextureTable:
         (all of them by default), as Texture.value."""
         ids = np.asarray(ids, dtype=np.intp)
         if self.kinds_present <= {SOLID}:
-            return self.color[ids]
+            return self.color.take(ids, axis=0)
         kind = self.kind[ids]
-        out = self.color[ids]  # right for the solid ones; the others are overwritten
+        out = self.color.take(ids, axis=0)  # right for the solid ones; the others are overwritten
         rows = np.arange(len(hits))[rows]  # hit row of every id
         if CHECKER in self.kinds_present:
             sel = np.flatnonzero(kind == CHECKER)

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...materials.material import Material
+from ..arrays import put_rows
 from ..hits import HitBatch
 from ..textures import TextureTable
 from .frame import Rows
@@ -45,8 +46,12 @@ class ScatterBatch:
 
     def put(self, index: np.ndarray | slice, part: ScatterBatch) -> None:
         """Write `part` into the rows `index`."""
-        self.direction[index] = part.direction
-        self.weight[index] = part.weight
+        if isinstance(index, slice):
+            self.direction[index] = part.direction
+            self.weight[index] = part.weight
+        else:
+            put_rows(self.direction, index, part.direction)
+            put_rows(self.weight, index, part.weight)
         self.pdf[index] = part.pdf
         self.alive[index] = part.alive
         self.specular[index] = part.specular

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...materials import Dielectric, DiffuseLight, Lambertian, Metal, Mirror
+from ..arrays import put_rows, where_rows
 from ..hits import HitBatch
 from .frame import (
     components,
@@ -46,9 +47,12 @@ class LambertianKernel(AlbedoKernel):
         self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
         cos = dot(components(hits.normal), components(wi))
-        f = np.zeros((len(slots), 3))
         up = select(cos > 0.0)
-        f[up] = self.albedo(slots[up], hits, up) * INV_PI
+        if isinstance(up, slice):
+            f = self.albedo(slots, hits) * INV_PI
+        else:
+            f = np.zeros((len(slots), 3))
+            put_rows(f, up, self.albedo(slots.take(up), hits, up) * INV_PI)
         return f, np.maximum(0.0, cos) * INV_PI
 
 
@@ -163,8 +167,8 @@ class DiffuseLightKernel(Kernel):
         self.two_sided = np.array([bool(m.two_sided) for m in self.materials])
 
     def emitted(self, slots: np.ndarray, hits: HitBatch) -> np.ndarray:
-        on = hits.front_face | self.two_sided[slots]
-        return np.where(on[:, None], self.emit[slots], 0.0)
+        on = hits.front_face | self.two_sided.take(slots)
+        return where_rows(on, self.emit.take(slots, axis=0))
 
 
 SIMPLE_KERNELS = {

@@ -9,6 +9,7 @@ import numpy as np
 from ...materials import OrenNayar
 from ...materials.material import Material
 from ...texture import Texture
+from ..arrays import put_rows
 from ..hits import HitBatch
 from .fallback import ScalarFallback
 from .glossy import GLOSSY_KERNELS
@@ -89,7 +90,7 @@ class MaterialTable:
                 yield kernel, slice(None), slots, hits
             else:
                 rows = np.flatnonzero(kind == k)
-                yield kernel, rows, slots[rows], hits.take(rows)
+                yield kernel, rows, slots.take(rows), hits.take(rows)
 
     def flat_color(self, ids: np.ndarray, hits: HitBatch) -> np.ndarray:
         """(N, 3) as Material.flat_color: the albedo's value, white without one."""
@@ -102,7 +103,9 @@ class MaterialTable:
         """(N, 3) as Material.emitting: radiance emitted back along the arriving rays."""
         out = np.zeros((len(hits), 3))
         for kernel, rows, slots, part in self._groups(ids, hits, "emits"):
-            out[rows] = kernel.emitted(slots, part)
+            if isinstance(rows, slice):
+                return kernel.emitted(slots, part)  # one kernel has all the hits
+            put_rows(out, rows, kernel.emitted(slots, part))
         return out
 
     def eval(
@@ -114,7 +117,8 @@ class MaterialTable:
         for kernel, rows, slots, part in self._groups(ids, hits, "evaluates"):
             if isinstance(rows, slice):
                 return kernel.eval(slots, part, wi)  # one kernel has all the hits
-            f[rows], pdf[rows] = kernel.eval(slots, part, wi[rows])
+            fk, pdf[rows] = kernel.eval(slots, part, wi.take(rows, axis=0))
+            put_rows(f, rows, fk)
         return f, pdf
 
     def sample(self, ids: np.ndarray, hits: HitBatch, rng: np.random.Generator) -> ScatterBatch:
