@@ -403,6 +403,59 @@ class SphereSet(PrimitiveSet):
         t = np.where((t_min < lo) & (lo < t_max), lo, t)
         return np.where(miss, INF, t)
 
+    def closest(self, o, d, t_min, t_max, any_hit=False, skip=None):
+        """As PrimitiveSet.closest. Without a BVH, one sphere at a time over all rays
+        (1-D arrays of length N: an (N, K) broadcast runs numpy's inner loop over the
+        K spheres, which is slow for small K). Each sphere first rejects the rays
+        that miss it (the first half of pair_t) and finishes the root only for the
+        rest, against the closest t found so far; the arithmetic per (ray, sphere) is
+        pair_t's, so t is bit-identical and ties keep the lower index (as argmin)."""
+        if self.bvh is not None:
+            return super().closest(o, d, t_min, t_max, any_hit, skip)
+        n = len(o)
+        t_best = np.array(t_max, dtype=np.float64, copy=True)
+        idx = np.full(n, -1, dtype=np.int64)
+        ox, oy, oz = np.ascontiguousarray(o.T)
+        dx, dy, dz = np.ascontiguousarray(d.T)
+        a_all = dx * dx + dy * dy + dz * dz
+        for k in range(len(self)):
+            cx, cy, cz = self.center[k]
+            r, r2 = self.radius[k], self.r2[k]
+            ocx, ocy, ocz = cx - ox, cy - oy, cz - oz
+            h = dx * ocx + dy * ocy + dz * ocz
+            c_term = ocx * ocx + ocy * ocy + ocz * ocz - r2
+            kk = h / a_all
+            fx = ocx - kk * dx
+            fy = ocy - kk * dy
+            fz = ocz - kk * dz
+            f2 = fx * fx + fy * fy + fz * fz
+            cand = ~(((h < 0.0) & (c_term > 0.0)) | (f2 > r2))
+            if any_hit:
+                cand &= idx < 0
+            if skip is not None:
+                cand &= skip != k
+            j = np.flatnonzero(cand)
+            if j.size == 0:
+                continue
+            a, tm = a_all, t_best
+            if j.size < n:
+                h, c_term, f2, a, tm = h[j], c_term[j], f2[j], a_all[j], t_best[j]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                f = np.sqrt(f2)
+                disc = a * (r - f) * (r + f)
+                q = h + np.copysign(np.sqrt(disc), h)
+                t0 = c_term / q
+                t1 = q / a
+            lo = np.minimum(t0, t1)
+            hi = np.maximum(t0, t1)
+            t = np.where((t_min < hi) & (hi < tm), hi, INF)
+            t = np.where((t_min < lo) & (lo < tm), lo, t)
+            hit = (t < tm) & (q != 0.0)
+            w = j[hit] if j.size < n else np.flatnonzero(hit)
+            t_best[w] = t[hit]
+            idx[w] = k
+        return t_best, idx
+
     def geometric(self, k, o, d, t):
         c, r = self.center.take(k, axis=0), self.radius.take(k)
         p = axpy(t, d, o)
