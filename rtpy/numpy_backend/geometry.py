@@ -32,7 +32,7 @@ from ..ray import SPAWN_ABSOLUTE_OFFSET, SPAWN_RELATIVE_OFFSET, Ray
 from ..sphere import Sphere
 from ..triangle import Triangle
 from ..vec3 import Vec3
-from .arrays import axpy, scale
+from .arrays import axpy, put_rows, scale
 from .hits import HitBatch
 
 # Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
@@ -376,7 +376,7 @@ class SphereSet(PrimitiveSet):
 
     def pair_t(self, o, d, k, t_min, t_max):
         # Sphere.hit_t, operation for operation (see rtpy/sphere.py for the maths).
-        c, r, r2 = self.center[k], self.radius[k], self.r2[k]
+        c, r, r2 = self.center.take(k, axis=0), self.radius.take(k), self.r2.take(k)
         dx, dy, dz = d[..., 0], d[..., 1], d[..., 2]
         ocx = c[..., 0] - o[..., 0]
         ocy = c[..., 1] - o[..., 1]
@@ -500,9 +500,9 @@ class SphereSet(PrimitiveSet):
     def cone(self, k, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Sphere._cone: (outside (N,) bool, cos_max, 1 - cos_max) of the cone the
         sphere subtends at p; only meaningful where outside."""
-        dv = self.center[k] - p
+        dv = self.center.take(k, axis=0) - p
         d2 = _dot(dv, dv)
-        r2 = self.r2[k]
+        r2 = self.r2.take(k)
         outside = ~(d2 <= r2 * 1.0000001)
         with np.errstate(divide="ignore", invalid="ignore"):
             sin2 = r2 / d2
@@ -518,21 +518,32 @@ class SphereSet(PrimitiveSet):
         valid = np.zeros(len(p), dtype=bool)
         o = np.flatnonzero(outside)
         if o.size:
-            om = omc[o]
-            cos_t = 1.0 - r1[o] * om
+            every = o.size == len(p)  # all outside (the usual case): no gathers
+            om = omc if every else omc.take(o)
+            ko = k if every else k.take(o)
+            po = p if every else p.take(o, axis=0)
+            cos_t = 1.0 - (r1 if every else r1.take(o)) * om
             sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
-            phi = 2.0 * math.pi * r2[o]
-            axis = self.center[k[o]] - p[o]
-            axis = axis * (1.0 / np.sqrt(_dot(axis, axis)))[:, None]
+            phi = 2.0 * math.pi * (r2 if every else r2.take(o))
+            axis = self.center.take(ko, axis=0) - po
+            axis = scale(axis, 1.0 / np.sqrt(_dot(axis, axis)))
             x, y = sin_t * np.cos(phi), sin_t * np.sin(phi)
             # onb.local_to_world(axis, x, y, cos_t)
             w0, w1, w2 = axis[:, 0], axis[:, 1], axis[:, 2]
             sign = np.copysign(1.0, w2)
             a = -1.0 / (sign + w2)
             b = w0 * w1 * a
-            direction[o, 0] = x * (1.0 + sign * w0 * w0 * a) + y * b + cos_t * w0
-            direction[o, 1] = x * sign * b + y * (sign + w1 * w1 * a) + cos_t * w1
-            direction[o, 2] = -x * sign * w0 - y * w1 + cos_t * w2
+            dirs = (
+                x * (1.0 + sign * w0 * w0 * a) + y * b + cos_t * w0,
+                x * sign * b + y * (sign + w1 * w1 * a) + cos_t * w1,
+                -x * sign * w0 - y * w1 + cos_t * w2,
+            )
+            if every:
+                direction = np.stack(dirs, axis=1)
+                pdf = 1.0 / (2.0 * math.pi * om)
+                valid[:] = True
+                return direction, pdf, valid
+            put_rows(direction, o, np.stack(dirs, axis=1))
             pdf[o] = 1.0 / (2.0 * math.pi * om)
             valid[o] = True
         i = np.flatnonzero(~outside)
