@@ -11,6 +11,7 @@ from .ray import Ray
 from .vec3 import Vec3
 
 if TYPE_CHECKING:
+    from .bvh import AABB
     from .materials.material import Material
 
 
@@ -20,7 +21,8 @@ class Hittable:
     Subclasses implement `hit_t`, the cheap part (the ray parameter of the
     closest hit inside an interval, or None), and `hit_info`, which builds the
     full record for one t. `intersect` combines them, as the course's
-    `intersect(ray, interval)`. The scene calls `hit_t` on every object and
+    `intersect(ray, interval)`. The scene calls `hit_t` on the objects a ray may
+    hit (all of them, or those its BVH cannot rule out by `bounding_box`) and
     `hit_info` only for the closest, so records are not built for hits that
     something nearer hides.
     """
@@ -28,6 +30,11 @@ class Hittable:
     material: Material
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
+        """The smallest t > t_min at which the ray hits, if it is < t_max; else None.
+
+        So a smaller t_max gives the same t or None, never another hit: the BVH,
+        which tests objects out of list order, relies on it.
+        """
         raise NotImplementedError
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
@@ -39,6 +46,11 @@ class Hittable:
         if t is None:
             return None
         return self.hit_info(ray, t)
+
+    def bounding_box(self) -> AABB | None:
+        """An axis-aligned box containing the object, or None when it has none
+        (unbounded); the BVH tests such objects on every ray."""
+        return None
 
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
         """Surface coordinates (u, v) of a hit on this object."""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import Hittable
 from .ray import Ray
@@ -55,6 +56,12 @@ class Quad(Hittable):
         if 0.0 <= a <= 1.0 and 0.0 <= b <= 1.0:
             return t
         return None
+
+    def bounding_box(self) -> AABB:
+        """The box around the four corners; padded, so an axis-aligned quad's box
+        is not flat."""
+        q, u, v = self.q, self.u, self.v
+        return AABB.from_points(q, q + u, q + v, q + u + v).padded()
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
         n, d = self.normal, ray.direction

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import Hittable
 from .onb import local_to_world
@@ -57,6 +58,11 @@ class Sphere(Hittable):
         if t_min < t1 < t_max:
             return t1
         return None
+
+    def bounding_box(self) -> AABB:
+        """center -+ radius on each axis, padded."""
+        c, r = self.center, self.radius
+        return AABB(Vec3(c.e0 - r, c.e1 - r, c.e2 - r), Vec3(c.e0 + r, c.e1 + r, c.e2 + r)).padded()
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
         c, r = self.center, self.radius

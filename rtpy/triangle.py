@@ -4,10 +4,18 @@ from __future__ import annotations
 
 import math
 
+from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import Hittable
 from .ray import Ray
 from .vec3 import Vec3, cross
+
+# Moller-Trumbore divides by det = e1 . (d x e2), which is |e1| |e2| |d| times
+# about the sine of the angle between the ray and the triangle's plane. When that
+# sine is below this, det is mostly rounding error and (t, u, v) could report a
+# "hit" far from the triangle, so the ray counts as parallel (the classic
+# algorithm's epsilon, made relative to the sizes).
+PARALLEL_TOLERANCE = 1e-6
 
 
 class Triangle(Hittable):
@@ -30,6 +38,8 @@ class Triangle(Hittable):
         self.material = material
         self._area = 0.5 * n_len
         self._tangent = self.e1 / self.e1.length()  # u runs from a toward b
+        # det^2 <= _parallel_det2 * |d|^2 means parallel
+        self._parallel_det2 = (PARALLEL_TOLERANCE * self.e1.length() * self.e2.length()) ** 2
 
     def _barycentric(self, ray: Ray) -> tuple[float, float, float] | None:
         """Moller-Trumbore: (t, u, v) of the ray's hit with the triangle's plane
@@ -40,8 +50,8 @@ class Triangle(Hittable):
         py = d.e2 * e2.e0 - d.e0 * e2.e2
         pz = d.e0 * e2.e1 - d.e1 * e2.e0
         det = e1.e0 * px + e1.e1 * py + e1.e2 * pz
-        if det == 0.0:
-            return None  # parallel to the plane
+        if det * det <= self._parallel_det2 * (d.e0 * d.e0 + d.e1 * d.e1 + d.e2 * d.e2):
+            return None  # parallel to the plane, within rounding
         inv = 1.0 / det
         a = self.a
         sx, sy, sz = o.e0 - a.e0, o.e1 - a.e1, o.e2 - a.e2
@@ -63,6 +73,11 @@ class Triangle(Hittable):
         if r is None or not t_min < r[0] < t_max:
             return None
         return r[0]
+
+    def bounding_box(self) -> AABB:
+        """The box around the three vertices; padded, so an axis-aligned triangle's
+        box is not flat."""
+        return AABB.from_points(self.a, self.b, self.c).padded()
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
         n, d = self.normal, ray.direction

@@ -1,9 +1,11 @@
 """Scalar-backend speed on the week-8 scene (issue 2's benchmark).
 
-    python scripts/bench_scalar.py [--width 96] [--spp 16] [--max-depth 5]
+    python scripts/bench_scalar.py [--scene week08_three_balls] [--width 96] [--spp 16]
+                                   [--max-depth 5] [--workers 1,2]
 
-Renders week08_three_balls with 1 and then 2 worker processes in one run and
-prints paths/s (camera paths per wall-clock second) for each, and the ratio.
+Renders the scene (default week08_three_balls) with each worker count (default 1
+and then 2 processes) in one run and prints paths/s (camera paths per
+wall-clock second) for each and, with more than one count, the speed-ups.
 """
 
 from __future__ import annotations
@@ -20,10 +22,16 @@ def main() -> None:
     parser.add_argument("--width", type=int, default=96)
     parser.add_argument("--spp", type=int, default=16)
     parser.add_argument("--max-depth", type=int, default=5)
+    parser.add_argument(
+        "--workers",
+        type=lambda text: [int(n) for n in text.split(",")],
+        default=[1, 2],
+        help="comma-separated worker counts to run, in order (default 1,2)",
+    )
     args = parser.parse_args()
     scene = rtpy.load_scene(args.scene)
     results = {}
-    for workers in (1, 2):
+    for workers in args.workers:
         cpu = time.process_time()
         image = rtpy.render(
             scene, width=args.width, spp=args.spp, max_depth=args.max_depth, workers=workers
@@ -38,7 +46,9 @@ def main() -> None:
         if workers == 1:
             line += f" (CPU {stats['paths'] / cpu:,.0f} paths per CPU-second)"
         print(line)
-    print(f"speed-up with 2 workers: {results[2] / results[1]:.2f}x")
+    first = args.workers[0]
+    for workers in args.workers[1:]:
+        print(f"speed-up with {workers} workers: {results[workers] / results[first]:.2f}x")
 
 
 if __name__ == "__main__":
