@@ -297,10 +297,12 @@ class BVH:
             return None
         return best_obj, best_t
 
-    def any_hit(self, ray: Ray, t_min: float, t_max: float) -> bool:
-        """True if some object is hit with t_min < t < t_max."""
+    def any_hit(
+        self, ray: Ray, t_min: float, t_max: float, ignore: Hittable | None = None
+    ) -> bool:
+        """True if some object other than `ignore` is hit with t_min < t < t_max."""
         for _, obj in self.unbounded:
-            if obj.hit_t(ray, t_min, t_max) is not None:
+            if obj is not ignore and obj.hit_t(ray, t_min, t_max) is not None:
                 return True
         o, d = ray.origin, ray.direction
         ox, oy, oz, dx, dy, dz = o.e0, o.e1, o.e2, d.e0, d.e1, d.e2
@@ -314,7 +316,7 @@ class BVH:
                 stack.append(node.left)
             else:
                 for _, obj in node.items:
-                    if obj.hit_t(ray, t_min, t_max) is not None:
+                    if obj is not ignore and obj.hit_t(ray, t_min, t_max) is not None:
                         return True
         return False
 

@@ -117,14 +117,21 @@ class Scene:
             return None
         return closest_obj.hit_info(ray, closest_t)
 
-    def find_occlusion(self, ray: Ray, interval: Interval, brute_force: bool = False) -> bool:
+    def find_occlusion(
+        self,
+        ray: Ray,
+        interval: Interval,
+        brute_force: bool = False,
+        ignore: Hittable | None = None,
+    ) -> bool:
         """True if anything (glass included) lies on the ray with t in the interval.
-        brute_force as for find_intersection."""
+        `ignore` is an object not to test (a light, for a shadow ray sent to a point
+        on it). brute_force as for find_intersection."""
         t_min, t_max = interval.min, interval.max
         if not brute_force and len(self.objects) >= self.bvh_min_objects:
-            return self.bvh().any_hit(ray, t_min, t_max)
+            return self.bvh().any_hit(ray, t_min, t_max, ignore)
         for obj in self.objects:
-            if obj.hit_t(ray, t_min, t_max) is not None:
+            if obj is not ignore and obj.hit_t(ray, t_min, t_max) is not None:
                 return True
         return False
 

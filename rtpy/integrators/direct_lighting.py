@@ -41,9 +41,13 @@ def sample_one_light(scene: Scene, ray_in: Ray, hit: HitInfo, lights: list[Light
     f = hit.material.BRDF(ray_in, shadow_ray, hit)
     if f.is_black():
         return BLACK
-    # Stop the shadow ray just short of the light's surface so it cannot hit it.
+    # The light itself is not tested: its shapes (spheres sampled on the cap facing
+    # the point, flat quads and triangles) cannot hide the sampled point from it,
+    # while rounding near the sampled point could make it seem to, most where the
+    # light is seen at a slant. Other objects count up to just short of the light.
     t_max = sample.distance - offset_scale(sample.point) - offset_scale(hit.point)
-    if scene.find_occlusion(shadow_ray, Interval(0.0, t_max)):
+    light_shape = getattr(light, "shape", None)
+    if scene.find_occlusion(shadow_ray, Interval(0.0, t_max), ignore=light_shape):
         return BLACK
     pdf = sample.pdf / n_lights  # choosing this light, then this direction
     if sample.is_delta:
