@@ -122,29 +122,11 @@ def test_center_images_agree(name):
     assert close.mean() > 0.99, f"{(~close).sum()} pixels differ"
 
 
-# The scalar backend's shadow rays can be blocked by the very light they were sent
-# to: sample_one_light stops them offset_scale(light point) + offset_scale(hit point)
-# short of the light, but the spawned origin moves the light's surface along the
-# ray by eps cos(theta_i) / cos(theta_light), which is more than that margin where
-# the light is seen at a slant. So the scalar direct light from area lights is too
-# dark near them (here: the gallery's floor near its quad light, 9 % in a block;
-# from a sphere light's samples near its silhouette, 6 % in
-# test_integrators.test_sphere_light_nee_gives_the_analytic_irradiance). The numpy
-# backend does not let a light block its own shadow ray and matches the analytic
-# value. Until the scalar backend does the same, these comparisons fail.
-SCALAR_SELF_SHADOW = pytest.mark.xfail(
-    reason="scalar shadow rays blocked by their own light (see SCALAR_SELF_SHADOW)",
-    strict=False,
-)
-CASES = [
-    pytest.param(
-        name,
-        integrator,
-        marks=SCALAR_SELF_SHADOW if name == "material_gallery" and integrator != "jittered" else (),
-    )
-    for name in SCENES
-    for integrator in SPP
-]
+# Every scene and integrator agrees. (Until commit 2f1fa6e the scalar backend let a
+# light block its own shadow ray, so material_gallery's direct light was 9 % too dark
+# near its quad light and these comparisons were marked xfail; neither backend now
+# lets a light block its own shadow ray.)
+CASES = [(name, integrator) for name in SCENES for integrator in SPP]
 
 
 @pytest.mark.parametrize("name,integrator", CASES)
