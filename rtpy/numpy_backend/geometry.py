@@ -354,7 +354,8 @@ def area_direction_pdf(p: np.ndarray, q: np.ndarray, n: np.ndarray, area: np.nda
     (normal n, either side)."""
     dv = q - p
     dist2 = _dot(dv, dv)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # Grazing or coincident points divide by ~0 here; np.where below discards them.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         cos_light = np.abs(_dot(dv, n)) / np.sqrt(dist2)
         pdf = dist2 / (cos_light * area)
     return np.where((dist2 == 0.0) | ~(cos_light >= 1e-12), 0.0, pdf)
@@ -504,7 +505,7 @@ class SphereSet(PrimitiveSet):
         d2 = _dot(dv, dv)
         r2 = self.r2.take(k)
         outside = ~(d2 <= r2 * 1.0000001)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inside: unused
             sin2 = r2 / d2
             cos_max = np.sqrt(1.0 - sin2)
             return outside, cos_max, sin2 / (1.0 + cos_max)
