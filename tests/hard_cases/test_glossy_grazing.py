@@ -142,8 +142,8 @@ BECKMANN_BUG = (
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("name", list(MATERIALS))
 def test_narrow_lobes_at_grazing_angles_are_finite(request, name, backend):
-    """Of these 130 pairs the naive f is NaN or inf for 85 (82 for Ward) and the naive
-    pdf for 62 (61 and 63); rtpy's f and pdf are finite and >= 0 for all of them.
+    """Of these 130 pairs the naive f is NaN or inf for 85 and the naive pdf for 62
+    (every model); rtpy's f and pdf are finite and >= 0 for all of them.
 
     No tolerance: finiteness and sign are exact properties."""
     if name == "beckmann" and backend == "scalar":
