@@ -149,7 +149,10 @@ class CookTorrance(GlossyMaterial):
             # alpha^2 / (pi cos^4 (alpha^2 + tan^2)^2), multiplied out by cos^4:
             k = a2 * cos2 + sin2
             return a2 / (math.pi * k * k)
-        exponent = sin2 / (a2 * cos2)  # tan^2 / alpha^2
+        denominator = a2 * cos2
+        if denominator == 0.0:  # underflow for tiny widths at the horizon: exp(-inf)
+            return 0.0
+        exponent = sin2 / denominator  # tan^2 / alpha^2
         if exponent > 700.0:  # exp underflows; the cos^4 below would lose to it anyway
             return 0.0
         return math.exp(-exponent) / (math.pi * a2 * cos2 * cos2)

@@ -710,6 +710,8 @@ class TriangleSet(PlanarSet):
         self.normal = np.array([_v(s.normal) for s in triangles], dtype=f).reshape(-1, 3)
         self.tan = np.array([_v(s._tangent) for s in triangles], dtype=f).reshape(-1, 3)
         self._area = np.array([float(s.area()) for s in triangles], dtype=f)
+        # Triangle's relative parallel test: det^2 <= parallel_det2 * |d|^2 is a miss.
+        self.parallel_det2 = np.array([s._parallel_det2 for s in triangles], dtype=f)
         self.origin = self.a
         self.N = np.cross(self.e1, self.e2)
         self.e2xa = np.cross(self.e2, self.a)
@@ -725,13 +727,13 @@ class TriangleSet(PlanarSet):
         corners = np.stack([self.a, self.a + self.e1, self.a + self.e2])
         return corners.min(axis=0), corners.max(axis=0)
 
-    def _finish(self, det, u_num, v_num, t_num, t_min, t_max):
+    def _finish(self, det, parallel, u_num, v_num, t_num, t_min, t_max):
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = 1.0 / det
             u = u_num * inv
             v = v_num * inv
             t = t_num * inv
-        ok = (det != 0.0) & (u >= 0.0) & (u <= 1.0) & (v >= 0.0) & (u + v <= 1.0)
+        ok = (det * det > parallel) & (u >= 0.0) & (u <= 1.0) & (v >= 0.0) & (u + v <= 1.0)
         ok &= (t > t_min) & (t < t_max)
         return np.where(ok, t, INF)
 
@@ -745,7 +747,8 @@ class TriangleSet(PlanarSet):
         u_num = mm[:, :k] - dd[:, k : 2 * k]
         v_num = -mm[:, k:] - dd[:, 2 * k :]
         t_num = on - self.aN
-        return self._finish(det, u_num, v_num, t_num, t_min, INF)
+        parallel = self.parallel_det2 * _dot(d, d)[:, None]
+        return self._finish(det, parallel, u_num, v_num, t_num, t_min, INF)
 
     def pair_t(self, o, d, k, t_min, t_max):
         m = np.cross(o, d)
@@ -754,7 +757,8 @@ class TriangleSet(PlanarSet):
         u_num = _dot(self.e2[k], m) - _dot(d, self.e2xa[k])
         v_num = -_dot(self.e1[k], m) - _dot(d, self.axe1[k])
         t_num = _dot(o, nn) - self.aN[k]
-        return self._finish(det, u_num, v_num, t_num, t_min, t_max)
+        parallel = self.parallel_det2[k] * _dot(d, d)
+        return self._finish(det, parallel, u_num, v_num, t_num, t_min, t_max)
 
     def uv(self, k, point):
         # Triangle.surface_uv: barycentric coordinates from dot products.

@@ -132,24 +132,13 @@ def naive_ward(material, wo, wi):
     return f, pdf
 
 
-BECKMANN_BUG = (
-    "scalar CookTorrance.D (Beckmann) computes sin2 / (a2 * cos2) after testing only "
-    "cos2 == 0: for 0 < h_z below about 2e-159 (roughness 0.001), a2 * cos2 underflows "
-    "to 0 and it raises ZeroDivisionError (the numpy kernel gives inf, then 0)"
-)
-
-
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("name", list(MATERIALS))
-def test_narrow_lobes_at_grazing_angles_are_finite(request, name, backend):
+def test_narrow_lobes_at_grazing_angles_are_finite(name, backend):
     """Of these 130 pairs the naive f is NaN or inf for 85 and the naive pdf for 62
     (every model); rtpy's f and pdf are finite and >= 0 for all of them.
 
     No tolerance: finiteness and sign are exact properties."""
-    if name == "beckmann" and backend == "scalar":
-        request.applymarker(
-            pytest.mark.xfail(strict=True, raises=ZeroDivisionError, reason=BECKMANN_BUG)
-        )
     material = MATERIALS[name]()
     wo, wi = grazing_pairs([c for c in COSINES if c != 5e-324])  # see the next test
     naive = naive_ward if isinstance(material, Ward) else naive_cook_torrance
