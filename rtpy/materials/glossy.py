@@ -29,6 +29,11 @@ from .material import Material, as_texture
 
 INV_PI = 1.0 / math.pi
 
+# Densities saturate here. A lobe seen at a subnormal grazing cosine can ask for more
+# than float64 holds (1 / (4 wo.h) with wo.h = 5e-324); inf would turn the MIS weight
+# pdf^2 / (pdf^2 + other^2) into inf / inf. 1e150 keeps pdf^2 finite.
+MAX_PDF = 1e150
+
 Local = tuple[float, float, float]  # a unit direction in the shading frame
 
 
@@ -77,7 +82,7 @@ class GlossyMaterial(Material):
         pdf = p_diffuse * wi[2] * INV_PI
         if p_diffuse < 1.0:
             pdf += (1.0 - p_diffuse) * self.specular_pdf(wo, wi)
-        return pdf
+        return min(pdf, MAX_PDF)
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
         frame = self.frame(hit)

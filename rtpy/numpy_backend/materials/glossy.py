@@ -19,6 +19,7 @@ import numpy as np
 from ...materials import BlinnPhong, CookTorrance, Phong, Ward
 from ...materials.blinn_phong import INV_EIGHT_PI
 from ...materials.cook_torrance import INV_SQRT_PI
+from ...materials.glossy import MAX_PDF
 from ...materials.phong import INV_TWO_PI
 from ...materials.ward import MAX_EXPONENT, MIN_COS_PRODUCT
 from ..hits import HitBatch
@@ -110,9 +111,10 @@ class GlossyKernel(AlbedoKernel):
     def _pdf(self, slots: np.ndarray, p_diffuse: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
         pdf = p_diffuse * wi[2] * INV_PI
         mixed = select(p_diffuse < 1.0)
-        p_specular = self.specular_pdf(slots[mixed], take(wo, mixed), take(wi, mixed))
+        with np.errstate(over="ignore"):  # saturated below, as the scalar _pdf
+            p_specular = self.specular_pdf(slots[mixed], take(wo, mixed), take(wi, mixed))
         pdf[mixed] = pdf[mixed] + (1.0 - p_diffuse[mixed]) * p_specular
-        return pdf
+        return np.minimum(pdf, MAX_PDF, out=pdf)
 
     def eval(
         self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray
