@@ -183,6 +183,17 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
     return checked
 
 
+def check_width(scene, path: Path, overrides: dict, option: str) -> None:
+    """A width override must give an image within the size limits with the scene's
+    aspect ratio (checked before anything is allocated)."""
+    if "width" not in overrides or scene.camera is None:
+        return
+    try:
+        scene.camera.with_width(overrides["width"])
+    except ValueError as e:
+        raise UsageError(f"{option} {overrides['width']} with {path}'s aspect ratio: {e}") from None
+
+
 def command_scenes() -> int:
     from .bundled import bundled_scenes
 
@@ -211,6 +222,7 @@ def command_render(args: argparse.Namespace) -> int:
         }
         given = {k: v for k, v in flags.items() if v is not None}
         overrides.update(validate_overrides(given, as_flags=True))
+        check_width(scene, path, overrides, "--width" if args.width is not None else "--set width")
         output = Path(args.output) if args.output else Path(f"{path.stem}.png")
         check_image_path(output)
         linear = check_linear_path(args.linear) if args.linear else None

@@ -189,7 +189,9 @@ def cameras(draw):
     view = _add(look_at, look_from, -1.0)
     vup = draw(direction)
     if not _norm(_cross(vup, view)) > 1e-3 * _norm(vup) * _norm(view):
-        vup = _cross(view, [1.0, 0.0, 0.0]) if abs(view[0]) < 0.5 else [0.0, 1.0, 0.0]
+        axis = [0.0, 0.0, 0.0]
+        axis[min(range(3), key=lambda i: abs(view[i]))] = 1.0  # the axis most across view
+        vup = _cross(view, axis)
     camera = {
         "look_from": look_from,
         "look_at": look_at,

@@ -47,8 +47,9 @@ def bad_pixels(image: np.ndarray) -> str:
     bad = ~np.isfinite(image) | (image < 0)
     if not bad.any():
         return ""
-    rows, cols, chans = np.nonzero(bad)
-    return f"{bad.sum()} bad values, first at pixel ({cols[0]}, {rows[0]}): {image[rows[0], cols[0]]}"
+    rows, cols, _ = np.nonzero(bad)
+    first = image[rows[0], cols[0]]
+    return f"{bad.sum()} bad values, first at pixel ({cols[0]}, {rows[0]}): {first}"
 
 
 @settings(
