@@ -204,7 +204,41 @@ def command_scenes() -> int:
     return 0
 
 
+def _first_ctrl_c(signum, frame) -> None:
+    """Ctrl-C: stop the render (the renderer keeps what is finished); a second one
+    exits at once."""
+    signal.signal(signal.SIGINT, _second_ctrl_c)
+    raise KeyboardInterrupt
+
+
+def _second_ctrl_c(signum, frame) -> None:
+    """A second Ctrl-C exits at once, without waiting for the partial image to be
+    written: worker processes are killed, temporary files removed (an output file
+    is either complete or not there)."""
+    import multiprocessing
+    import os
+
+    from .image import remove_temporary_files
+
+    for child in multiprocessing.active_children():
+        child.kill()
+    remove_temporary_files()
+    os.write(2, b"\nrtpy: interrupted again: stopped at once\n")
+    os._exit(EXIT_INTERRUPTED)
+
+
 def command_render(args: argparse.Namespace) -> int:
+    previous = signal.signal(signal.SIGINT, _first_ctrl_c)
+    try:
+        return _render(args)
+    except KeyboardInterrupt:  # before or after the render: nothing was written
+        print("rtpy: interrupted: nothing written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _render(args: argparse.Namespace) -> int:
     from . import render
     from .bundled import resolve_scene
     from .scene_file import SceneError, load_scene
@@ -232,10 +266,8 @@ def command_render(args: argparse.Namespace) -> int:
 
     image = render(scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides)
 
-    # A second Ctrl-C while the partial image is written ends at once; writes
-    # are atomic, so no half-written file is left.
-    if image.interrupted:
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
+    # A Ctrl-C while the image is written (after a complete render) leaves no file:
+    # writes are atomic. After a first Ctrl-C, a second one ends at once.
     written = [image.save(output)]
     if linear is not None:
         written.append(image.save(linear))

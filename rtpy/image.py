@@ -193,6 +193,7 @@ def atomic_write(path: StrPath, write_fn: Callable[[Path], object]) -> Path:
         delete=False, dir=directory, prefix="." + target.name + ".", suffix=".tmp"
     ) as tmp:
         tmp_path = Path(tmp.name)
+        _temporary_files.add(tmp_path)
     try:
         write_fn(tmp_path)
         with open(tmp_path, "rb+") as f:  # make sure the data is on disk before renaming
@@ -202,7 +203,23 @@ def atomic_write(path: StrPath, write_fn: Callable[[Path], object]) -> Path:
     except BaseException:
         tmp_path.unlink(missing_ok=True)
         raise
+    finally:
+        _temporary_files.discard(tmp_path)
     return target
+
+
+# Temporary files of writes in progress, for a process that must exit at once.
+_temporary_files: set[Path] = set()
+
+
+def remove_temporary_files() -> None:
+    """Delete the temporary files of writes in progress (the targets are untouched).
+    For a signal handler that ends the process without unwinding (os._exit)."""
+    for path in list(_temporary_files):
+        try:
+            path.unlink(missing_ok=True)
+        except OSError:
+            pass
 
 
 # --------------------------------------------------------------------------- writers

@@ -160,42 +160,78 @@ def test_unknown_scene_name_exits_2():
     assert result.returncode == 2 and "cornell" in result.stderr
 
 
+def start_render(*args: str) -> subprocess.Popen:
+    return subprocess.Popen(
+        [sys.executable, "-m", "rtpy", "render", *args], stderr=subprocess.PIPE, text=True
+    )
+
+
+def wait_for_progress(proc: subprocess.Popen, timeout: float = 90) -> str:
+    """Read the progress bar until it shows that samples are done; returns what it read."""
+    deadline = time.monotonic() + timeout
+    seen = ""
+    while time.monotonic() < deadline:
+        chunk = os.read(proc.stderr.fileno(), 4096).decode()
+        if not chunk:
+            break  # the process ended
+        seen += chunk
+        if "path" in seen and "0/" not in seen.rsplit("\r", 1)[-1]:
+            return seen
+    raise AssertionError(f"no progress within {timeout} s: {seen}")
+
+
+@pytest.mark.parametrize("backend", ["scalar", "numpy"])
 @pytest.mark.parametrize("workers", ["1", "2"])
-def test_ctrl_c_writes_the_finished_samples(tmp_path, workers):
+def test_ctrl_c_writes_the_finished_samples(tmp_path, workers, backend):
     """SIGINT to a real render: it stops, writes a valid image of the samples
     finished so far, says how many, and exits with 130."""
     out = tmp_path / "partial.png"
-    proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "rtpy",
-            "render",
-            "cornell",
-            "--width",
-            "48",
-            "--spp",
-            "256",
-            "--workers",
-            workers,
-            "-o",
-            str(out),
-        ],
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    # Wait until the first samples are done (the progress bar shows a count).
-    deadline = time.monotonic() + 60
-    seen = ""
-    while time.monotonic() < deadline:
-        seen += os.read(proc.stderr.fileno(), 4096).decode()
-        if "path" in seen and "0/" not in seen.rsplit("\r", 1)[-1]:
-            break
+    spp = "256" if backend == "scalar" else "20000"
+    proc = start_render(
+        "cornell", "--width", "48", "--spp", spp, "--workers", workers, "--backend", backend,
+        "-o", str(out),
+    )  # fmt: skip
+    seen = wait_for_progress(proc)
     time.sleep(1.0)
     proc.send_signal(signal.SIGINT)
     _, rest = proc.communicate(timeout=60)
     assert proc.returncode == 130, seen + rest
-    assert "interrupted" in rest and "of 256 samples per pixel" in rest
+    assert "interrupted" in rest and f"of {spp} samples per pixel" in rest
+    assert "Traceback" not in rest
     with Image.open(out) as im:
         assert im.size == (48, 48)
         assert np.asarray(im).max() > 0
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_second_ctrl_c_exits_at_once(tmp_path, workers):
+    """A second SIGINT while the partial image is being written ends the process at
+    once: no waiting for the write, no traceback, no worker left running, and no
+    file half-written (the output is absent, and so is its temporary file).
+
+    The naive handling (Python's default KeyboardInterrupt, or SIG_DFL set once
+    the render returns) either prints a traceback from wherever the second signal
+    lands, or dies inside the write and leaves its temporary file behind. A
+    2000x2000 partial image takes seconds to encode, so the window is wide."""
+    out = tmp_path / "big.png"
+    proc = start_render(
+        "cornell", "--width", "2000", "--spp", "64", "--backend", "numpy",
+        "--workers", workers, "-o", str(out),
+    )  # fmt: skip
+    wait_for_progress(proc, timeout=120)
+    ps = subprocess.run(["ps", "-o", "pid=", "--ppid", str(proc.pid)], capture_output=True)
+    workers_pids = [int(p) for p in ps.stdout.split()]
+    assert len(workers_pids) == (2 if workers == "2" else 0)
+    proc.send_signal(signal.SIGINT)
+    time.sleep(0.3)  # the first one stops the render and starts writing
+    proc.send_signal(signal.SIGINT)
+    second = time.monotonic()
+    _, rest = proc.communicate(timeout=60)
+    elapsed = time.monotonic() - second
+    assert proc.returncode == 130, rest
+    assert "interrupted again" in rest and "Traceback" not in rest
+    assert elapsed < 1.5, f"took {elapsed:.1f} s after the second Ctrl-C"
+    assert list(tmp_path.iterdir()) == []
+    time.sleep(0.5)
+    alive = [pid for pid in workers_pids if Path(f"/proc/{pid}").exists()]
+    assert alive == [], "worker processes still running"  # killed, not orphaned
