@@ -257,7 +257,7 @@ def _render(args: argparse.Namespace) -> int:
         given = {k: v for k, v in flags.items() if v is not None}
         overrides.update(validate_overrides(given, as_flags=True))
         check_width(scene, path, overrides, "--width" if args.width is not None else "--set width")
-        output = Path(args.output) if args.output else Path(f"{path.stem}.png")
+        output = Path(args.output) if args.output is not None else Path(f"{path.stem}.png")
         check_image_path(output)
         linear = check_linear_path(args.linear) if args.linear else None
     except (SceneError, OutputError, UsageError) as err:

@@ -235,3 +235,56 @@ def test_second_ctrl_c_exits_at_once(tmp_path, workers):
     time.sleep(0.5)
     alive = [pid for pid in workers_pids if Path(f"/proc/{pid}").exists()]
     assert alive == [], "worker processes still running"  # killed, not orphaned
+
+
+@pytest.mark.parametrize(
+    "output,linear,message",
+    [
+        ("no/such/dir/out.png", None, "does not exist"),
+        ("a_file/out.png", None, "is not a directory"),
+        ("a_dir.png", None, "existing directory"),
+        ("x" * 300 + ".png", None, "File name too long"),
+        ("", None, "no file extension"),
+        ("out.png", "a_file/out.npy", "is not a directory"),
+        ("out.png", "a_dir.npy", "existing directory"),
+    ],
+)
+def test_unwritable_output_is_reported_before_rendering(
+    tmp_path, monkeypatch, capsys, output, linear, message
+):
+    """Output paths are checked before the render starts (CI runs as root, so
+    read-only directories are not tested; a file used as a directory, a missing
+    directory, a directory as the path and a name the file system refuses are).
+    The naive check (does the parent exist?) lets a name too long for the file
+    system through, and the render's hours are lost when the write fails."""
+    (tmp_path / "a_file").write_text("not a directory")
+    (tmp_path / "a_dir.png").mkdir()
+    (tmp_path / "a_dir.npy").mkdir()
+    before = sorted(p.name for p in tmp_path.iterdir())
+    monkeypatch.chdir(tmp_path)
+    rendered = []
+    monkeypatch.setattr(rtpy, "render", lambda *a, **k: rendered.append(1))
+    argv = ["render", "cornell", *SMALL, "-o", output]
+    if linear is not None:
+        argv += ["--linear", linear]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("rtpy: error: cannot write") and message in err
+    assert rendered == []
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_unwritable_output_real_subprocess_says_so_at_once(tmp_path):
+    """As a user runs it: a 30-minute render with a bad output path fails at once."""
+    (tmp_path / "a_file").write_text("")
+    start = time.monotonic()
+    result = run_cli(
+        "render", "cornell", "--spp", "100000", "-o", str(tmp_path / "a_file" / "x.png")
+    )
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.strip().splitlines() == [
+        f"rtpy: error: cannot write '{tmp_path / 'a_file' / 'x.png'}': "
+        f"'{tmp_path / 'a_file'}' is not a directory"
+    ]
+    assert time.monotonic() - start < 30
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
