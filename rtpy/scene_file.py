@@ -134,7 +134,14 @@ class SceneError(Exception):
             text += f" (line {self.line})"
         if self.suggestion is not None:
             text += f" — did you mean '{self.suggestion}'?"
-        return text
+        return text.translate(_ESCAPE_LINE_BREAKS)
+
+
+# A message is one line: names and strings quoted from the file keep no character
+# that str.splitlines (or a terminal) takes for a line break.
+_ESCAPE_LINE_BREAKS = str.maketrans(
+    {c: repr(c)[1:-1] for c in "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"}
+)
 
 
 def _suggest(word: str, choices: Iterable[str]) -> str | None:

@@ -249,6 +249,10 @@ def test_broken_scene_file_renders_or_gives_one_clear_error(texture_png, case, b
             'center = [0, 0, 0]\nradius = nan\nmaterial = "m"\n',
             "[[objects]] #1 radius",
         ),
+        # Found by the fuzzer: a string or key quoted in the message held a character
+        # that splitlines and terminals take for a line break (U+0085, U+2028).
+        ('[camera]\naspect_ratio = "\u0085"\n', "[camera] aspect_ratio"),
+        ('[camera]\n"wid\u2028th" = 3\n', "[camera] wid\\u2028th"),
     ],
 )
 def test_real_subprocess_gives_one_clear_error(tmp_path, text, where):
