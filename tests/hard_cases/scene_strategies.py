@@ -135,7 +135,12 @@ class SceneMaker:
             radius = r.log_uniform(1e-3, 1e3, 1e-3, 1e3, 1e5)
             return {"type": "sphere", "center": q, "radius": radius, "material": material}
         e1, e2 = r.triple(-3.0, 3.0, 0.0), r.triple(-3.0, 3.0, 0.0)
-        if r.rng.random() < 0.3:  # a sliver: e2 almost along e1
+        if r.rng.random() < 0.4:  # on a grid, as in a Cornell box: shared planes and edges
+            q = [float(r.rng.randint(-2, 2)) for _ in range(3)]
+            i, j = r.rng.sample(range(3), 2)
+            e1, e2 = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+            e1[i], e2[j] = r.rng.choice([-2.0, -1.0, 1.0, 2.0]), r.rng.choice([-2.0, 1.0, 2.0])
+        elif r.rng.random() < 0.3:  # a sliver: e2 almost along e1
             e2 = add([x * r.uniform(-2.0, 2.0) for x in e1], e2, r.log_uniform(1e-12, 1e-2))
         if kind == "quad":
             if not norm(cross(e1, e2)) > 0.0:
@@ -146,10 +151,14 @@ class SceneMaker:
             b, c = add(q, [1.0, 0.0, 0.0]), add(q, [0.0, 1.0, 0.0])
         return {"type": "triangle", "a": q, "b": b, "c": c, "material": material}
 
-    def camera(self) -> dict:
+    def camera(self, target: list[float] | None = None) -> dict:
+        """A camera anywhere, looking at `target` (when given and not too close) or
+        in a random direction."""
         r = self
         look_from = r.triple(-4.0, 4.0, 0.0)
         view = r.direction()
+        if target is not None and norm(add(target, look_from, -1.0)) > 1e-3:
+            view = add(target, look_from, -1.0)
         vup = r.direction()
         if not norm(cross(vup, view)) > 1e-3 * norm(vup) * norm(view):
             axis = [0.0, 0.0, 0.0]
@@ -190,11 +199,14 @@ class SceneMaker:
         textures = {f"t{i}": self.texture() for i in range(r.randint(0, 2))}
         materials = {f"m{i}": self.material(sorted(textures)) for i in range(r.randint(1, 4))}
         names = sorted(materials)
+        objects = [self.shape(r.choice(names)) for _ in range(r.randint(1, 5))]
+        target = r.choice(objects)
+        target = target.get("center") or target.get("q") or target.get("a")
         data = {
-            "camera": self.camera(),
+            "camera": self.camera(target if r.random() < 0.8 else None),
             "render": self.render(),
             "materials": materials,
-            "objects": [self.shape(r.choice(names)) for _ in range(r.randint(1, 5))],
+            "objects": objects,
         }
         if textures:
             data["textures"] = textures

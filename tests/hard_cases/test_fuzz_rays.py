@@ -144,7 +144,7 @@ def check_hit(shape, o, d, t, point, normal, u, v, aimed) -> str:
         return f"normal {normal} not unit or not facing the ray {d}"
     if not (-1e-9 <= u <= 1 + 1e-9 and -1e-9 <= v <= 1 + 1e-9):
         return f"(u, v) = ({u}, {v})"
-    if not math.isnan(aimed) and t > aimed * (1 + REL):
+    if not math.isnan(aimed) and t > aimed + REL * size:
         return f"t = {t} beyond the aimed-at point at {aimed}"
     return ""
 
