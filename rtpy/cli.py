@@ -14,7 +14,7 @@ from pathlib import Path
 
 from .image import OutputError, check_image_path, check_linear_path
 from .render_settings import INTEGRATOR_NAMES
-from .scene_file import MAX_MAX_DEPTH, MAX_SPP, MAX_WIDTH
+from .scene_file import MAX_MAX_DEPTH, MAX_RADIANCE, MAX_SPP, MAX_WIDTH
 
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
@@ -172,12 +172,14 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
                     isinstance(c, int | float)
                     and not isinstance(c, bool)
                     and math.isfinite(c)
-                    and c >= 0
+                    and 0 <= c <= MAX_RADIANCE
                     for c in value
                 )
             )
             if not ok:
-                raise fail(key, "3 finite numbers >= 0, such as [0.1, 0.1, 0.1]", value)
+                raise fail(
+                    key, f"3 numbers in [0, {MAX_RADIANCE:g}], such as [0.1, 0.1, 0.1]", value
+                )
             value = Color(*map(float, value))
         checked[key] = value
     return checked

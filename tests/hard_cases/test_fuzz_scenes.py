@@ -23,7 +23,7 @@ from PIL import Image
 from test_scene_file import to_toml
 
 import rtpy
-from rtpy.scene_file import load_scene_text
+from rtpy.scene_file import SceneError, load_scene_text
 
 from .scene_strategies import examples, random_scene, seeds
 
@@ -78,3 +78,65 @@ def test_the_check_catches_a_nan_pixel():
     for value in (np.nan, np.inf, -1e-300):
         image[1, 2, 0] = value
         assert "pixel (2, 1)" in bad_pixels(image)
+
+
+LIMIT_SCENE = """
+[camera]
+look_from = [0, 0, 2]
+width = 8
+[render]
+spp = 8
+max_depth = 12
+russian_roulette = 0
+background = [{big}, {big}, {big}]
+[materials.lamp]
+type = "diffuse_light"
+emit = [{big}, {big}, {big}]
+two_sided = true
+[materials.shiny]
+type = "phong"
+albedo = [1, 1, 1]
+kd = 1
+ks = 1
+exponent = 1
+[[objects]]
+type = "sphere"
+center = [0, 0, -1]
+radius = 0.5
+material = "lamp"
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 4
+material = "shiny"
+[[lights]]
+type = "point"
+position = [0, 1, 0]
+intensity = [{big}, {big}, {big}]
+"""
+
+
+@pytest.mark.parametrize("integrator", ["path", "whitted", "direct"])
+def test_largest_radiances_and_weights_sum_without_overflow(scene_dir, integrator):
+    """Found while testing the fuzzer's limits: emit = 1e308 is finite and >= 0, as
+    the contract asks, but the sum of two samples is inf, so the pixel was Inf (and
+    kd = 1e300 overflows a path's weight). Radiances (emit, intensity, background)
+    are now at most 1e30 and kd, ks at most 1; a closed, over-bright scene at those
+    limits renders finite pixels on both backends."""
+    text = LIMIT_SCENE.format(big="1e30")
+    text = text.replace("[render]", f'[render]\nintegrator = "{integrator}"')
+    scene = load_scene_text(text, scene_dir / "limit.toml")
+    for backend in rtpy.BACKENDS:
+        image = rtpy.render(scene, backend=backend).linear
+        assert not bad_pixels(image), backend
+        assert image.max() > 1e29
+    for before, after in [
+        ("emit = [1e30", "emit = [1e308"),
+        ("background = [1e30", "background = [1e31"),
+        ("intensity = [1e30", "intensity = [1e31"),
+        ("kd = 1\n", "kd = 1.5\n"),
+        ("ks = 1\n", "ks = 1e300\n"),
+    ]:
+        key = before.split()[0]
+        with pytest.raises(SceneError, match=rf" {key}: expected"):
+            load_scene_text(text.replace(before, after), scene_dir / "limit.toml")
