@@ -54,6 +54,16 @@ def non_negative_int(text: str) -> int:
     return value
 
 
+MAX_WORKERS = 256  # more processes than that only exhaust the machine
+
+
+def worker_count(text: str) -> int:
+    value = positive_int(text)
+    if value > MAX_WORKERS:
+        raise argparse.ArgumentTypeError(f"expected at most {MAX_WORKERS} processes, got {value}")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m rtpy", description="rtpy: a teaching ray tracer in Python."
@@ -82,7 +92,12 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--integrator", choices=INTEGRATOR_NAMES)
     r.add_argument("--max-depth", type=positive_int, help="most ray segments per path")
     r.add_argument("--seed", type=non_negative_int)
-    r.add_argument("--workers", type=positive_int, default=1, help="processes (default 1)")
+    r.add_argument(
+        "--workers",
+        type=worker_count,
+        default=1,
+        help=f"processes (default 1, at most {MAX_WORKERS})",
+    )
     r.add_argument(
         "--backend",
         choices=("scalar", "numpy"),

@@ -135,7 +135,10 @@ def test_bad_options_exit_2_and_write_nothing(tmp_path, monkeypatch, extra, mess
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("extra", [["--integrator", "pathh"], ["--spp", "-3"], ["--width", "x"]])
+@pytest.mark.parametrize(
+    "extra",
+    [["--integrator", "pathh"], ["--spp", "-3"], ["--width", "x"], ["--workers", "100000"]],
+)
 def test_argparse_errors_exit_2(extra):
     result = run_cli("render", "week08_three_balls", *extra)
     assert result.returncode == 2 and "Traceback" not in result.stderr

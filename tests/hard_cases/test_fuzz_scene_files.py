@@ -287,3 +287,62 @@ def test_the_checks_reject_a_traceback_and_a_written_file(tmp_path):
     (tmp_path / "out.png").write_bytes(b"half")
     with pytest.raises(AssertionError):
         check_one_clear_error(2, good, scene, tmp_path, before)
+
+
+OPTION_VALUES = {
+    "--width": ["0", "-1", "4", "16384", "1000000000", "1e9", "x", ""],
+    "--spp": ["0", "1", "2", "1000001", "nan", "-5"],
+    "--max-depth": ["0", "1", "3", "501", "2.5"],
+    "--seed": ["0", "-1", "99999999999999999999999", "abc"],
+    "--workers": ["0", "1", "257", "-2"],
+    "--integrator": ["path", "whitted", "center", "pathh", ""],
+    "--backend": ["scalar", "numpy", "gpu"],
+    "--set": [
+        "spp=0", "spp=2", "spp=2.0", "width=16384", "width=5", "max_depth=0", "nee=maybe",
+        "nee=false", "gamma=0", "gamma=nan", "gamma=inf", "background=[1e31, 0, 0]",
+        "background=[0.1, 0.2]", "background=[nan, 0, 0]", "sky=true", "seed=-3",
+        "integrator=direct", "bogus=1", "russian_roulette=-1", "spp", "=", "width=[1]",
+    ],
+    "-o": ["out.png", "out.gif", "", "missing/out.png", "out"],
+    "--linear": ["out.npy", "out.pfm", "out.png", "missing/out.npy"],
+}  # fmt: skip
+
+
+@settings(max_examples=examples(60), derandomize=True, deadline=None)
+@given(
+    options=st.lists(
+        st.sampled_from(sorted(OPTION_VALUES)).flatmap(
+            lambda flag: st.tuples(st.just(flag), st.sampled_from(OPTION_VALUES[flag]))
+        ),
+        max_size=4,
+    ),
+    aspect=st.sampled_from(["1", "0.001", '"16:9"']),
+)
+def test_random_command_line_options_render_or_give_one_clear_error(
+    tmp_path_factory, options, aspect
+):
+    """Options combine with the file: `--width 16384` with a scene's aspect ratio
+    0.001 asks for an image 16 million pixels high. The naive CLI checked the
+    option alone and started allocating; every combination here either renders
+    (exit 0) or exits 2 with one message (argparse's usage errors included) and
+    nothing written."""
+    folder = tmp_path_factory.mktemp("options")
+    scene = folder / "scene.toml"
+    scene.write_text(f"[camera]\nwidth = 4\naspect_ratio = {aspect}\n")
+    argv = ["render", str(scene), "--quiet", "--spp", "1"]
+    for flag, value in options:
+        if flag in ("-o", "--linear") and value:
+            value = str(folder / value)
+        argv += [flag, value]
+    if not any(flag == "-o" for flag, _ in options):
+        argv += ["-o", str(folder / "default.png")]
+    before = set(folder.iterdir())
+    status, stderr = run_main(argv)
+    assert status in (0, 2), stderr
+    assert "Traceback" not in stderr
+    if status == 2:
+        assert set(folder.iterdir()) == before, argv
+        assert stderr.strip().splitlines()[-1].count("error") >= 1, stderr
+        event("error")
+    else:
+        event("rendered")
