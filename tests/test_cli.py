@@ -183,8 +183,9 @@ def wait_for_progress(proc: subprocess.Popen, timeout: float = 90) -> str:
     raise AssertionError(f"no progress within {timeout} s: {seen}")
 
 
-@pytest.mark.parametrize("backend", ["scalar", "numpy"])
-@pytest.mark.parametrize("workers", ["1", "2"])
+@pytest.mark.parametrize(
+    "backend,workers", [("scalar", "1"), ("scalar", "2"), ("numpy", "1"), ("numpy", "2")]
+)
 def test_ctrl_c_writes_the_finished_samples(tmp_path, workers, backend):
     """SIGINT to a real render: it stops, writes a valid image of the samples
     finished so far, says how many, and exits with 130."""

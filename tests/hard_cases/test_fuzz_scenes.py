@@ -53,7 +53,7 @@ def bad_pixels(image: np.ndarray) -> str:
 
 
 @settings(
-    max_examples=examples(200),
+    max_examples=examples(150),
     derandomize=True,
     deadline=None,
     suppress_health_check=[HealthCheck.too_slow],
