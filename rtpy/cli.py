@@ -248,8 +248,8 @@ def command_render(args: argparse.Namespace) -> int:
     previous = signal.signal(signal.SIGINT, _first_ctrl_c)
     try:
         return _render(args)
-    except KeyboardInterrupt:  # before or after the render: nothing was written
-        print("rtpy: interrupted: nothing written", file=sys.stderr)
+    except KeyboardInterrupt:  # before or after the render, while loading or writing
+        print("rtpy: interrupted (no file is left half-written)", file=sys.stderr)
         return EXIT_INTERRUPTED
     finally:
         signal.signal(signal.SIGINT, previous)
