@@ -215,12 +215,13 @@ def test_second_ctrl_c_exits_at_once(tmp_path, workers):
 
     The naive handling (Python's default KeyboardInterrupt, or SIG_DFL set once
     the render returns) either prints a traceback from wherever the second signal
-    lands, or dies inside the write and leaves its temporary file behind. A
-    2000x2000 partial image takes seconds to encode, so the window is wide."""
+    lands, or dies inside the write and leaves its temporary file behind. Writing
+    this 3000x3000 partial image (PNG and .npy) takes about 3 s after one Ctrl-C;
+    the second comes 0.3 s after the first."""
     out = tmp_path / "big.png"
     proc = start_render(
-        "cornell", "--width", "2000", "--spp", "64", "--backend", "numpy",
-        "--workers", workers, "-o", str(out),
+        "cornell", "--width", "3000", "--spp", "64", "--backend", "numpy",
+        "--workers", workers, "-o", str(out), "--linear", str(tmp_path / "big.npy"),
     )  # fmt: skip
     wait_for_progress(proc, timeout=120)
     ps = subprocess.run(["ps", "-o", "pid=", "--ppid", str(proc.pid)], capture_output=True)
