@@ -31,6 +31,7 @@ SETTABLE_KEYS = (
     "background",
     "sky",
     "width",
+    "mis",
 )
 
 
@@ -151,7 +152,7 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
         elif key in ("russian_roulette", "seed"):
             if not is_int(value) or value < 0:
                 raise fail(key, "a whole number >= 0", value)
-        elif key in ("nee", "sky"):
+        elif key in ("nee", "sky", "mis"):
             if not isinstance(value, bool):
                 raise fail(key, "true or false", value)
         elif key == "gamma":
