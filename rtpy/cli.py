@@ -100,6 +100,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--quiet", action="store_true", help="no progress bar")
 
     sub.add_parser("scenes", help="list the bundled scenes")
+
+    from .bench import add_parser as add_bench_parser
+
+    add_bench_parser(sub)
     return parser
 
 
@@ -249,6 +253,10 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)  # usage errors exit with status 2
     if args.command == "scenes":
         return command_scenes()
+    if args.command == "bench":
+        from .bench import command_bench
+
+        return command_bench(args)
     return command_render(args)
 
 
