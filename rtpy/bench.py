@@ -330,6 +330,7 @@ def run_series(
     workers: int,
     ref: Reference,
     log=print,
+    seed: int = 1,
 ) -> list[Level]:
     """Render the levels of one series; with a budget, spp doubles from 1 while
     the next level is predicted to fit in what is left."""
@@ -345,8 +346,8 @@ def run_series(
                 break
         images, times, peaks = [], [], []
         for r in range(repeats):
-            seed = 1 + 1000 * k + r  # independent across levels and repeats
-            img, sec, peak = render_once(bs, backend, variant, spp, seed, workers)
+            # independent across levels and repeats
+            img, sec, peak = render_once(bs, backend, variant, spp, seed + 1000 * k + r, workers)
             images.append(img)
             times.append(sec)
             peaks.append(peak)
@@ -402,6 +403,7 @@ def run_bench(
     cache: Path | None = None,
     reference_spp: int = DEFAULT_REFERENCE_SPP,
     log=print,
+    seed: int = 1,
 ) -> BenchResult:
     result = BenchResult(
         settings={
@@ -413,6 +415,7 @@ def run_bench(
             "repeats": repeats,
             "width": width,
             "workers": workers,
+            "seed": seed,
             "alpha": ALPHA,
             "slope_tolerance": SLOPE_TOLERANCE,
             "date": time.strftime("%Y-%m-%d %H:%M:%S"),
@@ -427,7 +430,7 @@ def run_bench(
                 if depth not in refs:
                     refs[depth] = bs.reference_for(depth)
                 levels = run_series(
-                    bs, backend, variant, spps, budget, repeats, workers, refs[depth], log
+                    bs, backend, variant, spps, budget, repeats, workers, refs[depth], log, seed
                 )
                 result.levels.extend(levels)
                 scale = float(np.abs(refs[depth].image[refs[depth].mask]).mean())
