@@ -54,7 +54,10 @@ ExactImage = Callable[[Camera, int], tuple[np.ndarray, np.ndarray]]
 
 @dataclass
 class AnalyticScene:
-    """A scene, its camera and settings, and its exact image."""
+    """A scene, its camera and settings, and its exact image. ray_radiance, where
+    given, is the exact radiance along camera rays (origins (N, 3), unit
+    directions (N, 3)) -> (N, 3) for max_depth >= 2, which exact() averages over
+    each pixel."""
 
     name: str
     description: str
@@ -62,6 +65,7 @@ class AnalyticScene:
     camera: Camera
     settings: RenderSettings
     exact: ExactImage
+    ray_radiance: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
 
 
 # --------------------------------------------------------------------------- helpers
@@ -249,17 +253,22 @@ def _plane_hits(o: np.ndarray, d: np.ndarray) -> np.ndarray:
     return o + t[:, None] * d
 
 
-def _plane_exact(radiance_at) -> ExactImage:
-    """exact() of a plane scene whose radiance at plane points p (N, 3) is
-    radiance_at(p) (N, 3) for max_depth >= 2."""
+def _plane_scene(name: str, description: str, scene: Scene, camera: Camera, radiance_at):
+    """A plane scene whose radiance at plane points p (N, 3) is radiance_at(p) (N, 3)
+    for max_depth >= 2 (and 0 for max_depth 1)."""
+
+    def ray_radiance(o: np.ndarray, d: np.ndarray) -> np.ndarray:
+        return radiance_at(_plane_hits(o, d))
 
     def exact(cam: Camera, max_depth: int):
         mask = np.ones((cam.height, cam.width), dtype=bool)
         if max_depth < 2:
             return np.zeros((cam.height, cam.width, 3)), mask
-        return pixel_average(cam, lambda o, d: radiance_at(_plane_hits(o, d))), mask
+        return pixel_average(cam, ray_radiance), mask
 
-    return exact
+    return AnalyticScene(
+        name, description, scene, camera, RenderSettings(max_depth=4), exact, ray_radiance
+    )
 
 
 POINT_LIGHT_POSITION = Vec3(0.3, 2.0, -0.5)
@@ -278,13 +287,12 @@ def plane_point_light() -> AnalyticScene:
         cos_theta = to_light[:, 1] / np.sqrt(d2)
         return (PLANE_ALBEDO / math.pi) * (cos_theta / d2)[:, None] * intensity
 
-    return AnalyticScene(
+    return _plane_scene(
         "plane_point_light",
         "Lambertian plane under a point light: albedo/pi I cos(theta)/d^2 per pixel",
         scene,
         camera,
-        RenderSettings(max_depth=4),
-        _plane_exact(radiance_at),
+        radiance_at,
     )
 
 
@@ -307,13 +315,12 @@ def plane_sphere_light() -> AnalyticScene:
         # albedo / pi * (pi Le (r / d)^2 cos(theta))
         return PLANE_ALBEDO * ((r / d) ** 2 * cos_theta)[:, None] * le
 
-    return AnalyticScene(
+    return _plane_scene(
         "plane_sphere_light",
         "Lambertian plane under a sphere light: albedo Le (r/d)^2 cos(theta) per pixel",
         scene,
         camera,
-        RenderSettings(max_depth=4),
-        _plane_exact(radiance_at),
+        radiance_at,
     )
 
 
@@ -327,14 +334,13 @@ def plane_sky_band() -> AnalyticScene:
     scene = Scene([plane], environment=sky)
     value = _rgb(sky.irradiance_up()) * (PLANE_ALBEDO / math.pi)
 
-    return AnalyticScene(
+    return _plane_scene(
         "plane_sky_band",
         "Lambertian plane under a sky bright 60-85 deg from the zenith: "
         "albedo Ls (sin^2 t2 - sin^2 t1)",
         scene,
         camera,
-        RenderSettings(max_depth=4),
-        _plane_exact(lambda p: np.broadcast_to(value, p.shape)),
+        lambda p: np.broadcast_to(value, p.shape),
     )
 
 
