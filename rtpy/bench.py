@@ -240,6 +240,7 @@ class Level:
     bias_se: float
     rel_bias: float
     bias_z: float
+    exact: bool = False  # RMSE below ROUNDING of the reference's scale: no error
     significant: bool = False
     efficiency: float = math.nan
     reference: str = ""
@@ -297,7 +298,7 @@ class BenchResult:
                 abs(lv.bias_z) > self.z_critical and not abs(lv.rel_bias) <= BIAS_FLOOR
             )
             denom = lv.rel_mse * lv.seconds
-            lv.efficiency = 1.0 / denom if denom > 0 else math.inf
+            lv.efficiency = 1.0 / denom if denom > 0 and not lv.exact else math.inf
 
     def problems(self, variants=None) -> list[str]:
         """Series that fail the unbiasedness check: a significant bias at any level,
@@ -374,6 +375,7 @@ def run_series(
             bias_se=st.bias_se,
             rel_bias=st.rel_bias,
             bias_z=z_score(st.bias, st.bias_se, scale),
+            exact=bool(st.mse <= (ROUNDING * scale) ** 2),
             reference=ref.source,
         )
         levels.append(lv)
@@ -477,31 +479,56 @@ def table_rows(result: BenchResult) -> list[list[str]]:
     return [[_fmt(f, getattr(lv, key)) for key, _, f in TABLE_COLUMNS] for lv in result.levels]
 
 
-def format_table(result: BenchResult, markdown: bool = False) -> str:
-    head = [h for _, h, _ in TABLE_COLUMNS]
-    rows = table_rows(result)
+def _layout(head: list[str], rows: list[list[str]], markdown: bool) -> str:
     if markdown:
         lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        lines += ["| " + " | ".join(r) + " |" for r in rows]
-    else:
-        widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
-        lines = ["  ".join(h.rjust(w) for h, w in zip(head, widths, strict=True))]
-        lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
+        return "\n".join(lines + ["| " + " | ".join(r) + " |" for r in rows])
+    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
+    lines = ["  ".join(h.rjust(w) for h, w in zip(head, widths, strict=True))]
+    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
     return "\n".join(lines)
 
 
-def format_fits(result: BenchResult) -> str:
-    lines = [
-        f"slope of log MSE against log spp (unbiased: -1; bias test |z| > "
-        f"{result.z_critical:.2f}, family-wise alpha {ALPHA:g}):"
-    ]
+def format_table(result: BenchResult, markdown: bool = False) -> str:
+    """Every level of every series."""
+    return _layout([h for _, h, _ in TABLE_COLUMNS], table_rows(result), markdown)
+
+
+def format_series(result: BenchResult, markdown: bool = False) -> str:
+    """One row per series: its last (highest-spp) level, the fitted slope, and
+    whether any level was significantly biased."""
+    head = ["scene", "backend", "integrator", "spp", "s/render", "paths/s", "peak MB"]
+    head += ["relMSE", "1/(relMSE*s)", "slope", "biased?"]
+    rows = []
     for f in result.fits:
-        if f.slope is None:
-            text = f.note
-        else:
-            text = f"{f.slope:+.3f} +- {f.slope_se:.3f} over {f.levels} levels"
-        lines.append(f"  {f.scene:<20} {f.backend:<7} {f.integrator:<10} {text}")
-    return "\n".join(lines)
+        mine = [
+            lv
+            for lv in result.levels
+            if (lv.scene, lv.backend, lv.integrator) == (f.scene, f.backend, f.integrator)
+        ]
+        last = mine[-1]
+        slope = "exact" if f.slope is None else f"{f.slope:+.2f} ± {f.slope_se:.2f}"
+        biased = "YES" if any(lv.significant for lv in mine) else "no"
+        rows.append(
+            [
+                f.scene,
+                f.backend,
+                f.integrator,
+                str(last.spp),
+                f"{last.seconds:.2f}",
+                f"{last.paths_per_second:,.0f}",
+                f"{last.peak_mb:.0f}",
+                _fmt("{:.2g}", last.rel_mse),
+                _fmt("{:.3g}", last.efficiency),
+                slope,
+                biased,
+            ]
+        )
+    note = (
+        f"slope: of log MSE against log spp (unbiased: -1); biased?: |z| > "
+        f"{result.z_critical:.2f} at some level (family-wise alpha {ALPHA:g})"
+    )
+    return _layout(head, rows, markdown) + "\n" + ("\n" if markdown else "") + note
 
 
 def _json_value(v):
@@ -701,7 +728,7 @@ def command_bench(args: argparse.Namespace) -> int:
         return 2
     print(format_table(result))
     print()
-    print(format_fits(result))
+    print(format_series(result))
     files = write_outputs(result, out)
     png = plot(result, out)
     if png is None:

@@ -191,7 +191,7 @@ def test_quick_bench_runs_end_to_end_and_its_files_parse(tmp_path, capsys, monke
     assert len(doc["levels"]) == len(rows) and len(doc["fits"]) == 2 * 2 * len(VARIANTS)
     assert doc["settings"]["spp"] == [1, 4, 16] and doc["settings"]["width"] == 16
     assert all(isinstance(f["slope"], float) for f in doc["fits"])
-    assert "relMSE" in captured.out and "slope of log MSE" in captured.out
+    assert "relMSE" in captured.out and "slope: of log MSE" in captured.out
     assert captured.err.count("matplotlib is not installed") == 1
     assert not (out / "bench.png").exists()
     assert list(cache.glob("week05_point_light-w16-d*.npz"))
