@@ -163,6 +163,8 @@ def render_once(bs: BenchScene, backend: str, variant: str, spp: int, seed: int,
         **VARIANTS[variant],
     )
     seconds = time.perf_counter() - start
+    if image.interrupted:  # Ctrl-C inside the render: a partial image is no measurement
+        raise KeyboardInterrupt
     return image.linear, seconds, _peak_rss_mb(reset_ok)
 
 
@@ -289,6 +291,7 @@ class BenchResult:
     fits: list[Fit] = field(default_factory=list)
     z_critical: float = math.nan
     settings: dict = field(default_factory=dict)
+    interrupted: bool = False  # stopped by Ctrl-C: holds the levels finished before
 
     def finish(self) -> None:
         """Decide significance (Bonferroni over all levels) and efficiency."""
@@ -332,10 +335,12 @@ def run_series(
     ref: Reference,
     log=print,
     seed: int = 1,
+    levels: list[Level] | None = None,
 ) -> list[Level]:
-    """Render the levels of one series; with a budget, spp doubles from 1 while
-    the next level is predicted to fit in what is left."""
-    levels = []
+    """Render the levels of one series, appended to `levels` as they are done (so
+    a Ctrl-C keeps them); with a budget, spp doubles from 1 while the next level is
+    predicted to fit in what is left."""
+    levels = [] if levels is None else levels
     spent = 0.0
     k = 0
     spp_iter = iter(spps) if budget is None else None
@@ -423,27 +428,49 @@ def run_bench(
             "date": time.strftime("%Y-%m-%d %H:%M:%S"),
         }
     )
-    for name in scenes:
-        bs = load_bench_scene(name, width, cache, reference_spp, log)
-        refs: dict[int, Reference] = {}
-        for backend in backends:
-            for variant in variants:
-                depth = effective_depth(variant, bs.max_depth)
-                if depth not in refs:
-                    refs[depth] = bs.reference_for(depth)
-                levels = run_series(
-                    bs, backend, variant, spps, budget, repeats, workers, refs[depth], log, seed
-                )
-                result.levels.extend(levels)
-                scale = float(np.abs(refs[depth].image[refs[depth].mask]).mean())
-                slope, se = fit_slope(
-                    [lv.spp for lv in levels],
-                    [lv.mse for lv in levels],
-                    [lv.mse_se for lv in levels],
-                    zero=(ROUNDING * scale) ** 2,
-                )
-                note = "" if slope is not None else "no slope: error is zero (exact) or one level"
-                result.fits.append(Fit(bs.name, backend, variant, slope, se, len(levels), note))
+
+    def fit(bs: BenchScene, backend: str, variant: str, levels: list[Level], ref) -> None:
+        result.levels.extend(levels)
+        scale = float(np.abs(ref.image[ref.mask]).mean())
+        slope, se = fit_slope(
+            [lv.spp for lv in levels],
+            [lv.mse for lv in levels],
+            [lv.mse_se for lv in levels],
+            zero=(ROUNDING * scale) ** 2,
+        )
+        note = "" if slope is not None else "no slope: error is zero (exact) or one level"
+        result.fits.append(Fit(bs.name, backend, variant, slope, se, len(levels), note))
+
+    current = None
+    try:
+        for name in scenes:
+            bs = load_bench_scene(name, width, cache, reference_spp, log)
+            refs: dict[int, Reference] = {}
+            for backend in backends:
+                for variant in variants:
+                    depth = effective_depth(variant, bs.max_depth)
+                    if depth not in refs:
+                        refs[depth] = bs.reference_for(depth)
+                    current = (bs, backend, variant, [], refs[depth])
+                    run_series(
+                        bs,
+                        backend,
+                        variant,
+                        spps,
+                        budget,
+                        repeats,
+                        workers,
+                        refs[depth],
+                        log,
+                        seed,
+                        levels=current[3],
+                    )
+                    fit(*current)
+                    current = None
+    except KeyboardInterrupt:
+        result.interrupted = True
+        if current is not None and current[3]:
+            fit(*current)  # the levels of the series that was running
     result.finish()
     return result
 
@@ -551,6 +578,7 @@ def write_outputs(result: BenchResult, out: Path) -> list[Path]:
     tmp.replace(csv_path)
     doc = {
         "settings": result.settings,
+        "interrupted": result.interrupted,
         "z_critical": result.z_critical,
         "levels": [{k: _json_value(v) for k, v in asdict(lv).items()} for lv in result.levels],
         "fits": [
@@ -601,8 +629,10 @@ def plot(result: BenchResult, out: Path) -> Path | None:
         for ax in axes[row]:
             ax.grid(True, which="both", alpha=0.3)
     path = out / "bench.png"
-    fig.savefig(path, dpi=110)
+    tmp = out / ".bench.png.tmp"
+    fig.savefig(tmp, dpi=110, format="png")
     plt.close(fig)
+    tmp.replace(path)
     return path
 
 
@@ -726,9 +756,15 @@ def command_bench(args: argparse.Namespace) -> int:
     except SceneError as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return 2
-    print(format_table(result))
-    print()
-    print(format_series(result))
+    if result.interrupted:
+        import signal
+
+        signal.signal(signal.SIGINT, signal.SIG_DFL)  # a second Ctrl-C ends at once
+        log(f"rtpy bench: interrupted: keeping the {len(result.levels)} levels measured")
+    if result.levels:
+        print(format_table(result))
+        print()
+        print(format_series(result))
     files = write_outputs(result, out)
     png = plot(result, out)
     if png is None:
@@ -736,4 +772,4 @@ def command_bench(args: argparse.Namespace) -> int:
     else:
         files.append(png)
     log("rtpy bench: wrote " + ", ".join(str(p) for p in files))
-    return 0
+    return 130 if result.interrupted else 0

@@ -221,3 +221,33 @@ def test_bad_bench_options_exit_2_and_write_nothing(tmp_path, capsys, args, mess
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
     assert not out.exists()
+
+
+def test_ctrl_c_keeps_the_levels_measured(tmp_path):
+    """SIGINT to a real bench: it stops, writes the levels finished so far, exits 130."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    out = tmp_path / "out"
+    args = ["bench", "plane_sky_band", "--spp", "1,2,4,8,100000", "--width", "16"]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "rtpy", *args, "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 60
+    seen = ""
+    while time.monotonic() < deadline and "spp 8:" not in seen:
+        seen += os.read(proc.stderr.fileno(), 4096).decode()
+    time.sleep(0.5)  # now inside the render of 100000 spp
+    proc.send_signal(signal.SIGINT)
+    stdout, rest = proc.communicate(timeout=60)
+    assert proc.returncode == 130, seen + rest
+    assert "interrupted" in rest
+    rows, doc = read_outputs(out)
+    assert doc["interrupted"] is True
+    assert [int(r["spp"]) for r in rows] == [1, 2, 4, 8]
+    assert doc["fits"][0]["levels"] == 4 and "relMSE" in stdout
