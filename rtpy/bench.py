@@ -703,8 +703,10 @@ def _spp_list(text: str) -> list[int]:
         raise BenchUsageError(
             f"--spp: expected whole numbers such as 1,4,16,64; got {text!r}"
         ) from None
-    if len(values) < 1 or any(v < 1 for v in values):
-        raise BenchUsageError(f"--spp: expected numbers >= 1; got {text!r}")
+    from .scene_file import MAX_SPP
+
+    if len(values) < 1 or any(not 1 <= v <= MAX_SPP for v in values):
+        raise BenchUsageError(f"--spp: expected numbers from 1 to {MAX_SPP}; got {text!r}")
     return values
 
 
@@ -721,8 +723,12 @@ def command_bench(args: argparse.Namespace) -> int:
         repeats = args.repeats or (QUICK["repeats"] if args.quick else 4)
         if repeats < 2:
             raise BenchUsageError("--repeats: at least 2 (the bias test needs the spread)")
-        if width < 1 or args.workers < 1 or args.reference_spp < 1:
-            raise BenchUsageError("--width, --workers and --reference-spp must be >= 1")
+        from .scene_file import MAX_WIDTH
+
+        if not 1 <= width <= MAX_WIDTH:
+            raise BenchUsageError(f"--width: expected a whole number from 1 to {MAX_WIDTH}")
+        if args.workers < 1 or args.reference_spp < 1:
+            raise BenchUsageError("--workers and --reference-spp must be >= 1")
         if args.budget is not None and not args.budget > 0:
             raise BenchUsageError("--budget: expected seconds > 0")
         spps = _spp_list(args.spp) if args.spp else (QUICK["spp"] if args.quick else DEFAULT_SPP)
