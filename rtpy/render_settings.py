@@ -19,7 +19,7 @@ class RenderSettings:
     russian_roulette  segment index after which paths may end at random; 0 = off
     seed              random seed
     gamma             display gamma for 8-bit output
-    mis               "path" only, with nee: True = light sampling and BRDF sampling
+    mis               "path" and "direct", with nee: True = light and BRDF sampling
                       combined by MIS; False = next-event estimation alone (lights
                       found only by light sampling; emission that a BRDF-sampled ray
                       finds after a non-specular bounce is not added)

@@ -191,18 +191,7 @@ class Tracer:
         return w
 
     def add_emission(
-        self,
-        result,
-        rows,
-        beta,
-        obj,
-        ids,
-        hits,
-        prev_point,
-        prev_pdf,
-        prev_specular,
-        n_mis,
-        mis=True,
+        self, result, rows, beta, obj, ids, hits, prev_point, prev_pdf, prev_specular, n_mis, mis
     ) -> None:
         """result[rows] += beta * emitted * MIS weight at the hits on emitters."""
         em = self.materials.emitter.take(ids)
@@ -324,17 +313,7 @@ class PathIntegrator(BatchIntegrator):
             hits = tracer.hits(obj, o, d, t)
             ids = geo.material_id.take(obj)
             tracer.add_emission(
-                result,
-                rows,
-                beta,
-                obj,
-                ids,
-                hits,
-                prev_point,
-                prev_pdf,
-                prev_specular,
-                n_mis,
-                mis,
+                result, rows, beta, obj, ids, hits, prev_point, prev_pdf, prev_specular, n_mis, mis
             )
             if segment >= max_depth:
                 break
@@ -484,6 +463,7 @@ def direct_lighting(
                 sc.pdf[a[h]],
                 sc.specular[a[h]],
                 n_lights,
+                True,
             )
     return result
 
