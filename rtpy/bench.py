@@ -403,6 +403,7 @@ def run_bench(
     backends=("numpy",),
     variants=tuple(VARIANTS),
     spps=DEFAULT_SPP,
+    *,
     budget: float | None = None,
     repeats: int = 4,
     width: int | None = 64,
@@ -751,13 +752,13 @@ def command_bench(args: argparse.Namespace) -> int:
             backends,
             variants,
             spps,
-            args.budget,
-            repeats,
-            width,
-            args.workers,
-            Path(args.cache) if args.cache else None,
-            reference_spp,
-            log,
+            budget=args.budget,
+            repeats=repeats,
+            width=width,
+            workers=args.workers,
+            cache=Path(args.cache) if args.cache else None,
+            reference_spp=reference_spp,
+            log=log,
         )
     except SceneError as err:
         print(f"rtpy: error: {err}", file=sys.stderr)

@@ -148,6 +148,42 @@ def test_a_biased_integrator_is_caught_by_the_same_check(monkeypatch, plant, sce
         assert any(p.startswith(f"{scene}/") for p in problems), (scene, problems)
 
 
+def uniform_directions_with_cosine_weights(monkeypatch):
+    """A planted mistake that a furnace cannot see: directions drawn uniformly over
+    the hemisphere but weighted as if drawn by the cosine (weight = albedo). In a
+    uniform environment every sample is still exactly the albedo; under the sky
+    band, grazing directions are drawn too often."""
+    from rtpy.numpy_backend.materials.table import MaterialTable
+
+    original = MaterialTable.sample
+
+    def sample(self, ids, hits, rng):
+        sc = original(self, ids, hits, rng)
+        d = rng.normal(size=sc.direction.shape)
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        d *= np.sign(np.einsum("ij,ij->i", d, hits.normal))[:, None]
+        diffuse = sc.alive & ~sc.specular
+        sc.direction = np.where(diffuse[:, None], d, sc.direction)
+        return sc
+
+    monkeypatch.setattr(MaterialTable, "sample", sample)
+
+
+def test_a_wrong_pdf_at_grazing_angles_is_caught_by_the_sky_band_only(monkeypatch):
+    uniform_directions_with_cosine_weights(monkeypatch)
+    result = run_bench(
+        ["furnace", "plane_sky_band"],
+        ("numpy",),
+        ("path-brdf",),
+        SPP,
+        repeats=REPEATS,
+        width=WIDTH,
+        log=quiet,
+    )
+    problems = result.problems()
+    assert problems and all(p.startswith("plane_sky_band/") for p in problems), problems
+
+
 def test_fit_slope_recovers_a_known_slope_and_its_error():
     rng = np.random.default_rng(0)
     spp = np.array([1, 4, 16, 64, 256])
