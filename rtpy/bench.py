@@ -595,7 +595,8 @@ def write_outputs(result: BenchResult, out: Path) -> list[Path]:
 
 def plot(result: BenchResult, out: Path) -> Path | None:
     """bench.png: relMSE against time per render and against spp, log-log, one row
-    per scene; None when matplotlib is not installed."""
+    per scene (levels with no error left out); None when matplotlib is not
+    installed or there is nothing to draw."""
     try:
         import matplotlib
 
@@ -603,22 +604,31 @@ def plot(result: BenchResult, out: Path) -> Path | None:
         import matplotlib.pyplot as plt
     except ImportError:
         return None
-    scenes = list(dict.fromkeys(lv.scene for lv in result.levels))
+    drawn = [lv for lv in result.levels if lv.rel_mse > 0 and not lv.exact]
+    scenes = list(dict.fromkeys(lv.scene for lv in drawn))  # exact scenes: nothing to draw
+    if not scenes:
+        return None
     fig, axes = plt.subplots(
         len(scenes), 2, figsize=(10, 3.2 * len(scenes)), squeeze=False, constrained_layout=True
     )
     for row, scene in enumerate(scenes):
         series = {}
-        for lv in result.levels:
-            if lv.scene == scene and lv.rel_mse > 0:
+        for lv in drawn:
+            if lv.scene == scene:
                 series.setdefault((lv.backend, lv.integrator), []).append(lv)
         for (backend, integrator), lvs in series.items():
             label = f"{integrator} ({backend})"
-            style = "-" if backend == "numpy" else "--"
+            style = {
+                "ls": "-" if backend == "numpy" else "--",
+                "color": f"C{list(VARIANTS).index(integrator) % 10}",
+                "marker": "o" if backend == "numpy" else "s",
+                "ms": 3,
+                "label": label,
+            }
             t = [lv.seconds for lv in lvs]
             e = [lv.rel_mse for lv in lvs]
-            axes[row, 0].loglog(t, e, style, marker="o", ms=3, label=label)
-            axes[row, 1].loglog([lv.spp for lv in lvs], e, style, marker="o", ms=3, label=label)
+            axes[row, 0].loglog(t, e, **style)
+            axes[row, 1].loglog([lv.spp for lv in lvs], e, **style)
         axes[row, 0].set_ylabel(f"{scene}\nrelative MSE")
         axes[row, 0].set_xlabel("seconds per render")
         axes[row, 1].set_xlabel("samples per pixel")
@@ -631,7 +641,7 @@ def plot(result: BenchResult, out: Path) -> Path | None:
             ax.grid(True, which="both", alpha=0.3)
     path = out / "bench.png"
     tmp = out / ".bench.png.tmp"
-    fig.savefig(tmp, dpi=110, format="png")
+    fig.savefig(tmp, dpi=80, format="png")
     plt.close(fig)
     tmp.replace(path)
     return path
