@@ -168,18 +168,10 @@ def render_once(bs: BenchScene, backend: str, variant: str, spp: int, seed: int,
     return image.linear, seconds, _peak_rss_mb(reset_ok)
 
 
-@dataclass
-class ErrorStats:
-    mse: float
-    mse_se: float
-    rel_mse: float
-    bias: float
-    bias_se: float
-    rel_bias: float
-
-
-def error_stats(images: np.ndarray, ref: Reference) -> ErrorStats:
-    """Errors of `images` (repeats, H, W, 3), independent renders, against ref."""
+def error_stats(images: np.ndarray, ref: Reference) -> dict[str, float]:
+    """Errors of `images` (repeats, H, W, 3), independent renders, against ref:
+    mse and its standard error mse_se, rel_mse, bias and its standard error
+    bias_se, rel_bias (the Level fields of the same names)."""
     e = images[:, ref.mask, :] - ref.image[ref.mask]  # (repeats, P, 3)
     var_ref = ref.variance[ref.mask]  # (P, 3)
     sq = (e * e - var_ref).mean(axis=2).ravel()  # per render and pixel
@@ -197,14 +189,14 @@ def error_stats(images: np.ndarray, ref: Reference) -> ErrorStats:
         bias_var = math.inf
     bias_var += float(var_ref.mean(axis=1).sum()) / pixels**2
     ref_mean = float(ref.image[ref.mask].mean())
-    return ErrorStats(
-        mse=mse,
-        mse_se=mse_se,
-        rel_mse=mse / ref_sq if ref_sq > 0 else math.nan,
-        bias=bias,
-        bias_se=math.sqrt(bias_var),
-        rel_bias=bias / ref_mean if ref_mean != 0 else math.nan,
-    )
+    return {
+        "mse": mse,
+        "mse_se": mse_se,
+        "rel_mse": mse / ref_sq if ref_sq > 0 else math.nan,
+        "bias": bias,
+        "bias_se": math.sqrt(bias_var),
+        "rel_bias": bias / ref_mean if ref_mean != 0 else math.nan,
+    }
 
 
 def z_score(bias: float, se: float, scale: float) -> float:
@@ -372,15 +364,10 @@ def run_series(
             seconds=seconds,
             paths_per_second=bs.camera.width * bs.camera.height * spp / seconds,
             peak_mb=float(max(peaks)),
-            rmse=math.sqrt(max(st.mse, 0.0)),
-            mse=st.mse,
-            mse_se=st.mse_se,
-            rel_mse=st.rel_mse,
-            bias=st.bias,
-            bias_se=st.bias_se,
-            rel_bias=st.rel_bias,
-            bias_z=z_score(st.bias, st.bias_se, scale),
-            exact=bool(st.mse <= (ROUNDING * scale) ** 2),
+            rmse=math.sqrt(max(st["mse"], 0.0)),
+            **st,
+            bias_z=z_score(st["bias"], st["bias_se"], scale),
+            exact=bool(st["mse"] <= (ROUNDING * scale) ** 2),
             reference=ref.source,
         )
         levels.append(lv)

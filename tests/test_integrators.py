@@ -7,6 +7,7 @@ Bonferroni-corrected where several tests are made at once).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import statistics
 
@@ -183,35 +184,35 @@ def sample_mean(integrator, ray, scene, n, seed):
     return statistics.fmean(values), statistics.stdev(values) / math.sqrt(n)
 
 
-def test_path_with_and_without_nee_agree():
-    """BRDF sampling alone and MIS with light sampling estimate the same integral:
-    per-ray means agree within the measured noise. Light counted twice (the course
-    code's bug) or a wrong MIS weight would shift the MIS estimate."""
-    scene, rays = box_scene()
-    with_nee = make_integrator(RenderSettings(nee=True, max_depth=5))
-    without = make_integrator(RenderSettings(nee=False, max_depth=5))
-    limit = z_limit(len(rays))
+def per_ray_z(scene, rays, a, b, n_a, n_b, seed_a, seed_b, while_b=contextlib.nullcontext):
+    """For each ray: (z of mean_a - mean_b, mean_a, se_a, mean_b, se_b), the b
+    estimates made inside the context while_b()."""
+    out = []
     for k, ray in enumerate(rays):
-        m1, s1 = sample_mean(with_nee, ray, scene, 1500, seed=100 + k)
-        m2, s2 = sample_mean(without, ray, scene, 4000, seed=200 + k)
-        z = (m1 - m2) / math.hypot(s1, s2)
-        assert abs(z) < limit, f"ray {k}: nee {m1:.4f}+-{s1:.4f} vs brdf {m2:.4f}+-{s2:.4f}"
-        assert m1 > 0
+        m1, s1 = sample_mean(a, ray, scene, n_a, seed=seed_a + k)
+        with while_b():
+            m2, s2 = sample_mean(b, ray, scene, n_b, seed=seed_b + k)
+        out.append(((m1 - m2) / math.hypot(s1, s2), m1, s1, m2, s2))
+    return out
 
 
-def test_nee_only_and_mis_agree():
-    """Next-event estimation alone (mis = false: lights found only by light
-    sampling) and MIS estimate the same integral: per-ray means agree within the
-    measured noise (the rays of the box scene, which has an area and a point light)."""
+@pytest.mark.parametrize(
+    "variant,n_variant,seeds",
+    [({"nee": False}, 4000, (100, 200)), ({"mis": False}, 1500, (300, 400))],
+    ids=["brdf-only", "nee-only"],
+)
+def test_path_variants_agree_with_mis(variant, n_variant, seeds):
+    """BRDF sampling alone (nee = false), light sampling alone (mis = false) and MIS
+    estimate the same integral: per-ray means agree within the measured noise (the
+    box scene has an area and a point light). Light counted twice (the course
+    code's bug) or a wrong MIS weight would shift one of them."""
     scene, rays = box_scene()
     mis = make_integrator(RenderSettings(max_depth=5))
-    nee_only = make_integrator(RenderSettings(mis=False, max_depth=5))
+    other = make_integrator(RenderSettings(max_depth=5, **variant))
     limit = z_limit(len(rays))
-    for k, ray in enumerate(rays):
-        m1, s1 = sample_mean(mis, ray, scene, 1500, seed=300 + k)
-        m2, s2 = sample_mean(nee_only, ray, scene, 1500, seed=400 + k)
-        z = (m1 - m2) / math.hypot(s1, s2)
-        assert abs(z) < limit, f"ray {k}: mis {m1:.4f}+-{s1:.4f} vs nee {m2:.4f}+-{s2:.4f}"
+    zs = per_ray_z(scene, rays, mis, other, 1500, n_variant, *seeds)
+    for k, (z, m1, s1, m2, s2) in enumerate(zs):
+        assert abs(z) < limit, f"ray {k}: mis {m1:.4f}+-{s1:.4f} vs {variant} {m2:.4f}+-{s2:.4f}"
         assert m2 > 0
 
 
@@ -223,17 +224,18 @@ def test_nee_only_comparison_catches_dropped_brdf_emission_weight():
     scene, rays = box_scene()
     mis = make_integrator(RenderSettings(max_depth=5))
     bad = make_integrator(RenderSettings(mis=False, max_depth=5))
-    original = path.emission_weight
-    zs = []
-    for k, ray in enumerate(rays):
-        m1, s1 = sample_mean(mis, ray, scene, 1500, seed=300 + k)
-        path.emission_weight = lambda *args: 1.0  # only while the nee-only one runs
+
+    @contextlib.contextmanager
+    def counting_twice():  # only while the nee-only integrator runs
+        original = path.emission_weight
+        path.emission_weight = lambda *args: 1.0
         try:
-            m2, s2 = sample_mean(bad, ray, scene, 1500, seed=400 + k)
+            yield
         finally:
             path.emission_weight = original
-        zs.append((m1 - m2) / math.hypot(s1, s2))
-    assert max(abs(z) for z in zs) > z_limit(len(rays))
+
+    zs = per_ray_z(scene, rays, mis, bad, 1500, 1500, 300, 400, counting_twice)
+    assert max(abs(z[0]) for z in zs) > z_limit(len(rays))
 
 
 def test_mis_catches_light_counted_twice():
