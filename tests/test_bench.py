@@ -268,11 +268,14 @@ def test_ctrl_c_keeps_the_levels_measured(tmp_path):
 
     out = tmp_path / "out"
     args = ["bench", "plane_sky_band", "--spp", "1,2,4,8,100000", "--width", "16"]
+    parent_handler = signal.getsignal(signal.SIGINT)
     proc = subprocess.Popen(
         [sys.executable, "-m", "rtpy", *args, "--out", str(out)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        # a child inherits an ignored SIGINT; make sure Ctrl-C reaches it as in a shell
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     deadline = time.monotonic() + 60
     seen = ""
@@ -280,7 +283,12 @@ def test_ctrl_c_keeps_the_levels_measured(tmp_path):
         seen += os.read(proc.stderr.fileno(), 4096).decode()
     time.sleep(0.5)  # now inside the render of 100000 spp
     proc.send_signal(signal.SIGINT)
-    stdout, rest = proc.communicate(timeout=60)
+    try:
+        stdout, rest = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        stdout, rest = proc.communicate()
+        raise AssertionError(f"no exit after SIGINT (parent's handler {parent_handler}): {seen}")
     assert proc.returncode == 130, seen + rest
     assert "interrupted" in rest
     rows, doc = read_outputs(out)
