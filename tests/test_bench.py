@@ -288,7 +288,9 @@ def test_ctrl_c_keeps_the_levels_measured(tmp_path):
     except subprocess.TimeoutExpired:
         proc.kill()
         stdout, rest = proc.communicate()
-        raise AssertionError(f"no exit after SIGINT (parent's handler {parent_handler}): {seen}")
+        raise AssertionError(
+            f"no exit after SIGINT (parent's handler {parent_handler}): {seen}"
+        ) from None
     assert proc.returncode == 130, seen + rest
     assert "interrupted" in rest
     rows, doc = read_outputs(out)
