@@ -31,6 +31,7 @@ SETTABLE_KEYS = (
     "background",
     "sky",
     "width",
+    "mis",
 )
 
 
@@ -114,6 +115,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--quiet", action="store_true", help="no progress bar")
 
     sub.add_parser("scenes", help="list the bundled scenes")
+
+    from .bench import add_parser as add_bench_parser
+
+    add_bench_parser(sub)
     return parser
 
 
@@ -166,7 +171,7 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
         elif key in ("russian_roulette", "seed"):
             if not is_int(value) or value < 0:
                 raise fail(key, "a whole number >= 0", value)
-        elif key in ("nee", "sky"):
+        elif key in ("nee", "sky", "mis"):
             if not isinstance(value, bool):
                 raise fail(key, "true or false", value)
         elif key == "gamma":
@@ -309,6 +314,10 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)  # usage errors exit with status 2
     if args.command == "scenes":
         return command_scenes()
+    if args.command == "bench":
+        from .bench import command_bench
+
+        return command_bench(args)
     return command_render(args)
 
 

@@ -83,6 +83,7 @@ RENDER_KEYS = (
     "background",
     "sky",
     "gamma",
+    "mis",
 )
 TEXTURE_KEYS = {
     "solid": ("type", "color"),
@@ -778,6 +779,8 @@ class _Loader:
             )
         if "nee" in t:
             kwargs["nee"] = self.boolean(w, "nee", t["nee"])
+        if "mis" in t:
+            kwargs["mis"] = self.boolean(w, "mis", t["mis"])
         if "russian_roulette" in t:
             kwargs["russian_roulette"] = self.integer(
                 w, "russian_roulette", t["russian_roulette"], NON_NEGATIVE

@@ -108,6 +108,21 @@ def test_overrides_reach_the_renderer(tmp_path):
     np.testing.assert_array_equal(np.load(out), expected)
 
 
+def test_set_mis_reaches_the_renderer_and_is_checked(tmp_path):
+    out = tmp_path / "o.npy"
+    args = ["render", "cornell", "--width", "12", "--spp", "2", "--seed", "3", "--quiet"]
+    assert (
+        main([*args, "-o", str(tmp_path / "o.png"), "--set", "mis=false", "--linear", str(out)])
+        == 0
+    )
+    scene = rtpy.load_scene("cornell")
+    expected = rtpy.render(scene, width=12, spp=2, seed=3, mis=False).linear
+    np.testing.assert_array_equal(np.load(out), expected)
+    assert not np.array_equal(expected, rtpy.render(scene, width=12, spp=2, seed=3).linear)
+    assert main([*args, "-o", str(tmp_path / "p.png"), "--set", "mis=2"]) == 2
+    assert not (tmp_path / "p.png").exists()
+
+
 def write(tmp_path: Path, text: str) -> Path:
     path = tmp_path / "bad.toml"
     path.write_text(text)

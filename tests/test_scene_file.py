@@ -1002,3 +1002,13 @@ def test_every_bundled_scene_loads(path):
     assert scene.objects, f"{path.name} has no objects"
     assert scene.name == path.stem
     assert re.fullmatch(r"#\s*\S.*", path.read_text(encoding="utf-8").splitlines()[0])
+
+
+def test_mis_key_is_a_boolean_defaulting_to_true():
+    assert load("").settings.mis is True
+    assert load("[render]\nmis = false\n").settings.mis is False
+    err = error_of("[render]\nmis = 0\n")
+    assert_names(err, "[render]", "mis")
+    assert "true or false" in str(err)
+    err = error_of("[render]\nmiss = false\n")
+    assert_names(err, "[render]", "miss", "mis")

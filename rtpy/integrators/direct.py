@@ -12,7 +12,8 @@ from .integrator import FORWARD, Integrator
 class DirectIntegrator(Integrator):
     """Emission seen directly plus light arriving after one reflection, from
     point and area lights (with shadow rays) and the background. No indirect
-    bounce. This is exactly the "path" estimator with max_depth = 2."""
+    bounce. This is exactly the "path" estimator with max_depth = 2 (mis = False
+    included)."""
 
     name = "direct"
 
@@ -21,4 +22,4 @@ class DirectIntegrator(Integrator):
         if hit is None:
             return scene.background_radiance(ray.direction)
         emitted = hit.material.emitting(hit)
-        return emitted + direct_lighting(scene, ray, hit)
+        return emitted + direct_lighting(scene, ray, hit, self.settings.mis)
