@@ -28,6 +28,7 @@ def sample_one_light(scene: Scene, ray_in: Ray, hit: HitInfo, lights: list[Light
     by light arriving directly from `lights`: one light picked uniformly, one
     direction toward it, weight f_r * L * cos(theta_i) / pdf (times the MIS weight
     for area lights)."""
+    # BEGIN SOLUTION week05: one light, one shadow ray, f_r * L * cos / pdf
     n_lights = len(lights)
     light = lights[min(int(random_double() * n_lights), n_lights - 1)]
     sample = light.sample(hit.point)
@@ -54,6 +55,7 @@ def sample_one_light(scene: Scene, ray_in: Ray, hit: HitInfo, lights: list[Light
         return f * sample.radiance * (cos_i / pdf)
     weight = power_heuristic(pdf, hit.material.pdf(ray_in, shadow_ray, hit))
     return f * sample.radiance * (cos_i * weight / pdf)
+    # END SOLUTION
 
 
 def emission_weight(
@@ -74,6 +76,7 @@ def direct_lighting(scene: Scene, ray_in: Ray, hit: HitInfo) -> Color:
     bounce: light sampling plus BRDF sampling, combined by MIS. A BRDF-sampled
     ray that escapes sees the background. At specular materials only the
     sampled ray is followed."""
+    # BEGIN SOLUTION week05: light sampling plus the BRDF-sampled bounce, light counted once
     material = hit.material
     lights = scene.lights
     result = BLACK
@@ -93,3 +96,4 @@ def direct_lighting(scene: Scene, ray_in: Ray, hit: HitInfo) -> Color:
             )
             result = result + scatter.attenuation * emitted * w
     return result
+    # END SOLUTION
