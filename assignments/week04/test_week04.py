@@ -125,9 +125,10 @@ def test_triangle_hit():
 def test_closest_hit():
     """Scene.find_intersection: the closest of all objects"""
     rng = np.random.default_rng(7)
-    for k in range(100):
-        spheres = [Sphere(v(rng.uniform(-3, 3, 3)), rng.uniform(0.3, 1), M) for _ in range(6)]
-        o, d = random_ray(rng, np.zeros(3), 2.0)
+    behind = 0  # rays that hit more than one object
+    for k in range(200):
+        spheres = [Sphere(v(rng.uniform(-2, 2, 3)), rng.uniform(0.4, 1.0), M) for _ in range(7)]
+        o, d = random_ray(rng, np.zeros(3), 1.0)
         ts = [(s.hit_t(Ray(v(o), v(d)), 0.0, math.inf), i) for i, s in enumerate(spheres)]
         ts = [(t, i) for t, i in ts if t is not None]
         hit = Scene(spheres).find_intersection(Ray(v(o), v(d)), Interval(0.0, math.inf))
@@ -135,11 +136,13 @@ def test_closest_hit():
         if not ts:
             assert hit is None, f"{where}: no object is hit, expected None"
             continue
+        behind += len(ts) > 1
         t, i = min(ts)
         assert hit is not None and abs(hit.t - t) < 1e-9 * max(1, t), (
             f"{where}: returned the hit at t = {None if hit is None else hit.t}, the closest is at t = {t}"
         )
         assert hit.obj is spheres[i], f"{where}: the hit record must name the closest object"
+    assert behind > 20  # the cases test the choice of the closest hit
 
 
 def shapes_scene():
