@@ -260,7 +260,9 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
     # `python -m pytest` runs the graders too
     pyproject = dest / "pyproject.toml"
     pyproject.write_text(
-        pyproject.read_text().replace('testpaths = ["tests"]', 'testpaths = ["tests", "assignments"]')
+        pyproject.read_text().replace(
+            'testpaths = ["tests"]', 'testpaths = ["tests", "assignments"]'
+        )
     )
     # the week's own folder, and the tests that can pass
     shutil.copytree(
@@ -307,7 +309,7 @@ def hit(week):
 builtins._rtpy_armed, builtins._rtpy_hit = armed, hit  # the probes' names
 '''
 
-REGION_LOG_PLUGIN = '''import os
+REGION_LOG_PLUGIN = """import os
 
 import rtpy._region_log as log
 
@@ -319,7 +321,7 @@ def pytest_runtest_setup(item):
         os.environ["RTPY_REGION_TEST"] = name  # for command-line subprocesses
         for week in log.armed:
             log.armed[week] = True
-'''
+"""
 
 
 def map_tests(root: str | Path | None = None, pytest_args: tuple[str, ...] = ()) -> dict[str, str]:
@@ -358,9 +360,22 @@ def map_tests(root: str | Path | None = None, pytest_args: tuple[str, ...] = ())
         log = dest / "regions.log"
         env = dict(os.environ, RTPY_REGION_LOG=str(log), PYTHONPATH=str(dest))
         subprocess.run(
-            [sys.executable, "-m", "pytest", "-q", "-p", "region_log_plugin", "-p",
-             "no:cacheprovider", "--ignore=tests/numpy_backend", *pytest_args, "tests"],
-            cwd=dest, env=env, check=False,
+            [
+                sys.executable,
+                "-m",
+                "pytest",
+                "-q",
+                "-p",
+                "region_log_plugin",
+                "-p",
+                "no:cacheprovider",
+                "--ignore=tests/numpy_backend",
+                *pytest_args,
+                "tests",
+            ],
+            cwd=dest,
+            env=env,
+            check=False,
         )
         weeks: dict[str, str] = {}
         for line in log.read_text().splitlines() if log.exists() else []:

@@ -53,9 +53,7 @@ def render_stack(scene, seeds, **settings) -> np.ndarray:
     """(R, H, W, 3) linear renders of scene, one per seed (scalar backend)."""
     import rtpy
 
-    return np.stack(
-        [rtpy.render(scene, seed=s, quiet=True, **settings).linear for s in seeds]
-    )
+    return np.stack([rtpy.render(scene, seed=s, quiet=True, **settings).linear for s in seeds])
 
 
 def summarize(stack: np.ndarray, spp: int) -> dict[str, np.ndarray]:
@@ -114,9 +112,9 @@ def compare(graded: dict, reference: dict, alpha: float = ALPHA) -> Comparison:
         )
     mean_g, n = _blocks(graded["mean"])
     mean_r, _ = _blocks(reference["mean"])
-    var = _blocks(graded["s2"])[0] / float(graded["samples"]) + _blocks(reference["s2"])[
-        0
-    ] / float(reference["samples"])
+    var = _blocks(graded["s2"])[0] / float(graded["samples"]) + _blocks(reference["s2"])[0] / float(
+        reference["samples"]
+    )
     var = var / (n * n)
     mean_g, mean_r = mean_g / n, mean_r / n
     floor = (1e-9 * np.maximum(1.0, np.abs(mean_r))) ** 2  # noiseless blocks: rounding only
@@ -190,7 +188,7 @@ def failure_message(report) -> str:
 
 def grader_dir(week: str, root: Path | None = None) -> Path:
     """assignments/weekNN under the current directory, else next to the rtpy package."""
-    for base in ([root] if root else [Path.cwd(), Path(__file__).resolve().parent.parent]):
+    for base in [root] if root else [Path.cwd(), Path(__file__).resolve().parent.parent]:
         path = base / "assignments" / f"week{week}"
         if path.is_dir():
             return path

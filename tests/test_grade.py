@@ -390,8 +390,10 @@ def test_graders_pass_on_the_reference(tmp_path, capsys):
         results = json.loads(out.read_text())
         failed = [t for t in results["tests"] if t["score"] < t["max_score"]]
         assert status == 0 and not failed, f"week {week}: {failed}"
-        assert results["score"] == results["max_score"] == sum(
-            t["max_score"] for t in results["tests"]
+        assert (
+            results["score"]
+            == results["max_score"]
+            == sum(t["max_score"] for t in results["tests"])
         )
         assert len(results["tests"]) >= 5
         for t in results["tests"]:

@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (the assertion messages are prose for students)
 """Week 03 graders: Vec3 and Interval utilities, camera rays, the center and jittered
 integrators. Run them with `python -m rtpy grade 03`."""
 
@@ -39,8 +40,12 @@ def test_interval():
     """Interval.contains (closed), surrounds (open), clamp"""
     i = Interval(-1.0, 2.0)
     where = "Interval (rtpy/interval.py)"
-    assert i.contains(-1.0) and i.contains(2.0) and i.contains(0.5), f"{where}.contains includes both ends"
-    assert not i.contains(2.0001) and not i.contains(-1.5), f"{where}.contains: outside is not contained"
+    assert i.contains(-1.0) and i.contains(2.0) and i.contains(0.5), (
+        f"{where}.contains includes both ends"
+    )
+    assert not i.contains(2.0001) and not i.contains(-1.5), (
+        f"{where}.contains: outside is not contained"
+    )
     assert i.surrounds(0.5) and not i.surrounds(-1.0) and not i.surrounds(2.0), (
         f"{where}.surrounds is strict: the ends are not surrounded"
     )
@@ -54,8 +59,13 @@ def random_camera(rng):
     look_from = rng.uniform(-3, 3, 3)
     look_at = look_from + rng.normal(size=3)
     return Camera(
-        v(look_from), v(look_at), Vec3(0, 1, 0), vfov=rng.uniform(20, 100),
-        aspect_ratio="16:9", width=int(rng.integers(16, 64)), focus_distance=rng.uniform(0.5, 4),
+        v(look_from),
+        v(look_at),
+        Vec3(0, 1, 0),
+        vfov=rng.uniform(20, 100),
+        aspect_ratio="16:9",
+        width=int(rng.integers(16, 64)),
+        focus_distance=rng.uniform(0.5, 4),
     )
 
 
@@ -105,13 +115,20 @@ def test_jittered_ray():
         for _ in range(n):
             ray = cam.get_ray(i, j)
             d = np.array(list(ray.direction))
-            assert abs(np.linalg.norm(d) - 1) < 1e-9, "Camera.get_ray: the direction must be a unit vector"
+            assert abs(np.linalg.norm(d) - 1) < 1e-9, (
+                "Camera.get_ray: the direction must be a unit vector"
+            )
             x, y = pixel_position(cam, np.array(list(ray.origin)), d)
             xs.append(x - i)
             ys.append(y - j)
     xs, ys = np.array(xs), np.array(ys)
     where = f"Camera.get_ray({i}, {j}) (rtpy/camera.py)"
-    assert xs.min() >= -0.5 - 1e-9 and xs.max() <= 0.5 + 1e-9 and ys.min() >= -0.5 - 1e-9 and ys.max() <= 0.5 + 1e-9, (
+    assert (
+        xs.min() >= -0.5 - 1e-9
+        and xs.max() <= 0.5 + 1e-9
+        and ys.min() >= -0.5 - 1e-9
+        and ys.max() <= 0.5 + 1e-9
+    ), (
         f"{where}: rays leave the pixel's square (offsets {xs.min():.2f}..{xs.max():.2f}, "
         f"{ys.min():.2f}..{ys.max():.2f}; the center is offset 0, the square is -0.5..0.5)"
     )
@@ -124,8 +141,8 @@ def test_jittered_ray():
 class FakeScene:
     """A scene whose every ray hits `hit` (or nothing), for flat_color."""
 
-    def __init__(self, hit, background=Color(0.1, 0.2, 0.3)):
-        self.hit, self.background = hit, background
+    def __init__(self, hit, background=None):
+        self.hit, self.background = hit, background or Color(0.1, 0.2, 0.3)
 
     def find_intersection(self, ray, interval):
         return self.hit
@@ -142,15 +159,21 @@ def test_flat_color():
     ray = Ray(Vec3(0, 0, 0), Vec3(0, 0, -1))
     where = "flat_color (rtpy/integrators/center.py)"
     got = center.flat_color(ray, FakeScene(None))
-    assert list(got) == [0.1, 0.2, 0.3], f"{where}: a ray that hits nothing shows the background, got {got}"
+    assert list(got) == [0.1, 0.2, 0.3], (
+        f"{where}: a ray that hits nothing shows the background, got {got}"
+    )
     albedo = Color(0.7, 0.3, 0.2)
     hit = HitInfo(Vec3(0, 0, -1), Vec3(0, 0, 1), 1.0, True, Lambertian(albedo))
     got = center.flat_color(ray, FakeScene(hit))
-    assert list(got) == list(albedo), f"{where}: a diffuse surface shows its albedo {albedo}, got {got}"
+    assert list(got) == list(albedo), (
+        f"{where}: a diffuse surface shows its albedo {albedo}, got {got}"
+    )
     emit = Color(4.0, 3.0, 2.0)
     lit = HitInfo(Vec3(0, 0, -1), Vec3(0, 0, 1), 1.0, True, DiffuseLight(emit))
     got = center.flat_color(ray, FakeScene(lit))
-    assert list(got) == list(emit), f"{where}: a light's emitting face shows its emission {emit}, got {got}"
+    assert list(got) == list(emit), (
+        f"{where}: a light's emitting face shows its emission {emit}, got {got}"
+    )
     back = HitInfo(Vec3(0, 0, -1), Vec3(0, 0, 1), 1.0, False, DiffuseLight(emit))
     got = center.flat_color(ray, FakeScene(back))
     assert list(got) == [1.0, 1.0, 1.0], (

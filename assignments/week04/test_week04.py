@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (the assertion messages are prose for students)
 """Week 04 graders: sphere, quad and triangle intersection, the scene's closest hit.
 Run them with `python -m rtpy grade 04`."""
 
@@ -38,7 +39,9 @@ def sphere_t(o, d, c, r, t_min, t_max):
 
 def check_t(got, expected, where):
     if expected is None:
-        assert got is None, f"{where}: reported a hit at t = {got}, but the ray misses in the interval"
+        assert got is None, (
+            f"{where}: reported a hit at t = {got}, but the ray misses in the interval"
+        )
     else:
         assert got is not None and abs(got - expected) <= 1e-7 * max(1, abs(expected)), (
             f"{where}: t = {got}, expected {expected:.9g} (the nearest hit with t_min < t < t_max)"
@@ -74,7 +77,9 @@ def test_sphere_hit_info():
             continue
         hit = Sphere(v(c), r, M).hit_info(Ray(v(o), v(d)), t)
         p, n = np.array(list(hit.point)), np.array(list(hit.normal))
-        where = f"Sphere.hit_info (rtpy/sphere.py) for a ray from {'inside' if inside else 'outside'}"
+        where = (
+            f"Sphere.hit_info (rtpy/sphere.py) for a ray from {'inside' if inside else 'outside'}"
+        )
         assert np.allclose(p, o + t * d, atol=1e-7), f"{where}: point {p} is not o + t d"
         assert abs(np.linalg.norm(n) - 1) < 1e-9, f"{where}: the normal must be a unit vector"
         outward = (p - c) / r
@@ -146,7 +151,9 @@ def test_closest_hit():
 
 
 def shapes_scene():
-    red, green, blue = (Lambertian(Color(*c)) for c in ((0.8, 0.2, 0.2), (0.2, 0.8, 0.2), (0.2, 0.2, 0.8)))
+    red, green, blue = (
+        Lambertian(Color(*c)) for c in ((0.8, 0.2, 0.2), (0.2, 0.8, 0.2), (0.2, 0.2, 0.8))
+    )
     objects = [
         Quad(Vec3(-3, -0.5, -6), Vec3(6, 0, 0), Vec3(0, 0, 6), Lambertian(Color(0.5, 0.5, 0.5))),
         Sphere(Vec3(-0.9, 0.0, -2.0), 0.5, red),

@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (the assertion messages are prose for students)
 """Week 05 graders: point lights with 1/r^2, shadow rays, the direct integrator.
 
 Each test names the method it checks and says what is wrong when it fails.
@@ -33,19 +34,25 @@ def test_point_light_sample():
         s = PointLight(Vec3(*pos), Color(*intensity)).sample(Vec3(*p))
         d = pos - p
         dist = float(np.linalg.norm(d))
-        where = f"PointLight.sample (rtpy/light.py) with the light at {pos.round(3)}, p = {p.round(3)}"
+        where = (
+            f"PointLight.sample (rtpy/light.py) with the light at {pos.round(3)}, p = {p.round(3)}"
+        )
         assert s is not None, f"{where}: returned None"
         assert np.allclose(list(s.direction), d / dist, rtol=1e-9, atol=1e-12), (
             f"{where}: direction {s.direction} should be the unit vector from p toward the light "
             f"{(d / dist).round(6)}"
         )
-        assert math.isclose(s.distance, dist, rel_tol=1e-9), f"{where}: distance {s.distance} != {dist}"
+        assert math.isclose(s.distance, dist, rel_tol=1e-9), (
+            f"{where}: distance {s.distance} != {dist}"
+        )
         ratio = np.array(list(s.radiance)) / intensity
         assert np.allclose(ratio, 1.0 / dist**2, rtol=1e-9), (
             f"{where}: radiance is intensity * {ratio.mean():.4g}, expected intensity / d^2 = "
             f"intensity * {1 / dist**2:.4g} (a point light falls off with the square of the distance)"
         )
-        assert s.is_delta and s.pdf == 1.0, f"{where}: a point light is a delta light: is_delta True, pdf 1"
+        assert s.is_delta and s.pdf == 1.0, (
+            f"{where}: a point light is a delta light: is_delta True, pdf 1"
+        )
 
 
 @points(3)
@@ -80,7 +87,12 @@ def test_shadow_rays():
     m = Lambertian()
     ray = Ray(Vec3(0, 0, 0), Vec3(0, 0, -1))
     cases = [
-        ([Sphere(Vec3(0, 0, -2), 0.5, m)], Interval(0.0, 5.0), True, "a sphere halfway to the light"),
+        (
+            [Sphere(Vec3(0, 0, -2), 0.5, m)],
+            Interval(0.0, 5.0),
+            True,
+            "a sphere halfway to the light",
+        ),
         ([Sphere(Vec3(0, 0, -8), 0.5, m)], Interval(0.0, 5.0), False, "a sphere beyond the light"),
         ([Sphere(Vec3(0, 0, 3), 0.5, m)], Interval(0.0, 5.0), False, "a sphere behind the point"),
         ([Sphere(Vec3(2, 0, -2), 0.5, m)], Interval(0.0, 5.0), False, "a sphere beside the ray"),
@@ -119,7 +131,9 @@ def test_direct_light_on_a_plane_is_exact():
     for k in range(30):
         target = np.array([rng.uniform(-3, 3), 0.0, rng.uniform(-3, 3)])
         if k < 3:  # points in the sphere's shadow
-            target = lp + (np.array([0.5, 1.0, 0.2]) - lp) * (2.0 / 1.0) + rng.uniform(-0.05, 0.05, 3)
+            target = (
+                lp + (np.array([0.5, 1.0, 0.2]) - lp) * (2.0 / 1.0) + rng.uniform(-0.05, 0.05, 3)
+            )
             target[1] = 0.0
         # looked at from just above (below the sphere), from a random direction
         eye = target + 0.05 * unit(np.array([rng.uniform(-1, 1), 1.0, rng.uniform(-1, 1)]))
@@ -129,11 +143,20 @@ def test_direct_light_on_a_plane_is_exact():
         dist2 = to_light @ to_light
         cos = to_light[1] / math.sqrt(dist2)
         blocked = (  # computed here, not by the code being graded
-            scene.objects[1].hit_t(Ray(Vec3(*target), Vec3(*unit(to_light))), 1e-9, math.sqrt(dist2))
+            scene.objects[1].hit_t(
+                Ray(Vec3(*target), Vec3(*unit(to_light))), 1e-9, math.sqrt(dist2)
+            )
             is not None
         )
         expected = 0.0 if blocked else 1.0
-        expected = expected * np.array(list(albedo)) / math.pi * np.array(list(light.intensity)) * cos / dist2
+        expected = (
+            expected
+            * np.array(list(albedo))
+            / math.pi
+            * np.array(list(light.intensity))
+            * cos
+            / dist2
+        )
         assert np.allclose(got, expected, rtol=1e-6, atol=1e-12), (
             f"direct integrator at floor point {target.round(3)}{' (in shadow)' if blocked else ''}: "
             f"radiance {got.round(6)}, expected albedo/pi * I cos(theta) / d^2 = {expected.round(6)}. "
@@ -171,7 +194,9 @@ def make_reference_summary():
     from rtpy.grading import summarize
 
     settings = dict(RENDER, spp=REFERENCE["spp"])
-    return summarize(render_stack(area_light_scene(), REFERENCE["seeds"], **settings), REFERENCE["spp"])
+    return summarize(
+        render_stack(area_light_scene(), REFERENCE["seeds"], **settings), REFERENCE["spp"]
+    )
 
 
 @points(4)
@@ -194,7 +219,9 @@ def test_direct_render_matches_reference():
 def test_direct_sees_emitters_and_background():
     """direct integrator: emission seen directly, background on a miss"""
     emit = Color(2.0, 3.0, 4.0)
-    scene = Scene([Sphere(Vec3(0, 0, -3), 1.0, DiffuseLight(emit))], background=Color(0.1, 0.2, 0.3))
+    scene = Scene(
+        [Sphere(Vec3(0, 0, -3), 1.0, DiffuseLight(emit))], background=Color(0.1, 0.2, 0.3)
+    )
     integrator = DirectIntegrator(RenderSettings(integrator="direct"))
     got = integrator.radiance(Ray(Vec3(0, 0, 0), Vec3(0, 0, -1)), scene)
     assert np.allclose(list(got), list(emit)), (

@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (the assertion messages are prose for students)
 """Week 06 graders: reflect, refract (Snell), Schlick, total internal reflection, the
 mirror and the dielectric. Run them with `python -m rtpy grade 06`."""
 
@@ -61,13 +62,17 @@ def test_refract_obeys_snell():
             continue  # total internal reflection: refract is not called
         t = arr(vec3.refract(v(d), v(n), eta))
         where = f"refract (rtpy/vec3.py) with eta = {eta:.3f} at incidence {math.degrees(math.asin(sin_i)):.1f} degrees"
-        assert abs(np.linalg.norm(t) - 1) < 1e-9, f"{where}: the refracted direction must be a unit vector"
+        assert abs(np.linalg.norm(t) - 1) < 1e-9, (
+            f"{where}: the refracted direction must be a unit vector"
+        )
         assert t @ n < 0, f"{where}: the refracted ray must go through the surface (t . n < 0)"
         sin_t = np.linalg.norm(np.cross(t, n))
         assert abs(sin_t - eta * sin_i) < 1e-9, (
             f"{where}: sin(theta_t) = {sin_t:.6f}, Snell's law gives eta sin(theta_i) = {eta * sin_i:.6f}"
         )
-        assert abs(np.cross(d, n) @ t) < 1e-9, f"{where}: the refracted ray leaves the plane of incidence"
+        assert abs(np.cross(d, n) @ t) < 1e-9, (
+            f"{where}: the refracted ray leaves the plane of incidence"
+        )
 
 
 @points(2)

@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (the assertion messages are prose for students)
 """Week 07 graders: sphere and quad (u, v), checker and image textures, metal fuzz.
 Run them with `python -m rtpy grade 07`."""
 
@@ -6,7 +7,18 @@ from pathlib import Path
 
 import numpy as np
 
-from rtpy import Camera, CheckerTexture, Color, HitInfo, ImageTexture, Quad, Ray, Scene, Sphere, Vec3
+from rtpy import (
+    Camera,
+    CheckerTexture,
+    Color,
+    HitInfo,
+    ImageTexture,
+    Quad,
+    Ray,
+    Scene,
+    Sphere,
+    Vec3,
+)
 from rtpy.grading import points, render_stack
 from rtpy.materials import Lambertian, Metal
 from rtpy.sampling import make_generator, use_generator
@@ -31,7 +43,9 @@ def test_sphere_uv():
     for _ in range(50):
         theta, phi = rng.uniform(0.01, math.pi - 0.01), rng.uniform(0.01, 2 * math.pi - 0.01)
         # theta from -y, phi from -x toward +z... : point = (-cos phi sin theta, -cos theta, sin phi sin theta)
-        p = c + r * np.array([-math.cos(phi) * math.sin(theta), -math.cos(theta), math.sin(phi) * math.sin(theta)])
+        p = c + r * np.array(
+            [-math.cos(phi) * math.sin(theta), -math.cos(theta), math.sin(phi) * math.sin(theta)]
+        )
         hit = HitInfo(v(p), v((p - c) / r), 1.0, True, sphere.material, sphere)
         u, vv = sphere.surface_uv(hit)
         assert abs(u - phi / (2 * math.pi)) < 1e-9 and abs(vv - theta / math.pi) < 1e-9, (
@@ -105,7 +119,9 @@ def test_metal_fuzz():
     hit = HitInfo(Vec3(0, 0, 0), v(n), 1.0, True, None)
     where = "Metal.scattering (rtpy/materials/metal.py)"
     s = Metal(Color(0.8, 0.6, 0.4), 0.0).scattering(ray, hit)
-    assert np.allclose(arr(s.ray.direction), r, atol=1e-12), f"{where}: fuzz 0 must be a perfect mirror"
+    assert np.allclose(arr(s.ray.direction), r, atol=1e-12), (
+        f"{where}: fuzz 0 must be a perfect mirror"
+    )
     for fuzz in (0.1, 0.5):
         metal = Metal(Color(0.8, 0.6, 0.4), fuzz)
         angles, absorbed, n_samples = [], 0, 3000
@@ -116,9 +132,15 @@ def test_metal_fuzz():
                     absorbed += 1
                     continue
                 d = arr(s.ray.direction)
-                assert abs(np.linalg.norm(d) - 1) < 1e-9, f"{where}: the direction must be a unit vector"
-                assert d @ n > 0, f"{where}: a fuzzed direction below the surface must be absorbed (None)"
-                assert np.allclose(arr(s.attenuation), [0.8, 0.6, 0.4]), f"{where}: the weight is the albedo"
+                assert abs(np.linalg.norm(d) - 1) < 1e-9, (
+                    f"{where}: the direction must be a unit vector"
+                )
+                assert d @ n > 0, (
+                    f"{where}: a fuzzed direction below the surface must be absorbed (None)"
+                )
+                assert np.allclose(arr(s.attenuation), [0.8, 0.6, 0.4]), (
+                    f"{where}: the weight is the albedo"
+                )
                 angles.append(math.degrees(math.acos(min(1.0, d @ r))))
         angles = np.array(angles)
         # The fuzz point is uniform on a sphere of radius fuzz around the mirror
@@ -129,7 +151,9 @@ def test_metal_fuzz():
         ref = r + fuzz * ref / np.linalg.norm(ref, axis=1)[:, None]
         above = ref @ n > 0
         p_absorbed = 1 - above.mean()
-        z = (absorbed / n_samples - p_absorbed) / math.sqrt(max(p_absorbed * (1 - p_absorbed), 1e-4) / n_samples)
+        z = (absorbed / n_samples - p_absorbed) / math.sqrt(
+            max(p_absorbed * (1 - p_absorbed), 1e-4) / n_samples
+        )
         assert abs(z) < 4.5, (
             f"{where} with fuzz {fuzz} at 75 degrees: {absorbed} of {n_samples} samples absorbed, expected "
             f"about {p_absorbed * n_samples:.0f} (directions pushed below the surface return None)"

@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (the assertion messages are prose for students)
 """Week 08 graders: Phong, Blinn-Phong and Cook-Torrance BRDF() and scattering(), and
 the path integrator. Run them with `python -m rtpy grade 08`.
 
@@ -60,7 +61,9 @@ def brdf(material, wo, wi):
 def lobe_check(name, formula):
     material = MODELS[name]()
     for wo, wi in random_pairs(60, seed=8):
-        expected = material.kd * np.array(list(ALBEDO)) / math.pi + material.ks * formula(material, wo, wi)
+        expected = material.kd * np.array(list(ALBEDO)) / math.pi + material.ks * formula(
+            material, wo, wi
+        )
         got = brdf(material, wo, wi)
         assert np.allclose(got, expected, rtol=1e-6, atol=1e-12), (
             f"{WHERE[name]}: BRDF(wo={wo.round(3)}, wi={wi.round(3)}) = {got.round(6)}, expected "
@@ -168,8 +171,14 @@ def three_balls():
     objects = [
         Quad(Vec3(-4, 0, -6), Vec3(8, 0, 0), Vec3(0, 0, 6), ground),
         Sphere(Vec3(-1.1, 0.5, -2.5), 0.5, Phong(Color(0.7, 0.2, 0.2), kd=0.6, ks=0.3, exponent=8)),
-        Sphere(Vec3(0.0, 0.5, -2.5), 0.5, BlinnPhong(Color(0.2, 0.7, 0.2), kd=0.6, ks=0.3, exponent=30)),
-        Sphere(Vec3(1.1, 0.5, -2.5), 0.5, CookTorrance(Color(0.2, 0.2, 0.7), kd=0.6, ks=0.4, roughness=0.2)),
+        Sphere(
+            Vec3(0.0, 0.5, -2.5), 0.5, BlinnPhong(Color(0.2, 0.7, 0.2), kd=0.6, ks=0.3, exponent=30)
+        ),
+        Sphere(
+            Vec3(1.1, 0.5, -2.5),
+            0.5,
+            CookTorrance(Color(0.2, 0.2, 0.7), kd=0.6, ks=0.4, roughness=0.2),
+        ),
         Quad(Vec3(-0.8, 2.5, -3.0), Vec3(1.6, 0, 0), Vec3(0, 0, 1.0), DiffuseLight(Color(5, 5, 5))),
     ]
     camera = Camera(Vec3(0, 1.2, 0.8), Vec3(0, 0.5, -2.5), vfov=50, aspect_ratio="16:9", width=32)
