@@ -22,10 +22,10 @@ path integrator's light sampling), the bundled scenes, `assignments/weekNN/` (RE
 graders, scenes, reference data) and the tests of rtpy that can pass there.
 
 Which tests ship is decided by `assignments/test_weeks.toml`: for each test file,
-the earliest week whose solution regions it executes, as recorded by running the
-suite on an instrumented copy of rtpy (`python -m rtpy assignment map-tests`). A
-file is left out of week W's repository when that week is W or later (it would fail
-on the stubs or reveal the solution); files not listed need no region.
+the weeks whose solution regions it executes, as recorded by running the suite on
+an instrumented copy of rtpy (`python -m rtpy assignment map-tests`). A file ships
+in week W's repository only when all those weeks are before W (otherwise it would
+fail on the stubs); files not listed run no region and always ship.
 
 The numpy backend is withheld from every student repository: its vectorized twins
 mirror the solutions of weeks 03-08 (camera rays, intersections, point lights,
@@ -54,6 +54,9 @@ END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
 # What the student repository holds besides rtpy/ (top-level names of the source tree).
 COPIED = ("pyproject.toml", ".gitignore", "scenes")
 TEST_WEEKS_FILE = "assignments/test_weeks.toml"
+# Tests of the assignment machinery itself: they grade every week and generate
+# repositories, so they belong to rtpy only (and are not mapped).
+MACHINERY_TESTS = ("tests/test_grade.py", "tests/test_assignment.py")
 
 NUMPY_STUB = '''"""The numpy backend is withheld from the weekly assignment repositories: its
 vectorized twins contain the solutions. Render with the scalar backend (the default)."""
@@ -184,24 +187,30 @@ def check_week(week: str | int) -> str:
     return text
 
 
-def test_weeks(root: Path) -> dict[str, str]:
-    """tests/... path -> the earliest week whose regions that test file runs."""
+def test_weeks(root: Path) -> dict[str, list[str]]:
+    """tests/... path -> the weeks whose solution regions that test file runs."""
     path = Path(root) / TEST_WEEKS_FILE
     if not path.exists():
         return {}
     with open(path, "rb") as f:
-        return {k: f"{int(v):02d}" for k, v in tomllib.load(f).get("tests", {}).items()}
+        table = tomllib.load(f).get("tests", {})
+    return {k: [f"{int(w):02d}" for w in v] for k, v in table.items()}
 
 
 def shipped_tests(root: Path, week: str) -> tuple[list[str], list[str]]:
     """(test files shipped in week's repository, test files left out), as tests/... paths.
-    The numpy backend's tests are always left out (the backend is withheld)."""
+    The numpy backend's tests are always left out (the backend is withheld), and
+    so are MACHINERY_TESTS."""
     mapping = test_weeks(root)
     kept, left = [], []
     for path in sorted((Path(root) / "tests").rglob("*.py")):
         rel = path.relative_to(root).as_posix()
-        needs = mapping.get(rel)
-        if rel.startswith("tests/numpy_backend/") or (needs is not None and withheld(needs, week)):
+        needs = mapping.get(rel, [])
+        if (
+            rel.startswith("tests/numpy_backend/")
+            or rel in MACHINERY_TESTS
+            or any(withheld(w, week) for w in needs)
+        ):
             left.append(rel)
         else:
             kept.append(rel)
@@ -324,10 +333,12 @@ def pytest_runtest_setup(item):
 """
 
 
-def map_tests(root: str | Path | None = None, pytest_args: tuple[str, ...] = ()) -> dict[str, str]:
+def map_tests(
+    root: str | Path | None = None, pytest_args: tuple[str, ...] = ()
+) -> dict[str, set[str]]:
     """Run rtpy's tests (the numpy backend's excepted) on a copy of the tree whose
     solution regions record each test file that runs them, also from worker and
-    command-line subprocesses; returns {test file: earliest week it runs} and writes
+    command-line subprocesses; returns {test file: the weeks it runs} and writes
     it to assignments/test_weeks.toml."""
     import subprocess
     import sys
@@ -377,15 +388,17 @@ def map_tests(root: str | Path | None = None, pytest_args: tuple[str, ...] = ())
             env=env,
             check=False,
         )
-        weeks: dict[str, str] = {}
+        weeks: dict[str, set[str]] = {}
         for line in log.read_text().splitlines() if log.exists() else []:
             test, week = line.split("\t")
-            if test.startswith("tests/") and (test not in weeks or week < weeks[test]):
-                weeks[test] = week
-    body = "".join(f'"{k}" = {int(v)}\n' for k, v in sorted(weeks.items()))
+            if test.startswith("tests/"):
+                weeks.setdefault(test, set()).add(week)
+    body = "".join(
+        f'"{k}" = [{", ".join(str(int(w)) for w in sorted(v))}]\n' for k, v in sorted(weeks.items())
+    )
     (root / TEST_WEEKS_FILE).write_text(
-        "# The earliest week whose solution regions each test file runs, recorded by\n"
-        "# `python -m rtpy assignment map-tests` (see rtpy/assignment.py). A file is left\n"
-        "# out of the repositories of that week and earlier weeks.\n[tests]\n" + body
+        "# The weeks whose solution regions each test file runs, recorded by\n"
+        "# `python -m rtpy assignment map-tests` (see rtpy/assignment.py). A file ships\n"
+        "# in week W's repository only if all its weeks are before W.\n[tests]\n" + body
     )
     return weeks
