@@ -38,10 +38,12 @@ from __future__ import annotations
 
 import ast
 import io
+import json
 import os
 import re
 import shutil
 import tempfile
+import textwrap
 import tokenize
 import tomllib
 from dataclasses import dataclass
@@ -90,11 +92,17 @@ class Region:
     indent: str
 
     def stub(self) -> list[str]:
+        """The lines that replace the region: a TODO and a NotImplementedError naming
+        the task, its string split to fit 100 columns."""
         what = f"{self.function}: {self.message}" if self.message else self.function
         text = f"week{self.week} task: {what} (see assignments/week{self.week}/README.md)"
+        width = max(40, 92 - len(self.indent))
+        parts = textwrap.wrap(text, width, drop_whitespace=False) or [text]
         return [
             f"{self.indent}# TODO(week{self.week}): {self.message or 'implement this'}\n",
-            f"{self.indent}raise NotImplementedError({text!r})\n",
+            f"{self.indent}raise NotImplementedError(\n",
+            *(f"{self.indent}    {json.dumps(part)}\n" for part in parts),
+            f"{self.indent})\n",
         ]
 
 
