@@ -389,6 +389,7 @@ def map_tests(
                 "-p",
                 "no:cacheprovider",
                 "--ignore=tests/numpy_backend",
+                *(f"--ignore={t}" for t in MACHINERY_TESTS),
                 *pytest_args,
                 "tests",
             ],

@@ -46,6 +46,7 @@ SMOKE = [
     "tests/test_light.py",
     "tests/test_texture.py",
     "tests/test_camera.py",
+    "tests/test_packaging.py",
 ]
 
 DRIVER = """
