@@ -3,15 +3,24 @@
 integrators. Run them with `python -m rtpy grade 03`."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 
 import rtpy.integrators.center as center
 import rtpy.vec3 as vec3
-from rtpy import Camera, Color, HitInfo, Interval, Vec3
-from rtpy.grading import points
+from rtpy import Camera, Color, HitInfo, Interval, Scene, Vec3
+from rtpy.grading import (
+    assert_render_matches,
+    load_reference,
+    points,
+    render_stack,
+    summarize,
+)
 from rtpy.materials import DiffuseLight, Lambertian
 from rtpy.testing import chi2_sf
+
+HERE = Path(__file__).parent
 
 
 def v(a):
@@ -178,4 +187,43 @@ def test_flat_color():
     got = center.flat_color(ray, FakeScene(back))
     assert list(got) == [1.0, 1.0, 1.0], (
         f"{where}: the back of a one-sided light emits nothing and has no albedo: white, got {got}"
+    )
+
+
+class SkyScene(Scene):
+    """The sky alone. Scene.find_intersection is week 4's task, so this week's
+    renders use a scene that reports no hit without calling it."""
+
+    def find_intersection(self, ray, interval, brute_force=False):
+        return None
+
+
+def sky_scene():
+    camera = Camera(Vec3(0, 0, 0), Vec3(0, 0.3, -1), vfov=90, aspect_ratio="16:9", width=32)
+    return SkyScene([], sky=True, camera=camera)
+
+
+RENDER = {"integrator": "jittered", "spp": 4}
+SEEDS = (1, 2, 3, 4)
+REFERENCE = {"name": "jittered_sky", "seeds": tuple(range(100, 108)), "spp": 32}
+
+
+def make_reference_summary():
+    settings = dict(RENDER, spp=REFERENCE["spp"])
+    stack = render_stack(sky_scene(), REFERENCE["seeds"], **settings)
+    return summarize(stack, REFERENCE["spp"])
+
+
+@points(2)
+def test_sky_render_matches_reference():
+    """jittered render of the sky matches the reference (camera rays and pixel jitter)"""
+    stack = render_stack(sky_scene(), SEEDS, **RENDER)
+    assert_render_matches(
+        stack,
+        RENDER["spp"],
+        load_reference(HERE / "reference" / f"{REFERENCE['name']}.npz"),
+        "jittered render of the sky (rtpy/camera.py: _ray_through, get_ray) differs from the "
+        "reference beyond its noise: rays through the wrong points of the pixels (pixel "
+        "(0, 0) is the top-left one; a jittered sample is uniform over -0.5..0.5 around the "
+        "center) or directions that are not unit vectors",
     )
