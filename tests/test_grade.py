@@ -12,9 +12,12 @@ and the Gradescope JSON.
 from __future__ import annotations
 
 import importlib.util
+import inspect
 import json
 import math
 import re
+import sys
+import textwrap
 from functools import cache
 from pathlib import Path
 
@@ -56,6 +59,19 @@ def wrap(cls, name, change):
     return buggy
 
 
+def plant(mp, owner, name, old, new):
+    """Replace owner.name by its own source with `old` changed to `new`: a mistake
+    inside a function, such as a forgotten division."""
+    function = inspect.unwrap(getattr(owner, name))
+    source = textwrap.dedent(inspect.getsource(function))
+    assert old in source, f"{name}: {old!r} not in its source"
+    namespace: dict = {}
+    module_globals = vars(sys.modules[function.__module__])
+    module_globals = {"dot": vec3.dot, **module_globals}
+    exec(compile(source.replace(old, new), f"<planted {name}>", "exec"), module_globals, namespace)
+    mp.setattr(owner, name, namespace[name])
+
+
 # --- the mistakes -----------------------------------------------------------------------
 def no_falloff(mp):
     def sample(self, p, original=PointLight.sample):
@@ -84,6 +100,31 @@ def two_blockers_needed(mp):
         return hits > 1  # the course's "shadowed only if more than one object is hit"
 
     mp.setattr(Scene, "find_occlusion", find_occlusion)
+
+
+def cosine_with_unnormalised_vector(mp):
+    # The course code's cosine: the normal dotted with the vector to the light.
+    plant(
+        mp,
+        direct_lighting,
+        "sample_one_light",
+        "cos_i = normal.e0 * wi.e0 + normal.e1 * wi.e1 + normal.e2 * wi.e2",
+        "d = sample.point - hit.point; cos_i = dot(normal, d)",
+    )
+
+
+def roulette_not_divided(mp):
+    plant(mp, path_module.PathIntegrator, "radiance", "beta = beta / survive", "pass")
+
+
+def path_counts_light_twice(mp):
+    plant(
+        mp,
+        path_module.PathIntegrator,
+        "radiance",
+        "result = result + beta * emitted * w",
+        "result = result + beta * emitted",
+    )
 
 
 def albedo_as_brdf(mp):
@@ -330,6 +371,7 @@ PLANTED = [
     ("04", first_hit_not_closest, ["test_closest_hit", "test_center_render_matches_reference"]),
     ("05", no_falloff, ["test_point_light_sample", "test_direct_light_on_a_plane_is_exact"]),
     ("05", unnormalised_light_vector, ["test_point_light_sample"]),
+    ("05", cosine_with_unnormalised_vector, ["test_direct_light_on_a_plane_is_exact"]),
     ("05", two_blockers_needed, ["test_shadow_rays", "test_direct_light_on_a_plane_is_exact"]),
     ("05", albedo_as_brdf, ["test_lambertian_brdf_and_sampling"]),
     ("05", lambertian_no_pdf, ["test_lambertian_brdf_and_sampling"]),
@@ -349,6 +391,8 @@ PLANTED = [
     ("08", half_vector_pdf_without_jacobian, ["test_sampling_follows_pdf[blinn_phong]"]),
     ("08", glossy_no_pdf, ["test_weight_is_brdf_cos_over_pdf[cook_torrance_ggx]"]),
     ("08", light_counted_twice, ["test_path_render_matches_reference"]),
+    ("08", path_counts_light_twice, ["test_path_render_matches_reference", "test_path_furnace"]),
+    ("08", roulette_not_divided, ["test_path_furnace"]),
 ]
 
 
