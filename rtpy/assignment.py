@@ -195,7 +195,7 @@ def check_week(week: str | int) -> str:
     return text
 
 
-def test_weeks(root: Path) -> dict[str, list[str]]:
+def weeks_of_tests(root: Path) -> dict[str, list[str]]:
     """tests/... path -> the weeks whose solution regions that test file runs."""
     path = Path(root) / TEST_WEEKS_FILE
     if not path.exists():
@@ -209,7 +209,7 @@ def shipped_tests(root: Path, week: str) -> tuple[list[str], list[str]]:
     """(test files shipped in week's repository, test files left out), as tests/... paths.
     The numpy backend's tests are always left out (the backend is withheld), and
     so are MACHINERY_TESTS."""
-    mapping = test_weeks(root)
+    mapping = weeks_of_tests(root)
     kept, left = [], []
     for path in sorted((Path(root) / "tests").rglob("*.py")):
         rel = path.relative_to(root).as_posix()
@@ -402,6 +402,10 @@ def map_tests(
             test, week = line.split("\t")
             if test.startswith("tests/"):
                 weeks.setdefault(test, set()).add(week)
+        for path in sorted((root / "tests").rglob("test_*.py")):
+            rel = path.relative_to(root).as_posix()
+            if not rel.startswith("tests/numpy_backend/") and rel not in MACHINERY_TESTS:
+                weeks.setdefault(rel, set())  # runs no region: ships every week
     body = "".join(
         f'"{k}" = [{", ".join(str(int(w)) for w in sorted(v))}]\n' for k, v in sorted(weeks.items())
     )

@@ -26,12 +26,14 @@ from pathlib import Path
 import pytest
 
 from rtpy.assignment import (
+    MACHINERY_TESTS,
     WEEKS,
     AssignmentError,
     find_regions,
     make_assignment,
     regions_in,
     shipped_tests,
+    weeks_of_tests,
 )
 from rtpy.cli import main
 
@@ -61,6 +63,17 @@ def test_every_week_has_regions_inside_functions():
     for r in regions:
         assert r.function and r.message, r
         assert r.end > r.begin + 1, f"{r.path}:{r.begin + 1}: empty region"
+
+
+def test_every_test_file_is_mapped():
+    """assignments/test_weeks.toml covers every test file (a new test file needs
+    `python -m rtpy assignment map-tests`, or it would ship to weeks it fails in)."""
+    mapped = set(weeks_of_tests(ROOT))
+    for path in (ROOT / "tests").rglob("test_*.py"):
+        rel = path.relative_to(ROOT).as_posix()
+        if rel.startswith("tests/numpy_backend/") or rel in MACHINERY_TESTS:
+            continue
+        assert rel in mapped, f"{rel} is not in assignments/test_weeks.toml: run map-tests"
 
 
 def test_unbalanced_markers_are_refused(tmp_path):
