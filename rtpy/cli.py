@@ -149,7 +149,8 @@ def command_grade(week: str, json_path: str | None) -> int:
     print(score_table(results))
     if json_path:
         write_json(results, json_path)
-    return 0 if results["score"] == results["max_score"] else 1
+    passed = results["score"] == results["max_score"] and "output" not in results
+    return 0 if passed else 1
 
 
 def load_plugins(paths: list[str]) -> None:

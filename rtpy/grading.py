@@ -154,6 +154,11 @@ class PointsPlugin:
     """pytest plugin: every collected test's points, and whether it passed."""
 
     results: dict[str, TestResult] = field(default_factory=dict)
+    errors: list[str] = field(default_factory=list)  # graders that could not be loaded
+
+    def pytest_collectreport(self, report) -> None:
+        if report.failed:
+            self.errors.append(f"{report.nodeid}: {failure_message(report)}")
 
     def pytest_configure(self, config) -> None:
         config.addinivalue_line("markers", "points(n): points a grader test is worth")
@@ -210,15 +215,24 @@ def grade(week: str, extra_args: tuple[str, ...] = (), root: Path | None = None)
         {"name": r.name, "score": r.score, "max_score": r.max_score, "output": r.output}
         for r in plugin.results.values()
     ]
-    return {
+    results = {
         "score": sum(t["score"] for t in tests),
         "max_score": sum(t["max_score"] for t in tests),
         "execution_time": round(time.perf_counter() - start, 2),
         "tests": tests,
     }
+    if plugin.errors or not tests:
+        # Gradescope shows the top-level output; the score is 0, not 0 of 0.
+        results["score"] = 0
+        results["output"] = "The graders could not be loaded (is rtpy importable?):\n" + (
+            "\n".join(plugin.errors) or f"no tests found in {folder}"
+        )
+    return results
 
 
 def score_table(results: dict) -> str:
+    if "output" in results:
+        return results["output"]
     rows = [(t["name"], f"{t['score']:g}/{t['max_score']:g}") for t in results["tests"]]
     width = max([len(r[0]) for r in rows] + [4])
     lines = [f"{'test':<{width}}  points", "-" * (width + 8)]

@@ -453,3 +453,17 @@ def test_noise_aware_comparison_accepts_noise_and_rejects_bias():
     assert compare(a, b).passed
     brighter = dict(b, mean=b["mean"] * 1.05)
     assert not compare(a, brighter).passed
+
+
+def test_graders_that_cannot_load_score_zero(tmp_path, capsys, monkeypatch):
+    """A grader folder whose module fails to import (a syntax error in rtpy, say)
+    gives score 0 with the error, and exit status 1 — never 0 of 0 as a pass."""
+    folder = tmp_path / "assignments" / "week05"
+    folder.mkdir(parents=True)
+    (folder / "test_week05.py").write_text("import rtpy.no_such_module\n")
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "r.json"
+    assert main(["grade", "05", "--json", str(out)]) == 1
+    results = json.loads(out.read_text())
+    assert results["score"] == 0 and "no_such_module" in results["output"]
+    assert "could not be loaded" in capsys.readouterr().out
