@@ -208,7 +208,9 @@ def grade(week: str, extra_args: tuple[str, ...] = (), root: Path | None = None)
     plugin = PointsPlugin()
     start = time.perf_counter()
     pytest.main(
-        [str(folder), "-q", "-p", "no:cacheprovider", "--tb=line", "-o", "addopts=", *extra_args],
+        # quiet: the score table shows each failure's message (pytest on the folder
+        # shows the tracebacks)
+        [str(folder), "-qq", "-p", "no:cacheprovider", "--tb=no", "-o", "addopts=", *extra_args],
         plugins=[plugin],
     )
     tests = [
