@@ -59,6 +59,8 @@ TEST_WEEKS_FILE = "assignments/test_weeks.toml"
 # Tests of the assignment machinery itself: they grade every week and generate
 # repositories, so they belong to rtpy only (and are not mapped).
 MACHINERY_TESTS = ("tests/test_grade.py", "tests/test_assignment.py")
+# A test file that uses the numpy backend (withheld from student repositories).
+NUMPY_USE = re.compile(r"numpy_backend|backend\s*=\s*[\"']numpy[\"']")
 
 NUMPY_STUB = '''"""The numpy backend is withheld from the weekly assignment repositories: its
 vectorized twins contain the solutions. Render with the scalar backend (the default)."""
@@ -207,8 +209,8 @@ def weeks_of_tests(root: Path) -> dict[str, list[str]]:
 
 def shipped_tests(root: Path, week: str) -> tuple[list[str], list[str]]:
     """(test files shipped in week's repository, test files left out), as tests/... paths.
-    The numpy backend's tests are always left out (the backend is withheld), and
-    so are MACHINERY_TESTS."""
+    Tests of the numpy backend, and any test file that uses it (NUMPY_USE), are left
+    out (the backend is withheld), and so are MACHINERY_TESTS."""
     mapping = weeks_of_tests(root)
     kept, left = [], []
     for path in sorted((Path(root) / "tests").rglob("*.py")):
@@ -216,6 +218,7 @@ def shipped_tests(root: Path, week: str) -> tuple[list[str], list[str]]:
         needs = mapping.get(rel, [])
         if (
             rel.startswith("tests/numpy_backend/")
+            or NUMPY_USE.search(path.read_text())
             or rel in MACHINERY_TESTS
             or any(withheld(w, week) for w in needs)
         ):
