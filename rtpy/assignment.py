@@ -304,7 +304,11 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
         + "week. Left out because they "
         + "test code you write this week or later, or the numpy backend (withheld here: "
         + "its vectorized code contains the solutions; render with the scalar backend):\n\n"
-        + "".join(f"- `{rel}`\n" for rel in left)
+        + "".join(
+            f"- `{rel}`\n"
+            for rel in left
+            if rel not in MACHINERY_TESTS and not rel.endswith("__init__.py")
+        )
     )
     (dest / "rtpy-README.md").write_text((root / "README.md").read_text())
 
