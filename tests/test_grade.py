@@ -460,7 +460,7 @@ def test_graders_that_cannot_load_score_zero(tmp_path, capsys, monkeypatch):
     gives score 0 with the error, and exit status 1 — never 0 of 0 as a pass."""
     folder = tmp_path / "assignments" / "week05"
     folder.mkdir(parents=True)
-    (folder / "test_week05.py").write_text("import rtpy.no_such_module\n")
+    (folder / "test_broken_grader.py").write_text("import rtpy.no_such_module\n")
     monkeypatch.chdir(tmp_path)
     out = tmp_path / "r.json"
     assert main(["grade", "05", "--json", str(out)]) == 1
