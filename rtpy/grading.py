@@ -141,7 +141,7 @@ def assert_render_matches(stack: np.ndarray, spp: int, reference: dict, what: st
 
 # --- running graders ------------------------------------------------------------------
 @dataclass
-class TestResult:
+class GraderResult:
     name: str
     nodeid: str
     max_score: float
@@ -153,7 +153,7 @@ class TestResult:
 class PointsPlugin:
     """pytest plugin: every collected test's points, and whether it passed."""
 
-    results: dict[str, TestResult] = field(default_factory=dict)
+    results: dict[str, GraderResult] = field(default_factory=dict)
     errors: list[str] = field(default_factory=list)  # graders that could not be loaded
 
     def pytest_collectreport(self, report) -> None:
@@ -171,7 +171,7 @@ class PointsPlugin:
             name = doc[0] if doc else item.name
             if "[" in item.name:
                 name += item.name[item.name.index("[") :]
-            self.results[item.nodeid] = TestResult(name, item.nodeid, value)
+            self.results[item.nodeid] = GraderResult(name, item.nodeid, value)
 
     def pytest_runtest_logreport(self, report) -> None:
         result = self.results.get(report.nodeid)
