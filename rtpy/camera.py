@@ -13,6 +13,12 @@ from .ray import Ray
 from .sampling import generator, random_in_unit_disk
 from .vec3 import Vec3, cross, unit_vector
 
+# The most pixels an image may have. A render keeps about 60 bytes per pixel (sums,
+# sample counts, the linear image) and 8-bit output another 30, so 2^25 pixels
+# (8K UHD, 7680 x 4320, fits) need about 3 GB; larger images are refused before
+# anything is allocated.
+MAX_PIXELS = 1 << 25
+
 
 def parse_aspect_ratio(value: float | str) -> float:
     """16/9 from 1.777..., "16:9" or "16/9"."""
@@ -69,6 +75,11 @@ class Camera:
         if not height < 1e9:
             raise ValueError(f"aspect_ratio {aspect_ratio} makes the image {height} pixels high")
         self.height = max(1, int(height))
+        if self.width * self.height > MAX_PIXELS:
+            raise ValueError(
+                f"width {self.width} x height {self.height} is {self.width * self.height:,} "
+                f"pixels; the most is {MAX_PIXELS:,} (about 3 GB of memory)"
+            )
 
         view = look_from - look_at
         if view.length_squared() == 0.0:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from .image import OutputError, check_image_path, check_linear_path
 from .render_settings import INTEGRATOR_NAMES
-from .scene_file import MAX_MAX_DEPTH, MAX_SPP, MAX_WIDTH
+from .scene_file import MAX_MAX_DEPTH, MAX_RADIANCE, MAX_SPP, MAX_WIDTH
 
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
@@ -54,6 +54,16 @@ def non_negative_int(text: str) -> int:
     return value
 
 
+MAX_WORKERS = 256  # more processes than that only exhaust the machine
+
+
+def worker_count(text: str) -> int:
+    value = positive_int(text)
+    if value > MAX_WORKERS:
+        raise argparse.ArgumentTypeError(f"expected at most {MAX_WORKERS} processes, got {value}")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m rtpy", description="rtpy: a teaching ray tracer in Python."
@@ -82,7 +92,12 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--integrator", choices=INTEGRATOR_NAMES)
     r.add_argument("--max-depth", type=positive_int, help="most ray segments per path")
     r.add_argument("--seed", type=non_negative_int)
-    r.add_argument("--workers", type=positive_int, default=1, help="processes (default 1)")
+    r.add_argument(
+        "--workers",
+        type=worker_count,
+        default=1,
+        help=f"processes (default 1, at most {MAX_WORKERS})",
+    )
     r.add_argument(
         "--backend",
         choices=("scalar", "numpy"),
@@ -240,15 +255,28 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
                     isinstance(c, int | float)
                     and not isinstance(c, bool)
                     and math.isfinite(c)
-                    and c >= 0
+                    and 0 <= c <= MAX_RADIANCE
                     for c in value
                 )
             )
             if not ok:
-                raise fail(key, "3 finite numbers >= 0, such as [0.1, 0.1, 0.1]", value)
+                raise fail(
+                    key, f"3 numbers in [0, {MAX_RADIANCE:g}], such as [0.1, 0.1, 0.1]", value
+                )
             value = Color(*map(float, value))
         checked[key] = value
     return checked
+
+
+def check_width(scene, path: Path, overrides: dict, option: str) -> None:
+    """A width override must give an image within the size limits with the scene's
+    aspect ratio (checked before anything is allocated)."""
+    if "width" not in overrides or scene.camera is None:
+        return
+    try:
+        scene.camera.with_width(overrides["width"])
+    except ValueError as e:
+        raise UsageError(f"{option} {overrides['width']} with {path}'s aspect ratio: {e}") from None
 
 
 def command_scenes() -> int:
@@ -261,7 +289,41 @@ def command_scenes() -> int:
     return 0
 
 
+def _first_ctrl_c(signum, frame) -> None:
+    """Ctrl-C: stop the render (the renderer keeps what is finished); a second one
+    exits at once."""
+    signal.signal(signal.SIGINT, _second_ctrl_c)
+    raise KeyboardInterrupt
+
+
+def _second_ctrl_c(signum, frame) -> None:
+    """A second Ctrl-C exits at once, without waiting for the partial image to be
+    written: worker processes are killed, temporary files removed (an output file
+    is either complete or not there)."""
+    import multiprocessing
+    import os
+
+    from .image import remove_temporary_files
+
+    for child in multiprocessing.active_children():
+        child.kill()
+    remove_temporary_files()
+    os.write(2, b"\nrtpy: interrupted again: stopped at once\n")
+    os._exit(EXIT_INTERRUPTED)
+
+
 def command_render(args: argparse.Namespace) -> int:
+    previous = signal.signal(signal.SIGINT, _first_ctrl_c)
+    try:
+        return _render(args)
+    except KeyboardInterrupt:  # before or after the render, while loading or writing
+        print("rtpy: interrupted (no file is left half-written)", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _render(args: argparse.Namespace) -> int:
     from . import render
     from .bundled import resolve_scene
     from .scene_file import SceneError, load_scene
@@ -280,7 +342,8 @@ def command_render(args: argparse.Namespace) -> int:
         }
         given = {k: v for k, v in flags.items() if v is not None}
         overrides.update(validate_overrides(given, as_flags=True))
-        output = Path(args.output) if args.output else Path(f"{path.stem}.png")
+        check_width(scene, path, overrides, "--width" if args.width is not None else "--set width")
+        output = Path(args.output) if args.output is not None else Path(f"{path.stem}.png")
         check_image_path(output)
         linear = check_linear_path(args.linear) if args.linear else None
     except (SceneError, OutputError, UsageError) as err:
@@ -289,10 +352,8 @@ def command_render(args: argparse.Namespace) -> int:
 
     image = render(scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides)
 
-    # A second Ctrl-C while the partial image is written ends at once; writes
-    # are atomic, so no half-written file is left.
-    if image.interrupted:
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
+    # A Ctrl-C while the image is written (after a complete render) leaves no file:
+    # writes are atomic. After a first Ctrl-C, a second one ends at once.
     written = [image.save(output)]
     if linear is not None:
         written.append(image.save(linear))

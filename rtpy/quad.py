@@ -17,7 +17,9 @@ class Quad(Hittable):
     def __init__(self, q: Vec3, u: Vec3, v: Vec3, material) -> None:
         n = cross(u, v)
         n_len = n.length()
-        if not n_len > 0.0 or not math.isfinite(n_len):
+        if not math.isfinite(n_len):
+            raise ValueError("quad is too large: the area |u x v| overflows")
+        if not n_len > 0.0:
             raise ValueError("quad is degenerate: u and v are parallel or zero")
         self.q, self.u, self.v = q, u, v
         self.material = material

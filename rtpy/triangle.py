@@ -32,7 +32,9 @@ class Triangle(Hittable):
         self.e2 = c - a
         n = cross(self.e1, self.e2)
         n_len = n.length()
-        if not n_len > 0.0 or not math.isfinite(n_len):
+        if not math.isfinite(n_len):
+            raise ValueError("triangle is too large: its area overflows")
+        if not n_len > 0.0:
             raise ValueError("triangle is degenerate: its vertices are collinear")
         self.normal = n / n_len
         self.material = material
