@@ -1,14 +1,17 @@
 """Render the reference data of the assignments' render graders with rtpy's solution.
 
-Every grader module `assignments/weekNN/test_weekNN.py` that defines REFERENCE and
-make_reference_summary() gets `assignments/weekNN/reference/<REFERENCE["name"]>.npz`
-(mean image, per-sample variance, sample count). Run after changing a graded
-scene or the physics:  python scripts/make_assignment_references.py [WEEK ...]
+Every grader module `assignments/weekNN/test_weekNN.py` defines REFERENCE and either
+make_reference_summary(), written to `reference/<REFERENCE["name"]>.npz` (mean image,
+per-sample variance, sample count), or make_reference_image(), written to `.npy`.
+Run after changing a graded scene or the physics:
+    python scripts/make_assignment_references.py [WEEK ...]
 """
 
 import importlib.util
 import sys
 from pathlib import Path
+
+import numpy as np
 
 from rtpy.grading import save_reference
 
@@ -23,11 +26,14 @@ def main(weeks: list[str]) -> None:
         spec = importlib.util.spec_from_file_location(f"grader_{folder.name}", path)
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)
-        if not hasattr(module, "make_reference_summary"):
-            continue
-        out = folder / "reference" / f"{module.REFERENCE['name']}.npz"
-        out.parent.mkdir(exist_ok=True)
-        save_reference(out, module.make_reference_summary())
+        name = folder / "reference" / module.REFERENCE["name"]
+        name.parent.mkdir(exist_ok=True)
+        if hasattr(module, "make_reference_summary"):  # noisy: mean and variance
+            out = name.with_suffix(".npz")
+            save_reference(out, module.make_reference_summary())
+        else:  # deterministic: the image
+            out = name.with_suffix(".npy")
+            np.save(out, module.make_reference_image())
         print(f"wrote {out.relative_to(ROOT)}")
 
 
