@@ -121,6 +121,7 @@ class Camera:
 
     def _ray_through(self, px: float, py: float) -> Ray:
         """Ray through the viewport at fractional pixel position (px, py)."""
+        # BEGIN SOLUTION week03: unit ray from the eye (or lens) through pixel position (px, py)
         p00, du, dv = self.pixel00, self.pixel_delta_u, self.pixel_delta_v
         tx = p00.e0 + px * du.e0 + py * dv.e0
         ty = p00.e1 + px * du.e1 + py * dv.e1
@@ -132,12 +133,17 @@ class Camera:
         dx, dy, dz = tx - origin.e0, ty - origin.e1, tz - origin.e2
         k = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
         return Ray(origin, Vec3(dx * k, dy * k, dz * k))
+        # END SOLUTION
 
     def get_center_ray(self, i: int, j: int) -> Ray:
         """The ray through the center of pixel (i, j)."""
+        # BEGIN SOLUTION week03: the ray through the center of pixel (i, j)
         return self._ray_through(float(i), float(j))
+        # END SOLUTION
 
     def get_ray(self, i: int, j: int) -> Ray:
         """A ray through a uniformly random point of pixel (i, j) (a box filter)."""
+        # BEGIN SOLUTION week03: a ray through a uniformly random point of pixel (i, j)
         r = generator().random
         return self._ray_through(i + r() - 0.5, j + r() - 0.5)
+        # END SOLUTION

@@ -113,13 +113,81 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"override a [render] key, VALUE in TOML syntax ({', '.join(SETTABLE_KEYS)})",
     )
     r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument(
+        "--plugin",
+        action="append",
+        default=[],
+        metavar="FILE.py",
+        help="import FILE.py first (registers a student's materials by register_material)",
+    )
 
     sub.add_parser("scenes", help="list the bundled scenes")
 
     from .bench import add_parser as add_bench_parser
 
     add_bench_parser(sub)
+    add_assignment_commands(sub)
     return parser
+
+
+def add_assignment_commands(sub) -> None:
+    """`assignment make WEEK OUT_DIR`, `assignment map-tests`, `grade WEEK`."""
+    a = sub.add_parser("assignment", help="write a weekly assignment repository")
+    asub = a.add_subparsers(dest="assignment_command", required=True, metavar="ACTION")
+    make = asub.add_parser("make", help="write week WEEK's student repository to OUT_DIR")
+    make.add_argument("week", metavar="WEEK", help="03 to 08")
+    make.add_argument("out_dir", metavar="OUT_DIR", help="a new or empty directory")
+    asub.add_parser("map-tests", help="record which weeks each test file needs (slow)")
+    g = sub.add_parser("grade", help="run a week's graders and print the score")
+    g.add_argument("week", metavar="WEEK", help="03 to 08")
+    g.add_argument("--json", metavar="RESULTS.json", help="Gradescope results file")
+
+
+def command_assignment(args: argparse.Namespace) -> int:
+    from .assignment import AssignmentError, check_week, make_assignment, map_tests
+
+    try:
+        if args.command == "grade":
+            return command_grade(check_week(args.week), args.json)
+        if args.assignment_command == "map-tests":
+            weeks = map_tests()
+            print(f"rtpy: {len(weeks)} test files need solution regions", file=sys.stderr)
+            return 0
+        out = make_assignment(args.week, args.out_dir)
+    except (AssignmentError, FileNotFoundError) as err:
+        print(f"rtpy: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    print(f"rtpy: wrote the week {check_week(args.week)} repository to {out}", file=sys.stderr)
+    return 0
+
+
+def command_grade(week: str, json_path: str | None) -> int:
+    """0 when every grader passes, 1 otherwise."""
+    from .grading import grade, score_table, write_json
+
+    results = grade(week)
+    print(score_table(results))
+    if json_path:
+        write_json(results, json_path)
+    passed = results["score"] == results["max_score"] and "output" not in results
+    return 0 if passed else 1
+
+
+def load_plugins(paths: list[str]) -> None:
+    """Import each file as a module (its @register_material classes become scene types)."""
+    import importlib.util
+
+    for i, name in enumerate(paths):
+        path = Path(name)
+        if path.suffix != ".py" or not path.is_file():
+            raise UsageError(f"--plugin {name}: not a .py file")
+        spec = importlib.util.spec_from_file_location(f"rtpy_plugin_{i}_{path.stem}", path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[spec.name] = module
+        try:
+            spec.loader.exec_module(module)
+        except Exception as err:
+            raise UsageError(f"--plugin {name}: {type(err).__name__}: {err}") from err
 
 
 class UsageError(Exception):
@@ -266,6 +334,7 @@ def _render(args: argparse.Namespace) -> int:
     from .scene_file import SceneError, load_scene
 
     try:
+        load_plugins(args.plugin)
         path = resolve_scene(args.scene)
         scene = load_scene(path)
         overrides = validate_overrides(parse_set(args.set))
@@ -318,6 +387,8 @@ def main(argv: list[str] | None = None) -> int:
         from .bench import command_bench
 
         return command_bench(args)
+    if args.command in ("assignment", "grade"):
+        return command_assignment(args)
     return command_render(args)
 
 

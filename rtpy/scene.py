@@ -108,6 +108,7 @@ class Scene:
                 return None
             obj, t = found
             return obj.hit_info(ray, t)
+        # BEGIN SOLUTION week04: the closest hit over all objects (earliest object wins ties)
         # Every object in list order. An object replaces the closest so far only
         # when it is strictly closer, so on equal t the earlier one stays.
         closest_t = interval.max
@@ -121,6 +122,7 @@ class Scene:
         if closest_obj is None:
             return None
         return closest_obj.hit_info(ray, closest_t)
+        # END SOLUTION
 
     def find_occlusion(
         self,
@@ -135,10 +137,12 @@ class Scene:
         t_min, t_max = interval.min, interval.max
         if not brute_force and len(self.objects) >= self.bvh_min_objects:
             return self.bvh().any_hit(ray, t_min, t_max, ignore)
+        # BEGIN SOLUTION week05: is anything on the shadow ray inside the interval?
         for obj in self.objects:
             if obj is not ignore and obj.hit_t(ray, t_min, t_max) is not None:
                 return True
         return False
+        # END SOLUTION
 
     def background_radiance(self, direction) -> Color:
         """Radiance arriving along a ray that escapes with this direction."""

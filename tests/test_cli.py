@@ -308,3 +308,24 @@ def test_unwritable_output_real_subprocess_says_so_at_once(tmp_path):
     ]
     assert time.monotonic() - start < 30
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
+def test_render_with_a_student_plugin_material(tmp_path):
+    """--plugin FILE.py imports the file; its @register_material class is a scene type."""
+    (tmp_path / "student.py").write_text(
+        "from rtpy.materials import Lambertian, register_material\n"
+        "from rtpy.vec3 import Color\n\n"
+        '@register_material("half_grey")\n'
+        "class HalfGrey(Lambertian):\n"
+        "    def __init__(self, level: float = 0.5):\n"
+        "        super().__init__(Color(level, level, level))\n"
+    )
+    (tmp_path / "scene.toml").write_text(
+        '[render]\nintegrator = "center"\n[materials.m]\ntype = "half_grey"\nlevel = 0.25\n'
+        '[[objects]]\ntype = "sphere"\ncenter = [0, 0, -1]\nradius = 0.5\nmaterial = "m"\n'
+    )
+    out = tmp_path / "out.npy"
+    args = ["render", str(tmp_path / "scene.toml"), "--width", "8", "--quiet"]
+    assert main([*args, "-o", str(tmp_path / "o.png"), "--linear", str(out)]) == 2  # unknown type
+    args += ["--plugin", str(tmp_path / "student.py")]
+    assert main([*args, "-o", str(tmp_path / "o.png"), "--linear", str(out)]) == 0
+    assert np.load(out)[2, 4].tolist() == [0.25, 0.25, 0.25]  # the ball's center pixel
+    assert main([*args[:-1], str(tmp_path / "missing.py"), "-o", str(tmp_path / "p.png")]) == 2

@@ -18,8 +18,10 @@ class DirectIntegrator(Integrator):
     name = "direct"
 
     def radiance(self, ray: Ray, scene: Scene) -> Color:
+        # BEGIN SOLUTION week05: emission plus direct lighting at the first hit
         hit = scene.find_intersection(ray, FORWARD)
         if hit is None:
             return scene.background_radiance(ray.direction)
         emitted = hit.material.emitting(hit)
         return emitted + direct_lighting(scene, ray, hit, self.settings.mis)
+        # END SOLUTION

@@ -30,6 +30,7 @@ def sample_one_light(
     by light arriving directly from `lights`: one light picked uniformly, one
     direction toward it, weight f_r * L * cos(theta_i) / pdf (times the MIS weight
     for area lights; with mis = False the weight is 1: light sampling alone)."""
+    # BEGIN SOLUTION week05: one light, one shadow ray, f_r * L * cos / pdf
     n_lights = len(lights)
     light = lights[min(int(random_double() * n_lights), n_lights - 1)]
     sample = light.sample(hit.point)
@@ -56,6 +57,7 @@ def sample_one_light(
         return f * sample.radiance * (cos_i / pdf)
     weight = power_heuristic(pdf, hit.material.pdf(ray_in, shadow_ray, hit))
     return f * sample.radiance * (cos_i * weight / pdf)
+    # END SOLUTION
 
 
 def emission_weight(
@@ -85,6 +87,7 @@ def direct_lighting(scene: Scene, ray_in: Ray, hit: HitInfo, mis: bool = True) -
     bounce: light sampling plus BRDF sampling, combined by MIS (mis = False: the
     lights by light sampling alone). A BRDF-sampled ray that escapes sees the
     background. At specular materials only the sampled ray is followed."""
+    # BEGIN SOLUTION week05: light sampling plus the BRDF-sampled bounce, light counted once
     material = hit.material
     lights = scene.lights
     result = BLACK
@@ -104,3 +107,4 @@ def direct_lighting(scene: Scene, ray_in: Ray, hit: HitInfo, mis: bool = True) -
             )
             result = result + scatter.attenuation * emitted * w
     return result
+    # END SOLUTION

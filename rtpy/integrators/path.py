@@ -32,6 +32,7 @@ class PathIntegrator(Integrator):
     name = "path"
 
     def radiance(self, ray: Ray, scene: Scene) -> Color:
+        # BEGIN SOLUTION week08: path loop: emission (MIS), light sampling, throughput, roulette
         settings = self.settings
         max_depth, rr_start = settings.max_depth, settings.russian_roulette
         lights = scene.lights if settings.nee else scene.point_lights
@@ -71,3 +72,4 @@ class PathIntegrator(Integrator):
                 beta = beta / survive
             segment += 1
         return result
+        # END SOLUTION
