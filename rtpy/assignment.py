@@ -351,12 +351,15 @@ def pytest_runtest_setup(item):
 
 
 def map_tests(
-    root: str | Path | None = None, pytest_args: tuple[str, ...] = ()
+    root: str | Path | None = None,
+    pytest_args: tuple[str, ...] = (),
+    files: tuple[str, ...] = (),
 ) -> dict[str, set[str]]:
     """Run rtpy's tests (the numpy backend's excepted) on a copy of the tree whose
     solution regions record each test file that runs them, also from worker and
     command-line subprocesses; returns {test file: the weeks it runs} and writes
-    it to assignments/test_weeks.toml."""
+    it to assignments/test_weeks.toml. With `files` (tests/... paths) only those
+    run, and only their entries are replaced (the quick way after adding a file)."""
     import subprocess
     import sys
 
@@ -400,18 +403,21 @@ def map_tests(
                 "--ignore=tests/numpy_backend",
                 *(f"--ignore={t}" for t in MACHINERY_TESTS),
                 *pytest_args,
-                "tests",
+                *(files or ("tests",)),
             ],
             cwd=dest,
             env=env,
             check=False,
         )
         weeks: dict[str, set[str]] = {}
+        if files:  # keep every other file's entry
+            weeks = {k: set(v) for k, v in weeks_of_tests(root).items() if k not in files}
+            weeks.update({Path(f).as_posix(): set() for f in files})
         for line in log.read_text().splitlines() if log.exists() else []:
             test, week = line.split("\t")
             if test.startswith("tests/"):
                 weeks.setdefault(test, set()).add(week)
-        for path in sorted((root / "tests").rglob("test_*.py")):
+        for path in [] if files else sorted((root / "tests").rglob("test_*.py")):
             rel = path.relative_to(root).as_posix()
             if not (rel.startswith("tests/numpy_backend/") or rel in MACHINERY_TESTS):
                 weeks.setdefault(rel, set())  # runs no region: ships every week

@@ -137,7 +137,8 @@ def add_assignment_commands(sub) -> None:
     make = asub.add_parser("make", help="write week WEEK's student repository to OUT_DIR")
     make.add_argument("week", metavar="WEEK", help="03 to 08")
     make.add_argument("out_dir", metavar="OUT_DIR", help="a new or empty directory")
-    asub.add_parser("map-tests", help="record which weeks each test file needs (slow)")
+    m = asub.add_parser("map-tests", help="record which weeks each test file needs (slow)")
+    m.add_argument("files", nargs="*", metavar="TEST_FILE", help="only these (tests/...)")
     g = sub.add_parser("grade", help="run a week's graders and print the score")
     g.add_argument("week", metavar="WEEK", help="03 to 08")
     g.add_argument("--json", metavar="RESULTS.json", help="Gradescope results file")
@@ -150,7 +151,7 @@ def command_assignment(args: argparse.Namespace) -> int:
         if args.command == "grade":
             return command_grade(check_week(args.week), args.json)
         if args.assignment_command == "map-tests":
-            weeks = map_tests()
+            weeks = map_tests(files=tuple(args.files))
             print(f"rtpy: {len(weeks)} test files need solution regions", file=sys.stderr)
             return 0
         out = make_assignment(args.week, args.out_dir)

@@ -28,10 +28,12 @@ import pytest
 from rtpy.assignment import (
     MACHINERY_TESTS,
     NUMPY_USE,
+    TEST_WEEKS_FILE,
     WEEKS,
     AssignmentError,
     find_regions,
     make_assignment,
+    map_tests,
     regions_in,
     shipped_tests,
     weeks_of_tests,
@@ -142,3 +144,29 @@ def test_student_repository(tmp_path, week):
         assert t["score"] == 0, f"week {week}: {t['name']} passes on the stubs"
         assert "NotImplementedError" in t["output"] and f"week{week} task" in t["output"], t
     assert report["smoke"] == 0, f"week {week}: smoke tests {smoke} failed:\n{proc.stdout[-3000:]}"
+
+
+def test_map_tests_of_some_files_records_their_weeks_and_keeps_the_rest(tmp_path):
+    """map-tests FILES runs only those files on the instrumented copy: their entries
+    are replaced by the weeks they execute, every other entry is kept."""
+    (tmp_path / "rtpy").mkdir()
+    (tmp_path / "rtpy" / "__init__.py").write_text("from __future__ import annotations\n")
+    (tmp_path / "rtpy" / "shade.py").write_text(
+        "def twice(x):\n"
+        "    # BEGIN SOLUTION week05: twice\n"
+        "    return 2 * x\n"
+        "    # END SOLUTION\n"
+    )
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "test_shade.py").write_text(
+        "from rtpy.shade import twice\n\n\ndef test_twice():\n    assert twice(2) == 4\n"
+    )
+    (tmp_path / "tests" / "test_other.py").write_text("def test_nothing():\n    assert True\n")
+    (tmp_path / "assignments").mkdir()
+    (tmp_path / TEST_WEEKS_FILE).write_text(
+        '[tests]\n"tests/test_other.py" = [7]\n"tests/test_shade.py" = [3]\n'
+    )
+    weeks = map_tests(tmp_path, files=("tests/test_shade.py",))
+    assert weeks == {"tests/test_other.py": {"07"}, "tests/test_shade.py": {"05"}}
+    on_disk = weeks_of_tests(tmp_path)
+    assert on_disk == {"tests/test_other.py": ["07"], "tests/test_shade.py": ["05"]}
