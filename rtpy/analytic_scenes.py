@@ -148,32 +148,6 @@ class GlowingLambertian(Lambertian):
 
     def emitting(self, hit):
         return self.emit
-
-
-def _register_numpy_kernel() -> None:
-    """GlowingLambertian's batched twin for the numpy backend (the Lambertian
-    kernel plus uniform emission), so that its scenes do not fall back to calling
-    the scalar methods per ray (about 50 times slower)."""
-    from .numpy_backend.materials.kernel import color_param
-    from .numpy_backend.materials.simple import LambertianKernel
-    from .numpy_backend.materials.table import KERNELS
-
-    class GlowingLambertianKernel(LambertianKernel):
-        emits = True
-
-        def __init__(self, materials) -> None:
-            super().__init__(materials)
-            self.emit = color_param(self.materials, "emit")
-
-        def emitted(self, slots: np.ndarray, hits) -> np.ndarray:
-            return self.emit.take(slots, axis=0)
-
-    KERNELS.setdefault(GlowingLambertian, GlowingLambertianKernel)
-
-
-_register_numpy_kernel()
-
-
 # --------------------------------------------------------------------------- scenes
 
 

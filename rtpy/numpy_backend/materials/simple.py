@@ -7,6 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ...analytic_scenes import GlowingLambertian
 from ...materials import Dielectric, DiffuseLight, Lambertian, Metal, Mirror
 from ..arrays import put_rows, where_rows
 from ..hits import HitBatch
@@ -171,8 +172,24 @@ class DiffuseLightKernel(Kernel):
         return where_rows(on, self.emit.take(slots, axis=0))
 
 
+class GlowingLambertianKernel(LambertianKernel):
+    """The analytic scenes' GlowingLambertian: the Lambertian kernel plus uniform
+    emission from both faces (without it those scenes would call the scalar
+    methods per ray, about 50 times slower)."""
+
+    emits = True
+
+    def __init__(self, materials: Sequence[GlowingLambertian]) -> None:
+        super().__init__(materials)
+        self.emit = color_param(self.materials, "emit")
+
+    def emitted(self, slots: np.ndarray, hits: HitBatch) -> np.ndarray:
+        return self.emit.take(slots, axis=0)
+
+
 SIMPLE_KERNELS = {
     Lambertian: LambertianKernel,
+    GlowingLambertian: GlowingLambertianKernel,
     Mirror: MirrorKernel,
     Metal: MetalKernel,
     Dielectric: DielectricKernel,
