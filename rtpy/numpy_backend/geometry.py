@@ -38,8 +38,15 @@ from .hits import HitBatch
 # Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
 BVH_THRESHOLD = 24
 BVH_LEAF_SIZE = 4
-# Rays are intersected in chunks of this many, so (chunk, K) temporaries stay in cache.
+# Rays are intersected in chunks of PAIR_CHUNK // K rays (at least RAY_CHUNK), so
+# (chunk, K) temporaries stay in cache while small sets still make few numpy calls.
 RAY_CHUNK = 1024
+PAIR_CHUNK = 18432
+# A brute-force set of planar primitives culls clusters of them by their bounding box
+# (see cluster_parts): clusters of at least CLUSTER_SIZE primitives whose box has at
+# most CLUSTER_AREA of the surface area of the whole set's box.
+CLUSTER_SIZE = 3
+CLUSTER_AREA = 0.5
 
 INF = math.inf
 # Quads accept hits this little outside their edges (in units of the edge length):
@@ -241,6 +248,7 @@ class PrimitiveSet:
 
     objects: list[Hittable]
     bvh: BVH | None = None
+    parts: list | None = None  # see cluster_parts
 
     def __len__(self) -> int:
         return len(self.objects)
@@ -283,10 +291,13 @@ class PrimitiveSet:
                 return t
 
             return self.bvh.traverse(o, d, t_min, t_max, test, any_hit)
+        if self.parts is not None:
+            return self._closest_by_parts(o, d, t_min, t_max, any_hit, skip)
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(len(o), -1, dtype=np.int64)
-        for s in range(0, len(o), RAY_CHUNK):
-            e = min(s + RAY_CHUNK, len(o))
+        chunk = max(RAY_CHUNK, PAIR_CHUNK // len(self))
+        for s in range(0, len(o), chunk):
+            e = min(s + chunk, len(o))
             t = self.all_t(o[s:e], d[s:e], t_min)
             if skip is not None:
                 r = np.flatnonzero(skip[s:e] >= 0)
@@ -297,6 +308,65 @@ class PrimitiveSet:
             t_best[s:e][hit] = tj[hit]
             idx[s:e][hit] = j[hit]
         return t_best, idx
+
+    def cluster(self) -> None:
+        """Without a BVH: split the set into parts (cluster_parts), when that culls any."""
+        if self.bvh is not None or len(self) < 2 * CLUSTER_SIZE:
+            return
+        lo, hi = self.bounds()
+        groups = cluster_parts(self.corners(), lo, hi)
+        if len(groups) < 2:
+            return
+        # One part per group: (box lo, box hi, the group as a set of its own, members);
+        # the first part, the primitives in no cluster, has no box (every ray tests it).
+        self.parts = []
+        self.part_of = np.empty(len(self), dtype=np.int64)  # primitive -> its part
+        self.part_pos = np.empty(len(self), dtype=np.int64)  # primitive -> index in part
+        for g, members in enumerate(groups):
+            if g == 0 and members.size == 0:
+                continue
+            sub = type(self)([self.objects[i] for i in members], cluster=False)
+            box = (None, None) if g == 0 else _padded_box(lo[members], hi[members])
+            self.part_of[members] = len(self.parts)
+            self.part_pos[members] = np.arange(members.size)
+            self.parts.append((*box, sub, members))
+
+    def _closest_by_parts(self, o, d, t_min, t_max, any_hit, skip):
+        """closest() over self.parts: each clustered part only for the rays that enter
+        its box before the closest hit found so far (so the unclustered part goes first)."""
+        t_best = np.array(t_max, dtype=np.float64, copy=True)
+        idx = np.full(len(o), -1, dtype=np.int64)
+        oc = np.ascontiguousarray(o.T)
+        with np.errstate(divide="ignore"):
+            inv = 1.0 / np.ascontiguousarray(d.T)
+        for p, (lo, hi, part, members) in enumerate(self.parts):
+            if lo is None:
+                rays = None
+                ro, rd, rt = o, d, t_best
+            else:
+                enter = _enters_box(oc, inv, lo, hi, t_min, t_best)
+                if any_hit:
+                    enter &= idx < 0
+                rays = np.flatnonzero(enter)
+                if rays.size == 0:
+                    continue
+                ro, rd, rt = o.take(rays, axis=0), d.take(rays, axis=0), t_best.take(rays)
+            local_skip = None
+            if skip is not None:
+                sk = skip if rays is None else skip.take(rays)
+                k = np.maximum(sk, 0)
+                mine = (sk >= 0) & (self.part_of.take(k) == p)
+                local_skip = np.where(mine, self.part_pos.take(k), -1)
+            t, k = part.closest(ro, rd, t_min, rt, any_hit, local_skip)
+            hit = np.flatnonzero(k >= 0)
+            w = hit if rays is None else rays.take(hit)
+            t_best[w] = t.take(hit)
+            idx[w] = members.take(k.take(hit))
+        return t_best, idx
+
+    def corners(self) -> np.ndarray:
+        """(K, C, 3) corners of the primitives (for clustering)."""
+        raise NotImplementedError
 
     def sample_light(self, k, p, r1, r2):
         direction, pdf, valid = self.sample_direction(k, p, r1, r2)
@@ -325,6 +395,74 @@ class PrimitiveSet:
 
     def sample_point(self, k, r1, r2) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
+
+
+def cluster_parts(corners: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
+    """Groups of primitives worth culling together by one bounding box, as index arrays;
+    the first holds the primitives in no such group (possibly none).
+
+    A group is a connected set of primitives sharing corners (up to 1e-5 of the set's
+    size: the six quads of a box), of at least CLUSTER_SIZE primitives, whose box has
+    at most CLUSTER_AREA of the surface area of the whole set's box. In the Cornell
+    box the two boxes are groups (a ray enters their boxes ~20% and ~15% of the time),
+    the walls (whose box is the whole set's) and the light are not."""
+    k = len(corners)
+    extent = hi.max(axis=0) - lo.min(axis=0)
+    tol = 1e-5 * float(extent.max())
+    root = list(range(k))
+
+    def find(i: int) -> int:
+        while root[i] != i:
+            i = root[i]
+        return i
+
+    for i in range(k):
+        for j in range(i + 1, k):
+            gap = np.abs(corners[i][:, None, :] - corners[j][None, :, :]).max(axis=2)
+            if gap.min() <= tol:
+                root[find(j)] = find(i)
+    comps: dict[int, list[int]] = {}
+    for i in range(k):
+        comps.setdefault(find(i), []).append(i)
+    whole = _box_area(lo.min(axis=0), hi.max(axis=0))
+    free, groups = [], []
+    for members in comps.values():
+        m = np.array(members, dtype=np.int64)
+        small = _box_area(lo[m].min(axis=0), hi[m].max(axis=0)) <= CLUSTER_AREA * whole
+        if len(m) >= CLUSTER_SIZE and small:
+            groups.append(m)
+        else:
+            free.extend(members)
+    return [np.array(sorted(free), dtype=np.int64), *groups] if groups else []
+
+
+def _box_area(lo: np.ndarray, hi: np.ndarray) -> float:
+    e = np.maximum(hi - lo, 0.0)
+    return float(2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]))
+
+
+def _padded_box(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The box around boxes lo, hi (K, 3), padded so rounding in the slab test cannot
+    cull a ray that grazes a primitive on the box's boundary."""
+    lo, hi = lo.min(axis=0), hi.max(axis=0)
+    pad = 1e-7 * (float((hi - lo).max()) + float(np.abs(lo).max()) + float(np.abs(hi).max()))
+    return lo - pad, hi + pad
+
+
+def _enters_box(oc, inv, lo, hi, t_min: float, t_max: np.ndarray) -> np.ndarray:
+    """(N,) bool: rays (origin columns oc (3, N), reciprocal direction columns inv)
+    meet the box lo, hi at some t in (t_min, t_max) (slab test, one axis at a time).
+    A zero direction component gives inv = +-inf; then (lo - o) * inv is nan only for
+    an origin exactly on a slab plane, and nan comparisons count as entering."""
+    near = far = None
+    with np.errstate(invalid="ignore"):
+        for c in range(3):
+            a = (lo[c] - oc[c]) * inv[c]
+            b = (hi[c] - oc[c]) * inv[c]
+            n_c, f_c = np.minimum(a, b), np.maximum(a, b)
+            near = n_c if near is None else np.fmax(near, n_c)
+            far = f_c if far is None else np.fmin(far, f_c)
+        return ~((near > far) | (far <= t_min) | (near >= t_max))
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -608,7 +746,7 @@ class QuadSet(PlanarSet):
     so for p = o + t d: a = o . A + t (d . A) - q . A with A = v x w (B = w x u likewise).
     """
 
-    def __init__(self, quads: Sequence[Quad]) -> None:
+    def __init__(self, quads: Sequence[Quad], cluster: bool = True) -> None:
         self.objects = list(quads)
         f = np.float64
         self.q = np.array([_v(s.q) for s in quads], dtype=f).reshape(-1, 3)
@@ -632,10 +770,15 @@ class QuadSet(PlanarSet):
         self.Md_a = 2.0 * self.A.T
         self.Md_b = 2.0 * self.B.T
         self.build_bvh()
+        if cluster:
+            self.cluster()
+
+    def corners(self):
+        return np.stack([self.q, self.q + self.u, self.q + self.v, self.q + self.u + self.v], 1)
 
     def bounds(self):
-        corners = np.stack([self.q, self.q + self.u, self.q + self.v, self.q + self.u + self.v])
-        return corners.min(axis=0), corners.max(axis=0)
+        corners = self.corners()
+        return corners.min(axis=1), corners.max(axis=1)
 
     def all_t(self, o, d, t_min):
         # Homogeneous o: one product gives d - o.n and 2 (o.A - q.A) - 1 (and for B),
@@ -701,7 +844,7 @@ class TriangleSet(PlanarSet):
     are precomputed; the ray-sided ones are (N, 3) x (3, K) products).
     """
 
-    def __init__(self, triangles: Sequence[Triangle]) -> None:
+    def __init__(self, triangles: Sequence[Triangle], cluster: bool = True) -> None:
         self.objects = list(triangles)
         f = np.float64
         self.a = np.array([_v(s.a) for s in triangles], dtype=f).reshape(-1, 3)
@@ -722,10 +865,15 @@ class TriangleSet(PlanarSet):
         self.Md = np.concatenate([self.N, self.e2xa, self.axe1], axis=0).T.copy()
         self.Mm = np.concatenate([self.e2, self.e1], axis=0).T.copy()
         self.build_bvh()
+        if cluster:
+            self.cluster()
+
+    def corners(self):
+        return np.stack([self.a, self.a + self.e1, self.a + self.e2], 1)
 
     def bounds(self):
-        corners = np.stack([self.a, self.a + self.e1, self.a + self.e2])
-        return corners.min(axis=0), corners.max(axis=0)
+        corners = self.corners()
+        return corners.min(axis=1), corners.max(axis=1)
 
     def _finish(self, det, parallel, u_num, v_num, t_num, t_min, t_max):
         with np.errstate(divide="ignore", invalid="ignore"):
