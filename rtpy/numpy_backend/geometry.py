@@ -33,7 +33,7 @@ from ..sphere import Sphere
 from ..triangle import Triangle
 from ..vec3 import Vec3
 from .arrays import axpy, put_rows, scale
-from .hits import HitBatch
+from .hits import HitBatch, unused
 
 # Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
 BVH_THRESHOLD = 24
@@ -257,9 +257,12 @@ class PrimitiveSet:
     def pair_t(self, o, d, k, t_min, t_max) -> np.ndarray:
         raise NotImplementedError
 
-    def all_t(self, o: np.ndarray, d: np.ndarray, t_min: float) -> np.ndarray:
+    def all_t(
+        self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray | None = None
+    ) -> np.ndarray:
         """(N, K) ray parameters of every ray against every primitive with t > t_min
-        (inf: miss). The caller compares the smallest with each ray's t_max."""
+        (inf: miss). The caller compares the smallest with each ray's t_max; a set may
+        use t_max (N,), when given, to skip pairs that cannot hit before it."""
         k = np.arange(len(self))[None, :]
         return self.pair_t(o[:, None, :], d[:, None, :], k, t_min, INF)
 
@@ -298,7 +301,7 @@ class PrimitiveSet:
         chunk = max(RAY_CHUNK, PAIR_CHUNK // len(self))
         for s in range(0, len(o), chunk):
             e = min(s + chunk, len(o))
-            t = self.all_t(o[s:e], d[s:e], t_min)
+            t = self.all_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None)
             if skip is not None:
                 r = np.flatnonzero(skip[s:e] >= 0)
                 t[r, skip[s:e][r]] = INF
@@ -780,7 +783,10 @@ class QuadSet(PlanarSet):
         corners = self.corners()
         return corners.min(axis=1), corners.max(axis=1)
 
-    def all_t(self, o, d, t_min):
+    def all_t(self, o, d, t_min, t_max=None):
+        """As PrimitiveSet.all_t. With t_max (N,) (occlusion), the edges are tested
+        only for the quads whose plane some ray crosses in (t_min, t_max): a shadow
+        ray inside a room crosses none of the walls' planes."""
         # Homogeneous o: one product gives d - o.n and 2 (o.A - q.A) - 1 (and for B),
         # so a' = 2a - 1 and b' = 2b - 1 need one multiply-add each and the test
         # 0 <= a, b <= 1 becomes max(|a'|, |b'|) <= 1.
@@ -789,15 +795,28 @@ class QuadSet(PlanarSet):
         oh[:, 3] = 1.0
         with np.errstate(divide="ignore", invalid="ignore"):
             t = (oh @ self.Mo_n) / (d @ self.Md_n)
-            a = oh @ self.Mo_a
-            a += t * (d @ self.Md_a)
-            b = oh @ self.Mo_b
-            b += t * (d @ self.Md_b)
-            np.abs(a, out=a)
-            np.abs(b, out=b)
-            np.maximum(a, b, out=a)
-            ok = a <= EDGE
-            ok &= t > t_min
+            if t_max is None:
+                return self._inside(oh, d, t, t_min, slice(None))
+            crossed = (t > t_min) & (t < t_max[:, None])
+            cols = np.flatnonzero(crossed.any(axis=0))
+            if cols.size == len(self):
+                return self._inside(oh, d, t, t_min, slice(None))
+            out = np.full(t.shape, INF)
+            if cols.size:
+                out[:, cols] = self._inside(oh, d, t[:, cols], t_min, cols)
+            return out
+
+    def _inside(self, oh, d, t, t_min, cols):
+        """t where the hits at t on the quads cols lie inside them (else inf)."""
+        a = oh @ self.Mo_a[:, cols]
+        a += t * (d @ self.Md_a[:, cols])
+        b = oh @ self.Mo_b[:, cols]
+        b += t * (d @ self.Md_b[:, cols])
+        np.abs(a, out=a)
+        np.abs(b, out=b)
+        np.maximum(a, b, out=a)
+        ok = a <= EDGE
+        ok &= t > t_min
         return np.where(ok, t, INF)
 
     def pair_t(self, o, d, k, t_min, t_max):
@@ -885,7 +904,7 @@ class TriangleSet(PlanarSet):
         ok &= (t > t_min) & (t < t_max)
         return np.where(ok, t, INF)
 
-    def all_t(self, o, d, t_min):
+    def all_t(self, o, d, t_min, t_max=None):
         k = len(self)
         m = np.cross(o, d)
         on = o @ self.Mo
@@ -1162,7 +1181,7 @@ class Geometry:
             for kd, i in groups:
                 u[i], v[i] = self.sets[kd].uv(local[i], point[i])
         else:
-            u = v = np.zeros(n)
+            u = v = unused(n)
         if need_tangent:
             tangent = np.empty((n, 3))
             valid = np.empty(n, dtype=bool)
@@ -1172,7 +1191,7 @@ class Geometry:
                 bad = ~valid
                 tangent[bad] = onb_u(normal[bad])
         else:
-            tangent = np.zeros((n, 3))
+            tangent = unused(n, 3)
         return HitBatch(point, normal, -d, t, front, u, v, tangent)
 
     def set_of(self, obj: np.ndarray):
