@@ -548,10 +548,17 @@ class SphereSet(PrimitiveSet):
     def closest(self, o, d, t_min, t_max, any_hit=False, skip=None):
         """As PrimitiveSet.closest. Without a BVH, one sphere at a time over all rays
         (1-D arrays of length N: an (N, K) broadcast runs numpy's inner loop over the
-        K spheres, which is slow for small K). Each sphere first rejects the rays
-        that miss it (the first half of pair_t) and finishes the root only for the
-        rest, against the closest t found so far; the arithmetic per (ray, sphere) is
-        pair_t's, so t is bit-identical and ties keep the lower index (as argmin)."""
+        K spheres, which is slow for small K). Each sphere first rejects, for all rays,
+        those that surely miss it, by a cheaper test than pair_t's (below), and runs
+        pair_t's arithmetic, op for op, only for the rest, against the closest t found
+        so far: t is bit-identical and ties keep the lower index (as argmin).
+
+        The cheap test: pair_t misses where the sphere is behind an origin outside it
+        (h < 0 and |oc|^2 > r^2), or where the line passes farther than r from the
+        centre (f2 > r^2, f2 computed without cancellation). Here f2 is replaced by
+        |oc|^2 - h^2 / a, which cancels but errs by only ~1e-15 |oc|^2, so rays are
+        kept when it is at most r^2 + 1e-9 |oc|^2: a superset of pair_t's hits; the
+        kept rays then get pair_t's exact test."""
         if self.bvh is not None:
             return super().closest(o, d, t_min, t_max, any_hit, skip)
         n = len(o)
@@ -560,18 +567,15 @@ class SphereSet(PrimitiveSet):
         ox, oy, oz = np.ascontiguousarray(o.T)
         dx, dy, dz = np.ascontiguousarray(d.T)
         a_all = dx * dx + dy * dy + dz * dz
+        inv_a = 1.0 / a_all
         for k in range(len(self)):
             cx, cy, cz = self.center[k]
             r, r2 = self.radius[k], self.r2[k]
             ocx, ocy, ocz = cx - ox, cy - oy, cz - oz
             h = dx * ocx + dy * ocy + dz * ocz
-            c_term = ocx * ocx + ocy * ocy + ocz * ocz - r2
-            kk = h / a_all
-            fx = ocx - kk * dx
-            fy = ocy - kk * dy
-            fz = ocz - kk * dz
-            f2 = fx * fx + fy * fy + fz * fz
-            cand = ~(((h < 0.0) & (c_term > 0.0)) | (f2 > r2))
+            oc2 = ocx * ocx + ocy * ocy + ocz * ocz
+            cand = oc2 * (1.0 - 1e-9) - r2 <= h * h * inv_a
+            cand &= (h >= 0.0) | (oc2 <= r2)
             if any_hit:
                 cand &= idx < 0
             if skip is not None:
@@ -579,9 +583,16 @@ class SphereSet(PrimitiveSet):
             j = np.flatnonzero(cand)
             if j.size == 0:
                 continue
-            a, tm = a_all, t_best
+            a, tm, jx, jy, jz = a_all, t_best, dx, dy, dz
             if j.size < n:
-                h, c_term, f2, a, tm = h[j], c_term[j], f2[j], a_all[j], t_best[j]
+                h, oc2, ocx, ocy, ocz = h[j], oc2[j], ocx[j], ocy[j], ocz[j]
+                a, tm, jx, jy, jz = a_all[j], t_best[j], dx[j], dy[j], dz[j]
+            c_term = oc2 - r2
+            kk = h / a
+            fx = ocx - kk * jx
+            fy = ocy - kk * jy
+            fz = ocz - kk * jz
+            f2 = fx * fx + fy * fy + fz * fz
             with np.errstate(invalid="ignore", divide="ignore"):
                 f = np.sqrt(f2)
                 disc = a * (r - f) * (r + f)
@@ -592,7 +603,7 @@ class SphereSet(PrimitiveSet):
             hi = np.maximum(t0, t1)
             t = np.where((t_min < hi) & (hi < tm), hi, INF)
             t = np.where((t_min < lo) & (lo < tm), lo, t)
-            hit = (t < tm) & (q != 0.0)
+            hit = (t < tm) & (q != 0.0) & (f2 <= r2)
             w = j[hit] if j.size < n else np.flatnonzero(hit)
             t_best[w] = t[hit]
             idx[w] = k
