@@ -65,7 +65,7 @@ def render(
     """Render `scene` and return the image (linear array + PIL image).
 
     Keyword overrides: any [render] setting (integrator, spp, max_depth, nee,
-    russian_roulette, seed, gamma), background, sky, the camera width, or a
+    russian_roulette, seed, gamma, mis), background, sky, the camera width, or a
     whole `camera`. workers = number of processes; quiet = no progress bar.
     backend = "scalar" (the readable reference) or "numpy" (vectorized, many times
     faster; the same image up to Monte Carlo noise).

@@ -13,6 +13,12 @@ from .ray import Ray
 from .sampling import generator, random_in_unit_disk
 from .vec3 import Vec3, cross, unit_vector
 
+# The most pixels an image may have. A render keeps about 60 bytes per pixel (sums,
+# sample counts, the linear image) and 8-bit output another 30, so 2^25 pixels
+# (8K UHD, 7680 x 4320, fits) need about 3 GB; larger images are refused before
+# anything is allocated.
+MAX_PIXELS = 1 << 25
+
 
 def parse_aspect_ratio(value: float | str) -> float:
     """16/9 from 1.777..., "16:9" or "16/9"."""
@@ -69,6 +75,11 @@ class Camera:
         if not height < 1e9:
             raise ValueError(f"aspect_ratio {aspect_ratio} makes the image {height} pixels high")
         self.height = max(1, int(height))
+        if self.width * self.height > MAX_PIXELS:
+            raise ValueError(
+                f"width {self.width} x height {self.height} is {self.width * self.height:,} "
+                f"pixels; the most is {MAX_PIXELS:,} (about 3 GB of memory)"
+            )
 
         view = look_from - look_at
         if view.length_squared() == 0.0:
@@ -110,6 +121,7 @@ class Camera:
 
     def _ray_through(self, px: float, py: float) -> Ray:
         """Ray through the viewport at fractional pixel position (px, py)."""
+        # BEGIN SOLUTION week03: unit ray from the eye (or lens) through pixel position (px, py)
         p00, du, dv = self.pixel00, self.pixel_delta_u, self.pixel_delta_v
         tx = p00.e0 + px * du.e0 + py * dv.e0
         ty = p00.e1 + px * du.e1 + py * dv.e1
@@ -121,12 +133,17 @@ class Camera:
         dx, dy, dz = tx - origin.e0, ty - origin.e1, tz - origin.e2
         k = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
         return Ray(origin, Vec3(dx * k, dy * k, dz * k))
+        # END SOLUTION
 
     def get_center_ray(self, i: int, j: int) -> Ray:
         """The ray through the center of pixel (i, j)."""
+        # BEGIN SOLUTION week03: the ray through the center of pixel (i, j)
         return self._ray_through(float(i), float(j))
+        # END SOLUTION
 
     def get_ray(self, i: int, j: int) -> Ray:
         """A ray through a uniformly random point of pixel (i, j) (a box filter)."""
+        # BEGIN SOLUTION week03: a ray through a uniformly random point of pixel (i, j)
         r = generator().random
         return self._ray_through(i + r() - 0.5, j + r() - 0.5)
+        # END SOLUTION

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from .image import OutputError, check_image_path, check_linear_path
 from .render_settings import INTEGRATOR_NAMES
-from .scene_file import MAX_MAX_DEPTH, MAX_SPP, MAX_WIDTH
+from .scene_file import MAX_MAX_DEPTH, MAX_RADIANCE, MAX_SPP, MAX_WIDTH
 
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
@@ -31,6 +31,7 @@ SETTABLE_KEYS = (
     "background",
     "sky",
     "width",
+    "mis",
 )
 
 
@@ -51,6 +52,16 @@ def non_negative_int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
     if value < 0:
         raise argparse.ArgumentTypeError(f"expected a number >= 0, got {value}")
+    return value
+
+
+MAX_WORKERS = 256  # more processes than that only exhaust the machine
+
+
+def worker_count(text: str) -> int:
+    value = positive_int(text)
+    if value > MAX_WORKERS:
+        raise argparse.ArgumentTypeError(f"expected at most {MAX_WORKERS} processes, got {value}")
     return value
 
 
@@ -82,7 +93,12 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--integrator", choices=INTEGRATOR_NAMES)
     r.add_argument("--max-depth", type=positive_int, help="most ray segments per path")
     r.add_argument("--seed", type=non_negative_int)
-    r.add_argument("--workers", type=positive_int, default=1, help="processes (default 1)")
+    r.add_argument(
+        "--workers",
+        type=worker_count,
+        default=1,
+        help=f"processes (default 1, at most {MAX_WORKERS})",
+    )
     r.add_argument(
         "--backend",
         choices=("scalar", "numpy"),
@@ -97,9 +113,82 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"override a [render] key, VALUE in TOML syntax ({', '.join(SETTABLE_KEYS)})",
     )
     r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument(
+        "--plugin",
+        action="append",
+        default=[],
+        metavar="FILE.py",
+        help="import FILE.py first (registers a student's materials by register_material)",
+    )
 
     sub.add_parser("scenes", help="list the bundled scenes")
+
+    from .bench import add_parser as add_bench_parser
+
+    add_bench_parser(sub)
+    add_assignment_commands(sub)
     return parser
+
+
+def add_assignment_commands(sub) -> None:
+    """`assignment make WEEK OUT_DIR`, `assignment map-tests`, `grade WEEK`."""
+    a = sub.add_parser("assignment", help="write a weekly assignment repository")
+    asub = a.add_subparsers(dest="assignment_command", required=True, metavar="ACTION")
+    make = asub.add_parser("make", help="write week WEEK's student repository to OUT_DIR")
+    make.add_argument("week", metavar="WEEK", help="03 to 08")
+    make.add_argument("out_dir", metavar="OUT_DIR", help="a new or empty directory")
+    m = asub.add_parser("map-tests", help="record which weeks each test file needs (slow)")
+    m.add_argument("files", nargs="*", metavar="TEST_FILE", help="only these (tests/...)")
+    g = sub.add_parser("grade", help="run a week's graders and print the score")
+    g.add_argument("week", metavar="WEEK", help="03 to 08")
+    g.add_argument("--json", metavar="RESULTS.json", help="Gradescope results file")
+
+
+def command_assignment(args: argparse.Namespace) -> int:
+    from .assignment import AssignmentError, check_week, make_assignment, map_tests
+
+    try:
+        if args.command == "grade":
+            return command_grade(check_week(args.week), args.json)
+        if args.assignment_command == "map-tests":
+            weeks = map_tests(files=tuple(args.files))
+            print(f"rtpy: {len(weeks)} test files need solution regions", file=sys.stderr)
+            return 0
+        out = make_assignment(args.week, args.out_dir)
+    except (AssignmentError, FileNotFoundError) as err:
+        print(f"rtpy: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    print(f"rtpy: wrote the week {check_week(args.week)} repository to {out}", file=sys.stderr)
+    return 0
+
+
+def command_grade(week: str, json_path: str | None) -> int:
+    """0 when every grader passes, 1 otherwise."""
+    from .grading import grade, score_table, write_json
+
+    results = grade(week)
+    print(score_table(results))
+    if json_path:
+        write_json(results, json_path)
+    passed = results["score"] == results["max_score"] and "output" not in results
+    return 0 if passed else 1
+
+
+def load_plugins(paths: list[str]) -> None:
+    """Import each file as a module (its @register_material classes become scene types)."""
+    import importlib.util
+
+    for i, name in enumerate(paths):
+        path = Path(name)
+        if path.suffix != ".py" or not path.is_file():
+            raise UsageError(f"--plugin {name}: not a .py file")
+        spec = importlib.util.spec_from_file_location(f"rtpy_plugin_{i}_{path.stem}", path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[spec.name] = module
+        try:
+            spec.loader.exec_module(module)
+        except Exception as err:
+            raise UsageError(f"--plugin {name}: {type(err).__name__}: {err}") from err
 
 
 class UsageError(Exception):
@@ -151,7 +240,7 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
         elif key in ("russian_roulette", "seed"):
             if not is_int(value) or value < 0:
                 raise fail(key, "a whole number >= 0", value)
-        elif key in ("nee", "sky"):
+        elif key in ("nee", "sky", "mis"):
             if not isinstance(value, bool):
                 raise fail(key, "true or false", value)
         elif key == "gamma":
@@ -172,15 +261,28 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
                     isinstance(c, int | float)
                     and not isinstance(c, bool)
                     and math.isfinite(c)
-                    and c >= 0
+                    and 0 <= c <= MAX_RADIANCE
                     for c in value
                 )
             )
             if not ok:
-                raise fail(key, "3 finite numbers >= 0, such as [0.1, 0.1, 0.1]", value)
+                raise fail(
+                    key, f"3 numbers in [0, {MAX_RADIANCE:g}], such as [0.1, 0.1, 0.1]", value
+                )
             value = Color(*map(float, value))
         checked[key] = value
     return checked
+
+
+def check_width(scene, path: Path, overrides: dict, option: str) -> None:
+    """A width override must give an image within the size limits with the scene's
+    aspect ratio (checked before anything is allocated)."""
+    if "width" not in overrides or scene.camera is None:
+        return
+    try:
+        scene.camera.with_width(overrides["width"])
+    except ValueError as e:
+        raise UsageError(f"{option} {overrides['width']} with {path}'s aspect ratio: {e}") from None
 
 
 def command_scenes() -> int:
@@ -193,12 +295,47 @@ def command_scenes() -> int:
     return 0
 
 
+def _first_ctrl_c(signum, frame) -> None:
+    """Ctrl-C: stop the render (the renderer keeps what is finished); a second one
+    exits at once."""
+    signal.signal(signal.SIGINT, _second_ctrl_c)
+    raise KeyboardInterrupt
+
+
+def _second_ctrl_c(signum, frame) -> None:
+    """A second Ctrl-C exits at once, without waiting for the partial image to be
+    written: worker processes are killed, temporary files removed (an output file
+    is either complete or not there)."""
+    import multiprocessing
+    import os
+
+    from .image import remove_temporary_files
+
+    for child in multiprocessing.active_children():
+        child.kill()
+    remove_temporary_files()
+    os.write(2, b"\nrtpy: interrupted again: stopped at once\n")
+    os._exit(EXIT_INTERRUPTED)
+
+
 def command_render(args: argparse.Namespace) -> int:
+    previous = signal.signal(signal.SIGINT, _first_ctrl_c)
+    try:
+        return _render(args)
+    except KeyboardInterrupt:  # before or after the render, while loading or writing
+        print("rtpy: interrupted (no file is left half-written)", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _render(args: argparse.Namespace) -> int:
     from . import render
     from .bundled import resolve_scene
     from .scene_file import SceneError, load_scene
 
     try:
+        load_plugins(args.plugin)
         path = resolve_scene(args.scene)
         scene = load_scene(path)
         overrides = validate_overrides(parse_set(args.set))
@@ -211,7 +348,8 @@ def command_render(args: argparse.Namespace) -> int:
         }
         given = {k: v for k, v in flags.items() if v is not None}
         overrides.update(validate_overrides(given, as_flags=True))
-        output = Path(args.output) if args.output else Path(f"{path.stem}.png")
+        check_width(scene, path, overrides, "--width" if args.width is not None else "--set width")
+        output = Path(args.output) if args.output is not None else Path(f"{path.stem}.png")
         check_image_path(output)
         linear = check_linear_path(args.linear) if args.linear else None
     except (SceneError, OutputError, UsageError) as err:
@@ -220,10 +358,8 @@ def command_render(args: argparse.Namespace) -> int:
 
     image = render(scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides)
 
-    # A second Ctrl-C while the partial image is written ends at once; writes
-    # are atomic, so no half-written file is left.
-    if image.interrupted:
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
+    # A Ctrl-C while the image is written (after a complete render) leaves no file:
+    # writes are atomic. After a first Ctrl-C, a second one ends at once.
     written = [image.save(output)]
     if linear is not None:
         written.append(image.save(linear))
@@ -248,6 +384,12 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)  # usage errors exit with status 2
     if args.command == "scenes":
         return command_scenes()
+    if args.command == "bench":
+        from .bench import command_bench
+
+        return command_bench(args)
+    if args.command in ("assignment", "grade"):
+        return command_assignment(args)
     return command_render(args)
 
 

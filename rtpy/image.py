@@ -105,15 +105,28 @@ def check_writable(
         if _ext(p) not in allowed:
             raise _extension_error(path, allowed, role)
     parent = p.parent
-    if not parent.exists():
-        raise OutputError(f"{where}: directory '{parent}' does not exist")
-    if not parent.is_dir():
-        raise OutputError(f"{where}: '{parent}' is not a directory")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise OutputError(f"{where}: directory '{parent}' is not writable")
-    if p.is_dir():
-        raise OutputError(f"{where}: it is an existing directory")
+    try:
+        if not parent.exists():
+            raise OutputError(f"{where}: directory '{parent}' does not exist")
+        if not parent.is_dir():
+            raise OutputError(f"{where}: '{parent}' is not a directory")
+        if not os.access(parent, os.W_OK | os.X_OK):
+            raise OutputError(f"{where}: directory '{parent}' is not writable")
+        if p.is_dir():
+            raise OutputError(f"{where}: it is an existing directory")
+        # What atomic_write will do (name too long, read-only file system, ...).
+        _temporary_file(p, delete=True).close()
+    except OSError as e:
+        raise OutputError(f"{where}: {e.strerror or e}") from None
     return p
+
+
+def _temporary_file(target: Path, delete: bool):
+    """The temporary file atomic_write writes before renaming it to target (its name
+    cut so that it is no longer than any name the file system takes)."""
+    return tempfile.NamedTemporaryFile(
+        delete=delete, dir=target.parent, prefix="." + target.name[:200] + ".", suffix=".tmp"
+    )
 
 
 def check_image_path(path: StrPath) -> Path:
@@ -182,17 +195,15 @@ def atomic_write(path: StrPath, write_fn: Callable[[Path], object]) -> Path:
     absent or with its previous content. Returns ``path`` as a :class:`Path`.
     """
     target = Path(path)
-    directory = target.parent
     try:
         # Existing targets keep their permissions; new ones get the usual umask-based
         # mode rather than the private 0o600 that tempfile uses.
         mode = stat.S_IMODE(os.stat(target).st_mode)
     except OSError:
         mode = _new_file_mode()
-    with tempfile.NamedTemporaryFile(
-        delete=False, dir=directory, prefix="." + target.name + ".", suffix=".tmp"
-    ) as tmp:
+    with _temporary_file(target, delete=False) as tmp:
         tmp_path = Path(tmp.name)
+        _temporary_files.add(tmp_path)
     try:
         write_fn(tmp_path)
         with open(tmp_path, "rb+") as f:  # make sure the data is on disk before renaming
@@ -202,7 +213,23 @@ def atomic_write(path: StrPath, write_fn: Callable[[Path], object]) -> Path:
     except BaseException:
         tmp_path.unlink(missing_ok=True)
         raise
+    finally:
+        _temporary_files.discard(tmp_path)
     return target
+
+
+# Temporary files of writes in progress, for a process that must exit at once.
+_temporary_files: set[Path] = set()
+
+
+def remove_temporary_files() -> None:
+    """Delete the temporary files of writes in progress (the targets are untouched).
+    For a signal handler that ends the process without unwinding (os._exit)."""
+    for path in list(_temporary_files):
+        try:
+            path.unlink(missing_ok=True)
+        except OSError:
+            pass
 
 
 # --------------------------------------------------------------------------- writers

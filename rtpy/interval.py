@@ -18,18 +18,24 @@ class Interval:
 
     def contains(self, x: float) -> bool:
         """min <= x <= max."""
+        # BEGIN SOLUTION week03: min <= x <= max
         return self.min <= x <= self.max
+        # END SOLUTION
 
     def surrounds(self, x: float) -> bool:
         """min < x < max (strictly inside)."""
+        # BEGIN SOLUTION week03: min < x < max
         return self.min < x < self.max
+        # END SOLUTION
 
     def clamp(self, x: float) -> float:
+        # BEGIN SOLUTION week03: x clamped into [min, max]
         if x < self.min:
             return self.min
         if x > self.max:
             return self.max
         return x
+        # END SOLUTION
 
     def is_empty(self) -> bool:
         return not self.min <= self.max

@@ -58,6 +58,7 @@ class PointLight(Light):
         self.intensity = intensity
 
     def sample(self, p: Vec3) -> LightSample | None:
+        # BEGIN SOLUTION week05: direction, distance and radiance I / d^2 seen from p
         q = self.position
         dx, dy, dz = q.e0 - p.e0, q.e1 - p.e1, q.e2 - p.e2
         dist2 = dx * dx + dy * dy + dz * dz
@@ -66,6 +67,7 @@ class PointLight(Light):
         dist = math.sqrt(dist2)
         direction = Vec3(dx / dist, dy / dist, dz / dist)
         return LightSample(direction, dist, self.intensity / dist2, 1.0, True, q)
+        # END SOLUTION
 
 
 class AreaLight(Light):

@@ -17,7 +17,9 @@ class Quad(Hittable):
     def __init__(self, q: Vec3, u: Vec3, v: Vec3, material) -> None:
         n = cross(u, v)
         n_len = n.length()
-        if not n_len > 0.0 or not math.isfinite(n_len):
+        if not math.isfinite(n_len):
+            raise ValueError("quad is too large: the area |u x v| overflows")
+        if not n_len > 0.0:
             raise ValueError("quad is degenerate: u and v are parallel or zero")
         self.q, self.u, self.v = q, u, v
         self.material = material
@@ -28,6 +30,7 @@ class Quad(Hittable):
         self._tangent = u / u.length()
 
     def _coords(self, p: Vec3) -> tuple[float, float]:
+        # BEGIN SOLUTION week04: the planar coordinates (alpha, beta) of p: p = q + alpha u + beta v
         q, w = self.q, self.w
         px, py, pz = p.e0 - q.e0, p.e1 - q.e1, p.e2 - q.e2
         u, v = self.u, self.v
@@ -43,8 +46,10 @@ class Quad(Hittable):
             + w.e2 * (u.e0 * py - u.e1 * px)
         )
         return a, b
+        # END SOLUTION
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
+        # BEGIN SOLUTION week04: plane intersection, then the interior test 0 <= alpha, beta <= 1
         n, o, d = self.normal, ray.origin, ray.direction
         denom = n.e0 * d.e0 + n.e1 * d.e1 + n.e2 * d.e2
         if denom == 0.0:
@@ -56,6 +61,7 @@ class Quad(Hittable):
         if 0.0 <= a <= 1.0 and 0.0 <= b <= 1.0:
             return t
         return None
+        # END SOLUTION
 
     def bounding_box(self) -> AABB:
         """The box around the four corners; padded, so an axis-aligned quad's box
@@ -69,8 +75,10 @@ class Quad(Hittable):
         return HitInfo(ray.at(t), n if front_face else -n, t, front_face, self.material, self)
 
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
+        # BEGIN SOLUTION week07: (u, v) = (alpha, beta) of the hit
         a, b = self._coords(hit.point)
         return min(1.0, max(0.0, a)), min(1.0, max(0.0, b))
+        # END SOLUTION
 
     def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
         return self._tangent

@@ -19,6 +19,10 @@ class RenderSettings:
     russian_roulette  segment index after which paths may end at random; 0 = off
     seed              random seed
     gamma             display gamma for 8-bit output
+    mis               "path" and "direct", with nee: True = light and BRDF sampling
+                      combined by MIS; False = next-event estimation alone (lights
+                      found only by light sampling; emission that a BRDF-sampled ray
+                      finds after a non-specular bounce is not added)
     """
 
     integrator: str = "path"
@@ -28,6 +32,7 @@ class RenderSettings:
     russian_roulette: int = 5
     seed: int = 0
     gamma: float = 2.0
+    mis: bool = True
 
     def __post_init__(self) -> None:
         if self.integrator not in INTEGRATOR_NAMES:

@@ -76,6 +76,39 @@ def render_unit(scene: Scene, camera: Camera, integrator, seed: int, unit: Unit)
     return out
 
 
+class PixelSums:
+    """The sums of finished units, added into one image as they arrive.
+
+    Each tile's batches are added in batch order (a unit that arrives before an
+    earlier batch of its tile waits), so every pixel's sum is the same for any
+    order of arrival, that is for any number of workers, and memory holds one
+    image, not every unit of the render.
+    """
+
+    def __init__(self, width: int, height: int) -> None:
+        self.total = np.zeros((height, width, 3))
+        self.counts = np.zeros((height, width), dtype=np.int64)
+        self._next_batch: dict[int, int] = {}  # tile -> the batch to add next
+        self._waiting: dict[tuple[int, int], tuple[Unit, np.ndarray]] = {}
+
+    def add(self, unit: Unit, sums: np.ndarray) -> None:
+        self._waiting[(unit.tile, unit.batch)] = (unit, sums)
+        batch = self._next_batch.get(unit.tile, 0)
+        while (unit.tile, batch) in self._waiting:
+            self._add(*self._waiting.pop((unit.tile, batch)))
+            batch += 1
+        self._next_batch[unit.tile] = batch
+
+    def finish(self) -> None:
+        """Add the units still waiting for an earlier batch (after Ctrl-C)."""
+        for key in sorted(self._waiting):
+            self._add(*self._waiting.pop(key))
+
+    def _add(self, unit: Unit, sums: np.ndarray) -> None:
+        self.total[unit.y0 : unit.y1, unit.x0 : unit.x1] += sums
+        self.counts[unit.y0 : unit.y1, unit.x0 : unit.x1] += unit.spp
+
+
 # --- worker processes -------------------------------------------------------
 _worker_state: tuple | None = None
 
@@ -119,7 +152,7 @@ class Renderer:
         settings, camera = self.settings, self.camera
         spp = 1 if make_integrator(settings).uses_center_ray else settings.spp
         units = plan_units(camera.width, camera.height, spp)
-        results: dict[tuple[int, int], np.ndarray] = {}
+        results = PixelSums(camera.width, camera.height)
         total_paths = camera.width * camera.height * spp
         bar = tqdm(
             total=total_paths,
@@ -135,7 +168,7 @@ class Renderer:
         work = self._run(units)
         try:
             for unit, sums in work:
-                results[(unit.tile, unit.batch)] = sums
+                results.add(unit, sums)
                 bar.update(sums.shape[0] * sums.shape[1] * unit.spp)
         except KeyboardInterrupt:
             interrupted = True
@@ -143,7 +176,7 @@ class Renderer:
             work.close()  # stops worker processes still running
             bar.close()
         seconds = time.perf_counter() - start
-        return self._assemble(units, results, spp, interrupted, seconds)
+        return self._assemble(results, spp, interrupted, seconds)
 
     def _run(self, units: list[Unit]):
         if self.workers == 1:
@@ -166,17 +199,10 @@ class Renderer:
         finally:
             pool.join()
 
-    def _assemble(self, units, results, spp, interrupted, seconds) -> RenderedImage:
-        camera = self.camera
-        total = np.zeros((camera.height, camera.width, 3))
-        counts = np.zeros((camera.height, camera.width), dtype=np.int64)
-        for unit in units:  # a fixed order: the sum does not depend on the workers
-            sums = results.get((unit.tile, unit.batch))
-            if sums is None:
-                continue
-            total[unit.y0 : unit.y1, unit.x0 : unit.x1] += sums
-            counts[unit.y0 : unit.y1, unit.x0 : unit.x1] += unit.spp
-        linear = total / np.maximum(counts, 1)[..., None]
+    def _assemble(self, results: PixelSums, spp, interrupted, seconds) -> RenderedImage:
+        results.finish()
+        counts = results.counts
+        linear = results.total / np.maximum(counts, 1)[..., None]
         paths = int(counts.sum())
         stats = {
             "seconds": seconds,

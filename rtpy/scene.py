@@ -15,6 +15,7 @@ from .vec3 import Color
 
 if TYPE_CHECKING:
     from .camera import Camera
+    from .environment import Environment
     from .render_settings import RenderSettings
 
 
@@ -34,6 +35,8 @@ class Scene:
 
     background  radiance of rays that escape (a constant environment)
     sky         True: the RTIOW blue-white gradient instead of `background`
+    environment an rtpy.environment.Environment (radiance by direction) that
+                replaces both; Python API only
     camera, settings  what a scene file gave (None for scenes built in code)
     """
 
@@ -46,6 +49,7 @@ class Scene:
         camera: Camera | None = None,
         settings: RenderSettings | None = None,
         name: str = "scene",
+        environment: Environment | None = None,
     ) -> None:
         self.objects: list[Hittable] = list(objects or [])
         self.point_lights: list[PointLight] = list(point_lights or [])
@@ -54,6 +58,7 @@ class Scene:
         self.camera = camera
         self.settings = settings
         self.name = name
+        self.environment = environment
         self.area_lights: list[AreaLight] = []
         self.lights: list[Light] = []
         self.update_lights()
@@ -103,6 +108,7 @@ class Scene:
                 return None
             obj, t = found
             return obj.hit_info(ray, t)
+        # BEGIN SOLUTION week04: the closest hit over all objects (earliest object wins ties)
         # Every object in list order. An object replaces the closest so far only
         # when it is strictly closer, so on equal t the earlier one stays.
         closest_t = interval.max
@@ -116,6 +122,7 @@ class Scene:
         if closest_obj is None:
             return None
         return closest_obj.hit_info(ray, closest_t)
+        # END SOLUTION
 
     def find_occlusion(
         self,
@@ -130,13 +137,17 @@ class Scene:
         t_min, t_max = interval.min, interval.max
         if not brute_force and len(self.objects) >= self.bvh_min_objects:
             return self.bvh().any_hit(ray, t_min, t_max, ignore)
+        # BEGIN SOLUTION week05: is anything on the shadow ray inside the interval?
         for obj in self.objects:
             if obj is not ignore and obj.hit_t(ray, t_min, t_max) is not None:
                 return True
         return False
+        # END SOLUTION
 
     def background_radiance(self, direction) -> Color:
         """Radiance arriving along a ray that escapes with this direction."""
+        if self.environment is not None:
+            return self.environment.radiance(direction)
         if not self.sky:
             return self.background
         # RTIOW's sky: white at the horizon to light blue overhead, by the

@@ -45,6 +45,7 @@ from .vec3 import Color, Vec3, cross
 
 __all__ = [
     "MAX_HEIGHT",
+    "MAX_RADIANCE",
     "MAX_MAX_DEPTH",
     "MAX_SPP",
     "MAX_TEXTURE_PIXELS",
@@ -82,6 +83,7 @@ RENDER_KEYS = (
     "background",
     "sky",
     "gamma",
+    "mis",
 )
 TEXTURE_KEYS = {
     "solid": ("type", "color"),
@@ -134,7 +136,14 @@ class SceneError(Exception):
             text += f" (line {self.line})"
         if self.suggestion is not None:
             text += f" — did you mean '{self.suggestion}'?"
-        return text
+        return text.translate(_ESCAPE_LINE_BREAKS)
+
+
+# A message is one line: names and strings quoted from the file keep no character
+# that str.splitlines (or a terminal) takes for a line break.
+_ESCAPE_LINE_BREAKS = str.maketrans(
+    {c: repr(c)[1:-1] for c in "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"}
+)
 
 
 def _suggest(word: str, choices: Iterable[str]) -> str | None:
@@ -371,6 +380,11 @@ class _Range:
 ANY = _Range()
 POSITIVE = _Range(0, None, lo_open=True)
 NON_NEGATIVE = _Range(0)
+# Radiance (emit, intensity, background) and the kd / ks weights are bounded so that
+# no sum of samples can overflow: a path's weight grows at most about 2x a bounce
+# with kd, ks <= 1, so even 10^6 samples of 500 bounces stay below 1e30 * 1e157.
+MAX_RADIANCE = 1e30
+RADIANCE = _Range(0, MAX_RADIANCE)
 UNIT = _Range(0, 1)
 
 # Ranges of material parameters by name, for numbers and for each colour component.
@@ -378,11 +392,11 @@ UNIT = _Range(0, 1)
 MATERIAL_RANGES: dict[str, _Range] = {
     "albedo": UNIT,
     "f0": UNIT,
-    "emit": NON_NEGATIVE,
+    "emit": RADIANCE,
     "ior": POSITIVE,
     "fuzz": NON_NEGATIVE,
-    "kd": NON_NEGATIVE,
-    "ks": NON_NEGATIVE,
+    "kd": UNIT,
+    "ks": UNIT,
     "exponent": NON_NEGATIVE,
     "roughness": POSITIVE,
     "alpha_x": POSITIVE,
@@ -765,6 +779,8 @@ class _Loader:
             )
         if "nee" in t:
             kwargs["nee"] = self.boolean(w, "nee", t["nee"])
+        if "mis" in t:
+            kwargs["mis"] = self.boolean(w, "mis", t["mis"])
         if "russian_roulette" in t:
             kwargs["russian_roulette"] = self.integer(
                 w, "russian_roulette", t["russian_roulette"], NON_NEGATIVE
@@ -773,7 +789,7 @@ class _Loader:
             kwargs["seed"] = self.integer(w, "seed", t["seed"], NON_NEGATIVE)
         if "gamma" in t:
             kwargs["gamma"] = self.number(w, "gamma", t["gamma"], POSITIVE)
-        background = self.color(w, "background", t.get("background", [0, 0, 0]), NON_NEGATIVE)
+        background = self.color(w, "background", t.get("background", [0, 0, 0]), RADIANCE)
         sky = self.boolean(w, "sky", t.get("sky", False))
         try:
             settings = RenderSettings(**kwargs)
@@ -934,8 +950,8 @@ class _Loader:
         intensity = self.color(
             w,
             "intensity",
-            self.require(w, t, "intensity", "a colour, each component >= 0"),
-            NON_NEGATIVE,
+            self.require(w, t, "intensity", f"a colour, each component in [0, {MAX_RADIANCE:g}]"),
+            RADIANCE,
         )
         return PointLight(position, intensity)
 

@@ -25,6 +25,7 @@ class Sphere(Hittable):
         self._r2 = radius * radius
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
+        # BEGIN SOLUTION week04: the smallest root t of |o + t d - c|^2 = r^2 inside (t_min, t_max)
         o, d = ray.origin, ray.direction
         dx, dy, dz = d.e0, d.e1, d.e2
         ocx, ocy, ocz = self._cx - o.e0, self._cy - o.e1, self._cz - o.e2  # origin -> center
@@ -58,6 +59,7 @@ class Sphere(Hittable):
         if t_min < t1 < t_max:
             return t1
         return None
+        # END SOLUTION
 
     def bounding_box(self) -> AABB:
         """center -+ radius on each axis, padded."""
@@ -65,6 +67,7 @@ class Sphere(Hittable):
         return AABB(Vec3(c.e0 - r, c.e1 - r, c.e2 - r), Vec3(c.e0 + r, c.e1 + r, c.e2 + r)).padded()
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
+        # BEGIN SOLUTION week04: hit point, unit normal facing the ray, front_face
         c, r = self.center, self.radius
         p = ray.at(t)
         nx, ny, nz = p.e0 - c.e0, p.e1 - c.e1, p.e2 - c.e2
@@ -76,16 +79,19 @@ class Sphere(Hittable):
         front_face = d.e0 * nx + d.e1 * ny + d.e2 * nz < 0.0
         normal = Vec3(nx, ny, nz) if front_face else Vec3(-nx, -ny, -nz)
         return HitInfo(p, normal, t, front_face, self.material, self)
+        # END SOLUTION
 
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
         """RTIOW's spherical coordinates: u = phi / (2 pi) with phi measured from -x
         around +y; v = theta / pi with theta from -y (v = 0 at the south pole)."""
+        # BEGIN SOLUTION week07: spherical (u, v) of the hit
         c, r = self.center, self.radius
         p = hit.point
         x, y, z = (p.e0 - c.e0) / r, (p.e1 - c.e1) / r, (p.e2 - c.e2) / r
         theta = math.acos(max(-1.0, min(1.0, -y)))
         phi = math.atan2(-z, x) + math.pi
         return phi / (2.0 * math.pi), theta / math.pi
+        # END SOLUTION
 
     def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
         """d(point)/du: along the circle of latitude, toward increasing phi."""

@@ -39,9 +39,11 @@ class CheckerTexture(Texture):
         self.odd = odd
 
     def value(self, hit: HitInfo) -> Color:
+        # BEGIN SOLUTION week07: 3-D checker cells
         p, k = hit.point, self.inv_scale
         cell = math.floor(p.e0 * k) + math.floor(p.e1 * k) + math.floor(p.e2 * k)
         return self.even if cell % 2 == 0 else self.odd
+        # END SOLUTION
 
 
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:
@@ -73,8 +75,10 @@ class ImageTexture(Texture):
         return cls(srgb_to_linear(data))
 
     def value(self, hit: HitInfo) -> Color:
+        # BEGIN SOLUTION week07: nearest texel at (u, v), v = 0 at the bottom row
         u = min(1.0, max(0.0, hit.u))
         v = 1.0 - min(1.0, max(0.0, hit.v))  # image rows run top to bottom
         i = min(int(u * self.width), self.width - 1)
         j = min(int(v * self.height), self.height - 1)
         return self._rows[j][i]
+        # END SOLUTION

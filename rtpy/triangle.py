@@ -32,7 +32,9 @@ class Triangle(Hittable):
         self.e2 = c - a
         n = cross(self.e1, self.e2)
         n_len = n.length()
-        if not n_len > 0.0 or not math.isfinite(n_len):
+        if not math.isfinite(n_len):
+            raise ValueError("triangle is too large: its area overflows")
+        if not n_len > 0.0:
             raise ValueError("triangle is degenerate: its vertices are collinear")
         self.normal = n / n_len
         self.material = material
@@ -44,6 +46,7 @@ class Triangle(Hittable):
     def _barycentric(self, ray: Ray) -> tuple[float, float, float] | None:
         """Moller-Trumbore: (t, u, v) of the ray's hit with the triangle's plane
         inside the triangle, or None."""
+        # BEGIN SOLUTION week04: Moller-Trumbore: (t, u, v) inside the triangle, or None
         e1, e2, o, d = self.e1, self.e2, ray.origin, ray.direction
         # p = d x e2
         px = d.e1 * e2.e2 - d.e2 * e2.e1
@@ -67,6 +70,7 @@ class Triangle(Hittable):
             return None
         t = (e2.e0 * qx + e2.e1 * qy + e2.e2 * qz) * inv
         return t, u, v
+        # END SOLUTION
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
         r = self._barycentric(ray)

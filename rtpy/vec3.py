@@ -119,32 +119,40 @@ def dot(a: Vec3, b: Vec3) -> float:
 
 
 def cross(a: Vec3, b: Vec3) -> Vec3:
+    # BEGIN SOLUTION week03: the cross product a x b
     return Vec3(
         a.e1 * b.e2 - a.e2 * b.e1,
         a.e2 * b.e0 - a.e0 * b.e2,
         a.e0 * b.e1 - a.e1 * b.e0,
     )
+    # END SOLUTION
 
 
 def unit_vector(v: Vec3) -> Vec3:
     """v / |v|. The zero vector has no direction and raises ZeroDivisionError."""
+    # BEGIN SOLUTION week03: v / |v|
     k = 1.0 / math.sqrt(v.e0 * v.e0 + v.e1 * v.e1 + v.e2 * v.e2)
     return Vec3(v.e0 * k, v.e1 * k, v.e2 * k)
+    # END SOLUTION
 
 
 def reflect(v: Vec3, n: Vec3) -> Vec3:
     """Mirror v about the plane with unit normal n (v points toward the surface)."""
+    # BEGIN SOLUTION week06: mirror v about the unit normal n
     k = 2.0 * (v.e0 * n.e0 + v.e1 * n.e1 + v.e2 * n.e2)
     return Vec3(v.e0 - k * n.e0, v.e1 - k * n.e1, v.e2 - k * n.e2)
+    # END SOLUTION
 
 
 def refract(uv: Vec3, n: Vec3, etai_over_etat: float) -> Vec3:
     """Snell refraction of the unit vector uv (pointing toward the surface) through
     the unit normal n facing it. The caller checks for total internal reflection."""
+    # BEGIN SOLUTION week06: Snell refraction of uv through n
     cos_theta = min(-dot(uv, n), 1.0)
     perp = (uv + n * cos_theta) * etai_over_etat
     parallel = n * -math.sqrt(abs(1.0 - perp.length_squared()))
     return perp + parallel
+    # END SOLUTION
 
 
 BLACK = Color(0.0, 0.0, 0.0)

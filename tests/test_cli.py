@@ -108,6 +108,21 @@ def test_overrides_reach_the_renderer(tmp_path):
     np.testing.assert_array_equal(np.load(out), expected)
 
 
+def test_set_mis_reaches_the_renderer_and_is_checked(tmp_path):
+    out = tmp_path / "o.npy"
+    args = ["render", "cornell", "--width", "12", "--spp", "2", "--seed", "3", "--quiet"]
+    assert (
+        main([*args, "-o", str(tmp_path / "o.png"), "--set", "mis=false", "--linear", str(out)])
+        == 0
+    )
+    scene = rtpy.load_scene("cornell")
+    expected = rtpy.render(scene, width=12, spp=2, seed=3, mis=False).linear
+    np.testing.assert_array_equal(np.load(out), expected)
+    assert not np.array_equal(expected, rtpy.render(scene, width=12, spp=2, seed=3).linear)
+    assert main([*args, "-o", str(tmp_path / "p.png"), "--set", "mis=2"]) == 2
+    assert not (tmp_path / "p.png").exists()
+
+
 def write(tmp_path: Path, text: str) -> Path:
     path = tmp_path / "bad.toml"
     path.write_text(text)
@@ -135,7 +150,10 @@ def test_bad_options_exit_2_and_write_nothing(tmp_path, monkeypatch, extra, mess
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("extra", [["--integrator", "pathh"], ["--spp", "-3"], ["--width", "x"]])
+@pytest.mark.parametrize(
+    "extra",
+    [["--integrator", "pathh"], ["--spp", "-3"], ["--width", "x"], ["--workers", "100000"]],
+)
 def test_argparse_errors_exit_2(extra):
     result = run_cli("render", "week08_three_balls", *extra)
     assert result.returncode == 2 and "Traceback" not in result.stderr
@@ -160,42 +178,154 @@ def test_unknown_scene_name_exits_2():
     assert result.returncode == 2 and "cornell" in result.stderr
 
 
-@pytest.mark.parametrize("workers", ["1", "2"])
-def test_ctrl_c_writes_the_finished_samples(tmp_path, workers):
+def start_render(*args: str) -> subprocess.Popen:
+    return subprocess.Popen(
+        [sys.executable, "-m", "rtpy", "render", *args], stderr=subprocess.PIPE, text=True
+    )
+
+
+def wait_for_progress(proc: subprocess.Popen, timeout: float = 90) -> str:
+    """Read the progress bar until it shows that samples are done; returns what it read."""
+    deadline = time.monotonic() + timeout
+    seen = ""
+    while time.monotonic() < deadline:
+        chunk = os.read(proc.stderr.fileno(), 4096).decode()
+        if not chunk:
+            break  # the process ended
+        seen += chunk
+        if "path" in seen and "0/" not in seen.rsplit("\r", 1)[-1]:
+            return seen
+    raise AssertionError(f"no progress within {timeout} s: {seen}")
+
+
+@pytest.mark.parametrize(
+    "backend,workers", [("scalar", "1"), ("scalar", "2"), ("numpy", "1"), ("numpy", "2")]
+)
+def test_ctrl_c_writes_the_finished_samples(tmp_path, workers, backend):
     """SIGINT to a real render: it stops, writes a valid image of the samples
     finished so far, says how many, and exits with 130."""
     out = tmp_path / "partial.png"
-    proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "rtpy",
-            "render",
-            "cornell",
-            "--width",
-            "48",
-            "--spp",
-            "256",
-            "--workers",
-            workers,
-            "-o",
-            str(out),
-        ],
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    # Wait until the first samples are done (the progress bar shows a count).
-    deadline = time.monotonic() + 60
-    seen = ""
-    while time.monotonic() < deadline:
-        seen += os.read(proc.stderr.fileno(), 4096).decode()
-        if "path" in seen and "0/" not in seen.rsplit("\r", 1)[-1]:
-            break
+    spp = "256" if backend == "scalar" else "20000"
+    proc = start_render(
+        "cornell", "--width", "48", "--spp", spp, "--workers", workers, "--backend", backend,
+        "-o", str(out),
+    )  # fmt: skip
+    seen = wait_for_progress(proc)
     time.sleep(1.0)
     proc.send_signal(signal.SIGINT)
     _, rest = proc.communicate(timeout=60)
     assert proc.returncode == 130, seen + rest
-    assert "interrupted" in rest and "of 256 samples per pixel" in rest
+    assert "interrupted" in rest and f"of {spp} samples per pixel" in rest
+    assert "Traceback" not in rest
     with Image.open(out) as im:
         assert im.size == (48, 48)
         assert np.asarray(im).max() > 0
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_second_ctrl_c_exits_at_once(tmp_path, workers):
+    """A second SIGINT while the partial image is being written ends the process at
+    once: no waiting for the write, no traceback, no worker left running, and no
+    file half-written (the output is absent, and so is its temporary file).
+
+    The naive handling (Python's default KeyboardInterrupt, or SIG_DFL set once
+    the render returns) either prints a traceback from wherever the second signal
+    lands, or dies inside the write and leaves its temporary file behind. Writing
+    this 3000x3000 partial image (PNG and .npy) takes about 3 s after one Ctrl-C;
+    the second comes 0.3 s after the first."""
+    out = tmp_path / "big.png"
+    proc = start_render(
+        "cornell", "--width", "3000", "--spp", "64", "--backend", "numpy",
+        "--workers", workers, "-o", str(out), "--linear", str(tmp_path / "big.npy"),
+    )  # fmt: skip
+    wait_for_progress(proc, timeout=120)
+    ps = subprocess.run(["ps", "-o", "pid=", "--ppid", str(proc.pid)], capture_output=True)
+    workers_pids = [int(p) for p in ps.stdout.split()]
+    assert len(workers_pids) == (2 if workers == "2" else 0)
+    proc.send_signal(signal.SIGINT)
+    time.sleep(0.3)  # the first one stops the render and starts writing
+    proc.send_signal(signal.SIGINT)
+    second = time.monotonic()
+    _, rest = proc.communicate(timeout=60)
+    elapsed = time.monotonic() - second
+    assert proc.returncode == 130, rest
+    assert "interrupted again" in rest and "Traceback" not in rest
+    assert elapsed < 1.5, f"took {elapsed:.1f} s after the second Ctrl-C"
+    assert list(tmp_path.iterdir()) == []
+    time.sleep(0.5)
+    alive = [pid for pid in workers_pids if Path(f"/proc/{pid}").exists()]
+    assert alive == [], "worker processes still running"  # killed, not orphaned
+
+
+@pytest.mark.parametrize(
+    "output,linear,message",
+    [
+        ("no/such/dir/out.png", None, "does not exist"),
+        ("a_file/out.png", None, "is not a directory"),
+        ("a_dir.png", None, "existing directory"),
+        ("x" * 300 + ".png", None, "File name too long"),
+        ("", None, "no file extension"),
+        ("out.png", "a_file/out.npy", "is not a directory"),
+        ("out.png", "a_dir.npy", "existing directory"),
+    ],
+)
+def test_unwritable_output_is_reported_before_rendering(
+    tmp_path, monkeypatch, capsys, output, linear, message
+):
+    """Output paths are checked before the render starts (CI runs as root, so
+    read-only directories are not tested; a file used as a directory, a missing
+    directory, a directory as the path and a name the file system refuses are).
+    The naive check (does the parent exist?) lets a name too long for the file
+    system through, and the render's hours are lost when the write fails."""
+    (tmp_path / "a_file").write_text("not a directory")
+    (tmp_path / "a_dir.png").mkdir()
+    (tmp_path / "a_dir.npy").mkdir()
+    before = sorted(p.name for p in tmp_path.iterdir())
+    monkeypatch.chdir(tmp_path)
+    rendered = []
+    monkeypatch.setattr(rtpy, "render", lambda *a, **k: rendered.append(1))
+    argv = ["render", "cornell", *SMALL, "-o", output]
+    if linear is not None:
+        argv += ["--linear", linear]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("rtpy: error: cannot write") and message in err
+    assert rendered == []
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_unwritable_output_real_subprocess_says_so_at_once(tmp_path):
+    """As a user runs it: a 30-minute render with a bad output path fails at once."""
+    (tmp_path / "a_file").write_text("")
+    start = time.monotonic()
+    result = run_cli(
+        "render", "cornell", "--spp", "100000", "-o", str(tmp_path / "a_file" / "x.png")
+    )
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.strip().splitlines() == [
+        f"rtpy: error: cannot write '{tmp_path / 'a_file' / 'x.png'}': "
+        f"'{tmp_path / 'a_file'}' is not a directory"
+    ]
+    assert time.monotonic() - start < 30
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
+def test_render_with_a_student_plugin_material(tmp_path):
+    """--plugin FILE.py imports the file; its @register_material class is a scene type."""
+    (tmp_path / "student.py").write_text(
+        "from rtpy.materials import Lambertian, register_material\n"
+        "from rtpy.vec3 import Color\n\n"
+        '@register_material("half_grey")\n'
+        "class HalfGrey(Lambertian):\n"
+        "    def __init__(self, level: float = 0.5):\n"
+        "        super().__init__(Color(level, level, level))\n"
+    )
+    (tmp_path / "scene.toml").write_text(
+        '[render]\nintegrator = "center"\n[materials.m]\ntype = "half_grey"\nlevel = 0.25\n'
+        '[[objects]]\ntype = "sphere"\ncenter = [0, 0, -1]\nradius = 0.5\nmaterial = "m"\n'
+    )
+    out = tmp_path / "out.npy"
+    args = ["render", str(tmp_path / "scene.toml"), "--width", "8", "--quiet"]
+    assert main([*args, "-o", str(tmp_path / "o.png"), "--linear", str(out)]) == 2  # unknown type
+    args += ["--plugin", str(tmp_path / "student.py")]
+    assert main([*args, "-o", str(tmp_path / "o.png"), "--linear", str(out)]) == 0
+    assert np.load(out)[2, 4].tolist() == [0.25, 0.25, 0.25]  # the ball's center pixel
+    assert main([*args[:-1], str(tmp_path / "missing.py"), "-o", str(tmp_path / "p.png")]) == 2

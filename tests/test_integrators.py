@@ -7,6 +7,7 @@ Bonferroni-corrected where several tests are made at once).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import statistics
 
@@ -28,6 +29,16 @@ from rtpy import (
     Sphere,
     Vec3,
 )
+from rtpy.analytic_scenes import (
+    PLANE_ALBEDO,
+    POINT_LIGHT_INTENSITY,
+    POINT_LIGHT_POSITION,
+    GlowingLambertian,
+    furnace_scene,
+    pixels_fully_off_sphere,
+    pixels_fully_on_sphere,
+    plane_point_light,
+)
 from rtpy.integrators import INTEGRATORS, make_integrator
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import dot, unit_vector
@@ -46,14 +57,13 @@ def z_limit(n_tests: int, alpha: float = 1e-4) -> float:
 def test_point_light_on_plane_is_exact_per_pixel():
     """direct = albedo/pi * I * cos(theta) / d^2 at every pixel's center ray.
     The course code has no 1/d^2 and an unnormalised cosine: both would fail."""
-    albedo, intensity = 0.6, Color(5.0, 2.5, 1.0)
-    light_pos = Vec3(0.3, 2.0, -0.5)
-    plane = Quad(Vec3(-50, 0, -50), Vec3(100, 0, 0), Vec3(0, 0, 100), None)
-    plane.material = Lambertian(Color(albedo, albedo, albedo))
-    # Quad(q, u, v) with u x v pointing down; a Lambertian plane is two-sided,
+    # The plane's quad has u x v pointing down; a Lambertian plane is two-sided,
     # which the test relies on only through hit.normal facing the camera.
-    scene = Scene([plane], [PointLight(light_pos, intensity)])
-    camera = Camera(Vec3(0, 3, 2), Vec3(0, 0, -1), vfov=70, aspect_ratio=1.5, width=30)
+    analytic = plane_point_light()
+    scene, camera = analytic.scene, analytic.camera
+    albedo, intensity = PLANE_ALBEDO, POINT_LIGHT_INTENSITY
+    light_pos = POINT_LIGHT_POSITION
+    assert scene.point_lights[0].intensity == intensity
     integrator = make_integrator(RenderSettings(integrator="direct"))
     checked = 0
     with use_generator(make_generator(7)):
@@ -70,7 +80,7 @@ def test_point_light_on_plane_is_exact_per_pixel():
                 to_light = (light_pos.e0 - p[0], light_pos.e1, light_pos.e2 - p[2])
                 d2 = sum(c * c for c in to_light)
                 cos_theta = to_light[1] / math.sqrt(d2)
-                for ch, inten in enumerate((5.0, 2.5, 1.0)):
+                for ch, inten in enumerate((intensity.e0, intensity.e1, intensity.e2)):
                     expected = albedo / math.pi * inten * cos_theta / d2
                     assert got[ch] == pytest.approx(expected, rel=1e-9)
                 checked += 1
@@ -78,37 +88,6 @@ def test_point_light_on_plane_is_exact_per_pixel():
 
 
 # --- furnace tests -----------------------------------------------------------
-
-
-def furnace_scene(material) -> tuple[Scene, Camera]:
-    scene = Scene([Sphere(Vec3(0, 0, -3), 1.0, material)], background=Color(1.0, 1.0, 1.0))
-    camera = Camera(Vec3(0, 0, 0), Vec3(0, 0, -3), vfov=50, aspect_ratio=1.0, width=24)
-    return scene, camera
-
-
-def pixels_fully_on_sphere(camera: Camera, scene: Scene) -> np.ndarray:
-    """Mask of pixels whose whole footprint sees the sphere (all 4 corners hit)."""
-    mask = np.zeros((camera.height, camera.width), dtype=bool)
-    sphere = scene.objects[0]
-    for j in range(camera.height):
-        for i in range(camera.width):
-            corners = [
-                camera._ray_through(i + dx, j + dy) for dx in (-0.5, 0.5) for dy in (-0.5, 0.5)
-            ]
-            mask[j, i] = all(sphere.hit_t(r, 0.0, math.inf) is not None for r in corners)
-    return mask
-
-
-def pixels_fully_off_sphere(camera: Camera, scene: Scene) -> np.ndarray:
-    mask = np.zeros((camera.height, camera.width), dtype=bool)
-    sphere = scene.objects[0]
-    for j in range(camera.height):
-        for i in range(camera.width):
-            corners = [
-                camera._ray_through(i + dx, j + dy) for dx in (-0.5, 0.5) for dy in (-0.5, 0.5)
-            ]
-            mask[j, i] = not any(sphere.hit_t(r, 0.0, math.inf) is not None for r in corners)
-    return mask
 
 
 @pytest.mark.parametrize(
@@ -121,7 +100,8 @@ def test_furnace_convex_lambertian_sphere_shows_its_albedo(integrator, nee):
     a = 0.7
     scene, camera = furnace_scene(Lambertian(Color(a, 0.5 * a, 0.25)))
     image = rtpy.render(scene, camera=camera, integrator=integrator, nee=nee, spp=4, max_depth=6)
-    on, off = pixels_fully_on_sphere(camera, scene), pixels_fully_off_sphere(camera, scene)
+    sphere = scene.objects[0]
+    on, off = pixels_fully_on_sphere(camera, sphere), pixels_fully_off_sphere(camera, sphere)
     assert on.sum() > 50 and off.sum() > 50
     np.testing.assert_allclose(
         image.linear[on], np.broadcast_to([a, 0.5 * a, 0.25], (on.sum(), 3)), rtol=1e-12
@@ -136,19 +116,6 @@ def test_furnace_glass_sphere_conserves_energy(integrator):
     scene, camera = furnace_scene(Dielectric(1.5))
     image = rtpy.render(scene, camera=camera, integrator=integrator, spp=4, max_depth=40)
     np.testing.assert_allclose(image.linear, 1.0, atol=1e-6)
-
-
-class GlowingLambertian(Lambertian):
-    """Diffuse reflection plus uniform emission Le from both faces."""
-
-    is_emitter = True
-
-    def __init__(self, albedo: Color, emit: Color) -> None:
-        super().__init__(albedo)
-        self.emit = emit
-
-    def emitting(self, hit):
-        return self.emit
 
 
 @pytest.mark.parametrize("nee", [True, False])
@@ -217,20 +184,58 @@ def sample_mean(integrator, ray, scene, n, seed):
     return statistics.fmean(values), statistics.stdev(values) / math.sqrt(n)
 
 
-def test_path_with_and_without_nee_agree():
-    """BRDF sampling alone and MIS with light sampling estimate the same integral:
-    per-ray means agree within the measured noise. Light counted twice (the course
-    code's bug) or a wrong MIS weight would shift the MIS estimate."""
-    scene, rays = box_scene()
-    with_nee = make_integrator(RenderSettings(nee=True, max_depth=5))
-    without = make_integrator(RenderSettings(nee=False, max_depth=5))
-    limit = z_limit(len(rays))
+def per_ray_z(scene, rays, a, b, n_a, n_b, seed_a, seed_b, while_b=contextlib.nullcontext):
+    """For each ray: (z of mean_a - mean_b, mean_a, se_a, mean_b, se_b), the b
+    estimates made inside the context while_b()."""
+    out = []
     for k, ray in enumerate(rays):
-        m1, s1 = sample_mean(with_nee, ray, scene, 1500, seed=100 + k)
-        m2, s2 = sample_mean(without, ray, scene, 4000, seed=200 + k)
-        z = (m1 - m2) / math.hypot(s1, s2)
-        assert abs(z) < limit, f"ray {k}: nee {m1:.4f}+-{s1:.4f} vs brdf {m2:.4f}+-{s2:.4f}"
-        assert m1 > 0
+        m1, s1 = sample_mean(a, ray, scene, n_a, seed=seed_a + k)
+        with while_b():
+            m2, s2 = sample_mean(b, ray, scene, n_b, seed=seed_b + k)
+        out.append(((m1 - m2) / math.hypot(s1, s2), m1, s1, m2, s2))
+    return out
+
+
+@pytest.mark.parametrize(
+    "variant,n_variant,seeds",
+    [({"nee": False}, 4000, (100, 200)), ({"mis": False}, 1500, (300, 400))],
+    ids=["brdf-only", "nee-only"],
+)
+def test_path_variants_agree_with_mis(variant, n_variant, seeds):
+    """BRDF sampling alone (nee = false), light sampling alone (mis = false) and MIS
+    estimate the same integral: per-ray means agree within the measured noise (the
+    box scene has an area and a point light). Light counted twice (the course
+    code's bug) or a wrong MIS weight would shift one of them."""
+    scene, rays = box_scene()
+    mis = make_integrator(RenderSettings(max_depth=5))
+    other = make_integrator(RenderSettings(max_depth=5, **variant))
+    limit = z_limit(len(rays))
+    zs = per_ray_z(scene, rays, mis, other, 1500, n_variant, *seeds)
+    for k, (z, m1, s1, m2, s2) in enumerate(zs):
+        assert abs(z) < limit, f"ray {k}: mis {m1:.4f}+-{s1:.4f} vs {variant} {m2:.4f}+-{s2:.4f}"
+        assert m2 > 0
+
+
+def test_nee_only_comparison_catches_dropped_brdf_emission_weight():
+    """The comparison above has power: nee-only that also adds BRDF-found emission
+    with weight 1 (counting area light twice) is rejected."""
+    from rtpy.integrators import path
+
+    scene, rays = box_scene()
+    mis = make_integrator(RenderSettings(max_depth=5))
+    bad = make_integrator(RenderSettings(mis=False, max_depth=5))
+
+    @contextlib.contextmanager
+    def counting_twice():  # only while the nee-only integrator runs
+        original = path.emission_weight
+        path.emission_weight = lambda *args: 1.0
+        try:
+            yield
+        finally:
+            path.emission_weight = original
+
+    zs = per_ray_z(scene, rays, mis, bad, 1500, 1500, 300, 400, counting_twice)
+    assert max(abs(z[0]) for z in zs) > z_limit(len(rays))
 
 
 def test_mis_catches_light_counted_twice():

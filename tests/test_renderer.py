@@ -7,7 +7,7 @@ import pytest
 
 import rtpy
 from rtpy import Camera, Color, DiffuseLight, Lambertian, Metal, Scene, Sphere, Vec3
-from rtpy.renderer import plan_units
+from rtpy.renderer import PixelSums, plan_units
 
 
 @pytest.mark.parametrize("width,height,spp", [(1, 1, 1), (16, 16, 16), (37, 21, 5), (40, 3, 64)])
@@ -81,3 +81,37 @@ def test_ctrl_c_keeps_finished_samples():
     # Every pixel holds some finished samples: no black holes in the image.
     assert (image.linear.sum(axis=2) > 0).all()
     assert np.isfinite(image.linear).all()
+
+
+def test_pixel_sums_do_not_depend_on_the_order_units_arrive_in():
+    """Workers finish units in any order; PixelSums adds each tile's batches in batch
+    order, so the image is bit for bit the same (adding in arrival order is not:
+    float addition is not associative), and a unit is kept only until it is added."""
+    units = plan_units(40, 20, 6)
+    rng = np.random.default_rng(1)
+    sums = [
+        rng.random((u.y1 - u.y0, u.x1 - u.x0, 3)) * 10.0 ** rng.integers(-8, 8) for u in units
+    ]
+    in_order, shuffled = PixelSums(40, 20), PixelSums(40, 20)
+    naive = np.zeros((20, 40, 3))
+    for unit, s in zip(units, sums, strict=True):
+        in_order.add(unit, s)
+    for i in rng.permutation(len(units)):
+        shuffled.add(units[i], sums[i])
+        u = units[i]
+        naive[u.y0 : u.y1, u.x0 : u.x1] += sums[i]
+    assert not shuffled._waiting and not in_order._waiting  # everything added
+    np.testing.assert_array_equal(shuffled.total, in_order.total)
+    np.testing.assert_array_equal(shuffled.counts, np.full((20, 40), 6))
+    assert not np.array_equal(naive, in_order.total)
+
+
+def test_pixel_sums_after_ctrl_c_add_the_units_that_wait_for_an_earlier_batch():
+    units = plan_units(16, 16, 3)  # one tile, batches 0, 1, 2
+    acc = PixelSums(16, 16)
+    acc.add(units[0], np.ones((16, 16, 3)))
+    acc.add(units[2], np.full((16, 16, 3), 4.0))  # batch 1 never finished
+    assert acc.counts.max() == 1
+    acc.finish()
+    np.testing.assert_array_equal(acc.total, 5.0)
+    np.testing.assert_array_equal(acc.counts, 2)

@@ -14,7 +14,7 @@ from PIL import Image
 
 from rtpy import bundled
 from rtpy.bundled import bundled_dir, bundled_scenes, resolve_scene
-from rtpy.camera import Camera
+from rtpy.camera import MAX_PIXELS, Camera
 from rtpy.light import PointLight
 from rtpy.materials import Dielectric, DiffuseLight, Lambertian, Metal, Mirror
 from rtpy.quad import Quad
@@ -625,8 +625,13 @@ def test_absurd_sizes_are_refused_with_the_limits():
     assert_names(err, "[render]", "max_depth")
     err = error_of(f"[camera]\nwidth = {2**70}\n")
     assert_names(err, "[camera]", "width")
+    err = error_of(f"[camera]\nwidth = {MAX_WIDTH}\naspect_ratio = 1\n")
+    assert_names(err, "[camera]", "width")
+    assert f"{MAX_PIXELS:,}" in str(err)
     # the largest allowed sizes still load (nothing is rendered)
-    scene = load(f"[camera]\nwidth = {MAX_WIDTH}\naspect_ratio = 1\n[render]\nspp = {MAX_SPP}\n")
+    scene = load(f"[camera]\nwidth = {MAX_WIDTH}\naspect_ratio = 8\n[render]\nspp = {MAX_SPP}\n")
+    assert scene.camera.width * scene.camera.height == MAX_PIXELS
+    scene = load(f"[camera]\nwidth = 2\naspect_ratio = {2 / MAX_HEIGHT}\n")
     assert scene.camera.height == MAX_HEIGHT
 
 
@@ -997,3 +1002,13 @@ def test_every_bundled_scene_loads(path):
     assert scene.objects, f"{path.name} has no objects"
     assert scene.name == path.stem
     assert re.fullmatch(r"#\s*\S.*", path.read_text(encoding="utf-8").splitlines()[0])
+
+
+def test_mis_key_is_a_boolean_defaulting_to_true():
+    assert load("").settings.mis is True
+    assert load("[render]\nmis = false\n").settings.mis is False
+    err = error_of("[render]\nmis = 0\n")
+    assert_names(err, "[render]", "mis")
+    assert "true or false" in str(err)
+    err = error_of("[render]\nmiss = false\n")
+    assert_names(err, "[render]", "miss", "mis")

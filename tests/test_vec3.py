@@ -25,7 +25,9 @@ def comps(v: Vec3) -> tuple[float, float, float]:
 
 
 def norm(v: Vec3) -> float:
-    return math.sqrt(v.e0 * v.e0 + v.e1 * v.e1 + v.e2 * v.e2)
+    # hypot, not sqrt of the squares: those underflow to 0 for components below 1e-154,
+    # and a tolerance scaled by a zero norm fails a correct cross product.
+    return math.hypot(v.e0, v.e1, v.e2)
 
 
 def close_vec(a: Vec3, b: Vec3, abs_tol: float) -> bool:

@@ -11,6 +11,7 @@ from .integrator import FORWARD, Integrator
 def flat_color(ray: Ray, scene: Scene) -> Color:
     """Emitted radiance if the ray hits an emitter's emitting face, else the
     albedo (texture value) of the surface hit, else the background."""
+    # BEGIN SOLUTION week03: emission, else albedo of the first hit, else the background
     hit = scene.find_intersection(ray, FORWARD)
     if hit is None:
         return scene.background_radiance(ray.direction)
@@ -20,6 +21,7 @@ def flat_color(ray: Ray, scene: Scene) -> Color:
         if not emitted.is_black():
             return emitted
     return material.flat_color(hit)
+    # END SOLUTION
 
 
 class CenterIntegrator(Integrator):

@@ -12,13 +12,16 @@ from .integrator import FORWARD, Integrator
 class DirectIntegrator(Integrator):
     """Emission seen directly plus light arriving after one reflection, from
     point and area lights (with shadow rays) and the background. No indirect
-    bounce. This is exactly the "path" estimator with max_depth = 2."""
+    bounce. This is exactly the "path" estimator with max_depth = 2 (mis = False
+    included)."""
 
     name = "direct"
 
     def radiance(self, ray: Ray, scene: Scene) -> Color:
+        # BEGIN SOLUTION week05: emission plus direct lighting at the first hit
         hit = scene.find_intersection(ray, FORWARD)
         if hit is None:
             return scene.background_radiance(ray.direction)
         emitted = hit.material.emitting(hit)
-        return emitted + direct_lighting(scene, ray, hit)
+        return emitted + direct_lighting(scene, ray, hit, self.settings.mis)
+        # END SOLUTION

@@ -23,16 +23,21 @@ class PathIntegrator(Integrator):
     and is then divided by q, which ends weak paths early without bias.
     With nee = False, area lights are found only by BRDF sampling (the course's
     week-5 "random scattering"); point lights can only be reached by sampling
-    them, so they are still sampled.
+    them, so they are still sampled. With mis = False (and nee on), lights are
+    found only by light sampling: emission that a BRDF-sampled ray meets after a
+    non-specular bounce is not added (after the camera or a specular bounce it is,
+    since no light sampling happened there).
     """
 
     name = "path"
 
     def radiance(self, ray: Ray, scene: Scene) -> Color:
+        # BEGIN SOLUTION week08: path loop: emission (MIS), light sampling, throughput, roulette
         settings = self.settings
         max_depth, rr_start = settings.max_depth, settings.russian_roulette
         lights = scene.lights if settings.nee else scene.point_lights
         n_mis = len(lights) if settings.nee else 0  # lights that MIS weights account for
+        mis = settings.mis
         result = Color(0.0, 0.0, 0.0)
         beta = Color(1.0, 1.0, 1.0)
         prev_point, prev_pdf, prev_specular = None, 0.0, True  # the camera "bounce"
@@ -46,12 +51,12 @@ class PathIntegrator(Integrator):
             if material.is_emitter:
                 emitted = material.emitting(hit)
                 if not emitted.is_black():
-                    w = emission_weight(scene, hit, prev_point, prev_pdf, prev_specular, n_mis)
+                    w = emission_weight(scene, hit, prev_point, prev_pdf, prev_specular, n_mis, mis)
                     result = result + beta * emitted * w
             if segment >= max_depth:
                 break
             if lights and not material.is_specular:
-                result = result + beta * sample_one_light(scene, ray, hit, lights)
+                result = result + beta * sample_one_light(scene, ray, hit, lights, mis)
             scatter = material.scattering(ray, hit)
             if scatter is None:
                 break
@@ -67,3 +72,4 @@ class PathIntegrator(Integrator):
                 beta = beta / survive
             segment += 1
         return result
+        # END SOLUTION

@@ -53,21 +53,26 @@ class BlinnPhong(GlossyMaterial):
         self.exponent = check_exponent(exponent)
 
     def specular(self, wo: Local, wi: Local) -> Color:
+        # BEGIN SOLUTION week08: the Blinn-Phong lobe (n + 8) / (8 pi) (n . h)^n
         hx, hy, hz = wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]
         length = math.sqrt(hx * hx + hy * hy + hz * hz)
         cos_h = hz / length  # wo and wi above the surface, so hz > 0
         n = self.exponent
         return WHITE * ((n + 8.0) * INV_EIGHT_PI * cos_h**n)
+        # END SOLUTION
 
     def sample_specular(self, wo: Local, r1: float, r2: float) -> Local | None:
+        # BEGIN SOLUTION week08: sample a half vector, reflect wo about it
         hx, hy, hz = sample_cosine_power(self.exponent, r1, r2)
         wo_h = wo[0] * hx + wo[1] * hy + wo[2] * hz
         if wo_h <= 0.0:
             return None
         k = 2.0 * wo_h
         return k * hx - wo[0], k * hy - wo[1], k * hz - wo[2]
+        # END SOLUTION
 
     def specular_pdf(self, wo: Local, wi: Local) -> float:
+        # BEGIN SOLUTION week08: the half-vector density / (4 wo . h)
         hx, hy, hz = wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]
         length = math.sqrt(hx * hx + hy * hy + hz * hz)
         if length == 0.0:
@@ -76,3 +81,4 @@ class BlinnPhong(GlossyMaterial):
         if wo_h <= 0.0:
             return 0.0
         return cosine_power_pdf(self.exponent, hz / length) / (4.0 * wo_h)
+        # END SOLUTION

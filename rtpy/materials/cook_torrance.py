@@ -65,9 +65,11 @@ MIN_ALPHA = 1e-4
 
 def schlick_fresnel(f0: Color, cosine: float) -> Color:
     """Schlick's Fresnel reflectance F0 + (1 - F0) (1 - cos)^5, per colour channel."""
+    # BEGIN SOLUTION week08: Schlick's F per colour channel
     c = min(1.0, max(0.0, cosine))
     m = (1.0 - c) ** 5
     return Color(f0.e0 + (1.0 - f0.e0) * m, f0.e1 + (1.0 - f0.e1) * m, f0.e2 + (1.0 - f0.e2) * m)
+    # END SOLUTION
 
 
 def f0_from_ior(ior: float) -> float:
@@ -140,6 +142,7 @@ class CookTorrance(GlossyMaterial):
 
     def D(self, h: Local) -> float:
         """Microfacet density along the unit half vector h (0 below the surface)."""
+        # BEGIN SOLUTION week08: GGX and Beckmann normal distributions
         cos2 = h[2] * h[2]
         if h[2] <= 0.0 or cos2 == 0.0:
             return 0.0
@@ -156,9 +159,11 @@ class CookTorrance(GlossyMaterial):
         if exponent > 700.0:  # exp underflows; the cos^4 below would lose to it anyway
             return 0.0
         return math.exp(-exponent) / (math.pi * a2 * cos2 * cos2)
+        # END SOLUTION
 
     def G1(self, v: Local) -> float:
         """Smith's masking of the unit direction v (1 at the normal, 0 at grazing)."""
+        # BEGIN SOLUTION week08: Smith masking G1 for GGX and Beckmann
         cos = v[2]
         if cos <= 0.0:
             return 0.0
@@ -175,6 +180,7 @@ class CookTorrance(GlossyMaterial):
         # erf(a) - 1 = -erfc(a), without the cancellation for large a.
         lam = 0.5 * (INV_SQRT_PI * math.exp(-a * a) / a - math.erfc(a))
         return 1.0 / (1.0 + max(0.0, lam))
+        # END SOLUTION
 
     def G(self, wo: Local, wi: Local) -> float:
         """Shadowing-masking: the separable Smith product G1(wi) G1(wo)."""
@@ -186,6 +192,7 @@ class CookTorrance(GlossyMaterial):
 
     # --- the lobe, its sampling and its density -------------------------------------
     def specular(self, wo: Local, wi: Local) -> Color:
+        # BEGIN SOLUTION week08: D G F / (4 cos_i cos_o)
         cos_o, cos_i = wo[2], wi[2]
         if cos_o <= 0.0 or cos_i <= 0.0:
             return Color(0.0, 0.0, 0.0)
@@ -198,6 +205,7 @@ class CookTorrance(GlossyMaterial):
         # about 2 / alpha) even where the product cos_i cos_o would underflow to 0.
         visibility = (self.G1(wi) / cos_i) * (self.G1(wo) / cos_o) * 0.25
         return self.F(wo_h) * (self.D(h) * visibility)
+        # END SOLUTION
 
     def sample_half_vector(self, r1: float, r2: float) -> Local:
         """A half vector with density D(h) cos(theta_h), from two uniform numbers in [0, 1).
@@ -207,6 +215,7 @@ class CookTorrance(GlossyMaterial):
             Beckmann: tan^2(theta_h) = -alpha^2 ln(1 - r1)
         and phi_h = 2 pi r2 (D is the same in every direction around the normal).
         """
+        # BEGIN SOLUTION week08: a half vector with density D(h) cos(theta_h)
         a2 = self.alpha * self.alpha
         if self.distribution == "ggx":
             tan2 = a2 * r1 / (1.0 - r1)
@@ -216,6 +225,7 @@ class CookTorrance(GlossyMaterial):
         sin = math.sqrt(tan2) * cos
         phi = 2.0 * math.pi * r2
         return sin * math.cos(phi), sin * math.sin(phi), cos
+        # END SOLUTION
 
     def sample_specular(self, wo: Local, r1: float, r2: float) -> Local | None:
         hx, hy, hz = self.sample_half_vector(r1, r2)
@@ -228,6 +238,7 @@ class CookTorrance(GlossyMaterial):
     def specular_pdf(self, wo: Local, wi: Local) -> float:
         """D(h) cos(theta_h) / (4 (wo . h)): the half vector's density times the
         Jacobian d(w_h) / d(w_i) = 1 / (4 (wo . h)) of the reflection wi = reflect(wo, h)."""
+        # BEGIN SOLUTION week08: D(h) cos(theta_h) / (4 wo . h)
         h = _half_vector(wo, wi)
         if h is None:
             return 0.0
@@ -235,6 +246,7 @@ class CookTorrance(GlossyMaterial):
         if wo_h <= 0.0:
             return 0.0
         return self.D(h) * h[2] / (4.0 * wo_h)
+        # END SOLUTION
 
 
 def _half_vector(wo: Local, wi: Local) -> Local | None:

@@ -16,9 +16,11 @@ from .material import Material, as_texture
 def schlick(cosine: float, ior_ratio: float) -> float:
     """Schlick's approximation of the Fresnel reflectance at incidence cosine
     `cosine` for a relative index of refraction `ior_ratio`."""
+    # BEGIN SOLUTION week06: Schlick's Fresnel approximation
     r0 = (1.0 - ior_ratio) / (1.0 + ior_ratio)
     r0 = r0 * r0
     return r0 + (1.0 - r0) * (1.0 - cosine) ** 5
+    # END SOLUTION
 
 
 class Dielectric(Material):
@@ -40,6 +42,7 @@ class Dielectric(Material):
 
     def _split(self, ray_in: Ray, hit: HitInfo) -> tuple[float, Ray, Ray | None]:
         """(R, reflected ray, refracted ray or None under total internal reflection)."""
+        # BEGIN SOLUTION week06: (R, reflected ray, refracted ray or None under TIR)
         ratio = 1.0 / self.ior if hit.front_face else self.ior  # eta_incident / eta_transmitted
         d, n = ray_in.direction, hit.normal
         cos_theta = min(-(d.e0 * n.e0 + d.e1 * n.e1 + d.e2 * n.e2), 1.0)
@@ -49,13 +52,16 @@ class Dielectric(Material):
             return 1.0, reflected, None
         refracted = spawn_ray(hit.point, n, refract(d, n, ratio))
         return schlick(max(0.0, cos_theta), ratio), reflected, refracted
+        # END SOLUTION
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
+        # BEGIN SOLUTION week06: reflect with probability R, else refract
         reflectance, reflected, refracted = self._split(ray_in, hit)
         albedo = self.albedo.value(hit)
         if refracted is None or random_double() < reflectance:
             return ScatterInfo(reflected, albedo, 0.0, True)
         return ScatterInfo(refracted, albedo, 0.0, True)
+        # END SOLUTION
 
     def specular_rays(self, ray_in: Ray, hit: HitInfo) -> list[tuple[Ray, Color]]:
         reflectance, reflected, refracted = self._split(ray_in, hit)

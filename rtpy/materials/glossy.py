@@ -101,6 +101,7 @@ class GlossyMaterial(Material):
         return self._pdf(self.diffuse_probability(self.albedo.value(hit)), wo, wi)
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
+        # BEGIN SOLUTION week08: pick a lobe, sample it; weight = BRDF * cos / pdf of the mixture
         frame = self.frame(hit)
         wo = frame.to_local(-ray_in.direction)
         if wo[2] <= 0.0:
@@ -120,3 +121,4 @@ class GlossyMaterial(Material):
         weight = self._f(albedo, wo, wi) * (wi[2] / pdf)
         direction = frame.to_world(*wi)
         return ScatterInfo(spawn_ray(hit.point, hit.normal, direction), weight, pdf)
+        # END SOLUTION

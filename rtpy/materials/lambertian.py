@@ -27,17 +27,21 @@ class Lambertian(Material):
         self.albedo = as_texture(albedo)
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
+        # BEGIN SOLUTION week05: cosine-weighted direction, weight = BRDF * cos / pdf
         x, y, z = random_cosine_direction()
         direction = local_to_world(hit.normal, x, y, z)
         return ScatterInfo(
             spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), z * INV_PI
         )
+        # END SOLUTION
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
+        # BEGIN SOLUTION week05: f_r = albedo / pi above the surface
         n, wi = hit.normal, ray_light.direction
         if n.e0 * wi.e0 + n.e1 * wi.e1 + n.e2 * wi.e2 <= 0.0:
             return BLACK  # light below the surface
         return self.albedo.value(hit) * INV_PI
+        # END SOLUTION
 
     def pdf(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> float:
         n, wi = hit.normal, ray_light.direction

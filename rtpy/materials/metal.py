@@ -29,6 +29,7 @@ class Metal(Material):
         self.fuzz = fuzz
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
+        # BEGIN SOLUTION week07: reflection plus fuzz * random unit vector
         direction = reflect(ray_in.direction, hit.normal)
         if self.fuzz > 0.0:
             direction = direction + random_unit_vector() * self.fuzz
@@ -40,6 +41,7 @@ class Metal(Material):
         return ScatterInfo(
             spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), 0.0, True
         )
+        # END SOLUTION
 
     def specular_rays(self, ray_in: Ray, hit: HitInfo) -> list[tuple[Ray, Color]]:
         # Whitted follows the perfect reflection and ignores fuzz.

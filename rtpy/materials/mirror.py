@@ -20,10 +20,12 @@ class Mirror(Material):
         self.albedo = as_texture(albedo)
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
+        # BEGIN SOLUTION week06: the perfect mirror ray, weight albedo
         direction = reflect(ray_in.direction, hit.normal)
         return ScatterInfo(
             spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), 0.0, True
         )
+        # END SOLUTION
 
     def specular_rays(self, ray_in: Ray, hit: HitInfo) -> list[tuple[Ray, Color]]:
         s = self.scattering(ray_in, hit)

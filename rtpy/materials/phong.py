@@ -38,18 +38,22 @@ def sample_cosine_power(exponent: float, r1: float, r2: float) -> Local:
     Inverting the cumulative distribution of cos(theta), 1 - cos^(n+1), gives
     cos(theta) = r1^(1 / (n + 1)); the azimuth is uniform.
     """
+    # BEGIN SOLUTION week08: a direction with density (n + 1) / (2 pi) cos^n
     cos_theta = r1 ** (1.0 / (exponent + 1.0))
     sin_theta = math.sqrt(max(0.0, 1.0 - cos_theta * cos_theta))
     phi = 2.0 * math.pi * r2
     return sin_theta * math.cos(phi), sin_theta * math.sin(phi), cos_theta
+    # END SOLUTION
 
 
 def cosine_power_pdf(exponent: float, cos_theta: float) -> float:
     """Density of sample_cosine_power at a direction cos_theta from the axis
     (0 outside the hemisphere around the axis)."""
+    # BEGIN SOLUTION week08: the density (n + 1) / (2 pi) cos^n
     if cos_theta <= 0.0:
         return 0.0
     return (exponent + 1.0) * INV_TWO_PI * cos_theta**exponent
+    # END SOLUTION
 
 
 class Phong(GlossyMaterial):
@@ -89,16 +93,20 @@ class Phong(GlossyMaterial):
         return wi[2] * wo[2] - wi[0] * wo[0] - wi[1] * wo[1]
 
     def specular(self, wo: Local, wi: Local) -> Color:
+        # BEGIN SOLUTION week08: the normalised Phong lobe (n + 2) / (2 pi) max(0, r . wo)^n
         c = self._cos_to_mirror(wo, wi)
         if c <= 0.0:
             return BLACK
         n = self.exponent
         return WHITE * ((n + 2.0) * INV_TWO_PI * c**n)
+        # END SOLUTION
 
     def sample_specular(self, wo: Local, r1: float, r2: float) -> Local | None:
+        # BEGIN SOLUTION week08: sample the Phong lobe around the mirror direction of wo
         x, y, z = sample_cosine_power(self.exponent, r1, r2)
         d = local_to_world(Vec3(-wo[0], -wo[1], wo[2]), x, y, z)  # around m
         return d.e0, d.e1, d.e2
+        # END SOLUTION
 
     def specular_pdf(self, wo: Local, wi: Local) -> float:
         return cosine_power_pdf(self.exponent, self._cos_to_mirror(wo, wi))

@@ -145,16 +145,19 @@ class Ward(GlossyMaterial):
         return math.exp(-exponent) / (math.pi * self.ax * self.ay * h[2] ** 3)
 
     def sample_specular(self, wo: Local, r1: float, r2: float) -> Local | None:
+        # BEGIN SOLUTION week08: (not graded) reflect wo about a half vector; shows Blinn-Phong's
         hx, hy, hz = self.sample_half_vector(r1, r2)
         wo_h = wo[0] * hx + wo[1] * hy + wo[2] * hz
         if wo_h <= 0.0:
             return None  # reflecting about this h would send wo below the surface
         k = 2.0 * wo_h
         return k * hx - wo[0], k * hy - wo[1], k * hz - wo[2]
+        # END SOLUTION
 
     def specular_pdf(self, wo: Local, wi: Local) -> float:
         """p_h(h) / (4 (wo . h)): the half vector's density times the Jacobian
         d(w_h) / d(w_i) = 1 / (4 (wo . h)) of the reflection."""
+        # BEGIN SOLUTION week08: (not graded) half-vector density / (4 wo . h)
         x, y, z = wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]
         length = math.sqrt(x * x + y * y + z * z)
         if length == 0.0:
@@ -164,3 +167,4 @@ class Ward(GlossyMaterial):
         if wo_h <= 0.0:
             return 0.0
         return self.half_vector_pdf(h) / (4.0 * wo_h)
+        # END SOLUTION

@@ -11,7 +11,9 @@ radiance sample per ray (N, 3), with the same estimator as its scalar twin:
   (reflection R, refraction 1 - R) at specular hits, up to max_depth segments;
 - path: next-event estimation + BRDF sampling with MIS, Russian roulette after
   segment `russian_roulette` (survival min(0.95, max(beta))), max_depth segments
-  counting the camera ray; nee = false samples only point lights.
+  counting the camera ray; nee = false samples only point lights; mis = false
+  adds area lights by light sampling alone (weight 1, and weight 0 for emission
+  found by BRDF sampling after a non-specular bounce).
 
 Paths run as a wavefront: every live path is at the same segment, the whole
 batch is intersected, shaded by material kind, and paths that end are dropped.
@@ -87,10 +89,14 @@ class Tracer:
         bg = scene.background
         self.background_color = np.array([bg.e0, bg.e1, bg.e2], dtype=np.float64)
         self.sky = bool(scene.sky)
+        self.environment = getattr(scene, "environment", None)
 
     def background(self, d: np.ndarray) -> np.ndarray:
         """Radiance of rays escaping along d (N, 3): the constant background, or
-        RTIOW's sky gradient by the direction's y component."""
+        RTIOW's sky gradient by the direction's y component, or the scene's
+        environment (rtpy.environment) when it has one."""
+        if self.environment is not None:
+            return self.environment.radiance_array(d)
         if not self.sky:
             return np.broadcast_to(self.background_color, d.shape)
         a = 0.5 * (d[:, 1] / np.sqrt(_dot(d, d)) + 1.0)
@@ -100,11 +106,16 @@ class Tracer:
         return self.geometry.hit_batch(obj, o, d, t, self.need_uv, self.need_tangent)
 
     def sample_one_light(
-        self, hits: HitBatch, ids: np.ndarray, rng: np.random.Generator, include_area: bool
+        self,
+        hits: HitBatch,
+        ids: np.ndarray,
+        rng: np.random.Generator,
+        include_area: bool,
+        mis: bool = True,
     ) -> np.ndarray:
         """sample_one_light: the light-sampling estimate (N, 3) of light reflected
         toward hits.wo, from one light chosen uniformly, with a shadow ray; area
-        lights are MIS-weighted against BRDF sampling."""
+        lights are MIS-weighted against BRDF sampling (weight 1 if not mis)."""
         n = len(hits)
         out = np.zeros((n, 3))
         n_lights = self.lights.count(include_area)
@@ -139,7 +150,10 @@ class Tracer:
             k = np.flatnonzero(~blocked)
             idx, f, brdf_pdf = idx.take(k), rows_of(f, k), brdf_pdf.take(k)
         pdf = s.pdf.take(idx) / n_lights
-        weight = np.where(s.delta.take(idx), 1.0, power_heuristic(pdf, brdf_pdf))
+        if mis:
+            weight = np.where(s.delta.take(idx), 1.0, power_heuristic(pdf, brdf_pdf))
+        else:
+            weight = np.ones(idx.size)
         contrib = scale(f * rows_of(s.radiance, idx), cos_i.take(idx) * weight / pdf)
         put_rows(out, idx, contrib)
         return out
@@ -152,12 +166,16 @@ class Tracer:
         prev_pdf: np.ndarray,
         prev_specular: np.ndarray,
         n_mis: int,
+        mis: bool = True,
     ) -> np.ndarray:
         """MIS weight (N,) of emission found by BRDF sampling from prev_point; 1 after
-        the camera, after a specular bounce, or when lights are not sampled."""
+        the camera, after a specular bounce, or when lights are not sampled; 0
+        after other bounces if not mis (light sampling alone counts it)."""
         w = np.ones(len(obj))
         if n_mis == 0 or prev_point is None:
             return w
+        if not mis:
+            return prev_specular.astype(np.float64)
         m = np.flatnonzero(~prev_specular)
         if m.size == len(obj):
             light_pdf = self.lights.direction_pdf(obj, prev_point, hits.point, hits.normal)
@@ -173,7 +191,7 @@ class Tracer:
         return w
 
     def add_emission(
-        self, result, rows, beta, obj, ids, hits, prev_point, prev_pdf, prev_specular, n_mis
+        self, result, rows, beta, obj, ids, hits, prev_point, prev_pdf, prev_specular, n_mis, mis
     ) -> None:
         """result[rows] += beta * emitted * MIS weight at the hits on emitters."""
         em = self.materials.emitter.take(ids)
@@ -182,7 +200,7 @@ class Tracer:
         e = np.flatnonzero(em)
         if e.size == len(ids):
             emitted = self.materials.emitted(ids, hits)
-            w = self.emission_weight(obj, hits, prev_point, prev_pdf, prev_specular, n_mis)
+            w = self.emission_weight(obj, hits, prev_point, prev_pdf, prev_specular, n_mis, mis)
             add_rows(result, rows, scale(beta * emitted, w))
             return
         part = hits.take(e)
@@ -194,6 +212,7 @@ class Tracer:
             prev_pdf.take(e),
             prev_specular.take(e),
             n_mis,
+            mis,
         )
         add_rows(result, rows.take(e), scale(rows_of(beta, e) * emitted, w))
 
@@ -268,6 +287,7 @@ class PathIntegrator(BatchIntegrator):
         result = np.zeros((n, 3))
         n_lights = tracer.lights.count(include_area=nee)
         n_mis = n_lights if nee else 0  # lights that MIS weights account for
+        mis = self.settings.mis
         geo, materials = tracer.geometry, tracer.materials
         rows = np.arange(n)  # the camera ray each live path belongs to
         beta = np.ones((n, 3))
@@ -293,7 +313,7 @@ class PathIntegrator(BatchIntegrator):
             hits = tracer.hits(obj, o, d, t)
             ids = geo.material_id.take(obj)
             tracer.add_emission(
-                result, rows, beta, obj, ids, hits, prev_point, prev_pdf, prev_specular, n_mis
+                result, rows, beta, obj, ids, hits, prev_point, prev_pdf, prev_specular, n_mis, mis
             )
             if segment >= max_depth:
                 break
@@ -306,12 +326,12 @@ class PathIntegrator(BatchIntegrator):
             if n_lights:
                 ns = np.flatnonzero(~materials.specular.take(ids))
                 if ns.size == rows.size:
-                    direct = tracer.sample_one_light(hits, ids, rng, include_area=nee)
+                    direct = tracer.sample_one_light(hits, ids, rng, nee, mis)
                     direct *= beta
                     add_rows(result, rows, direct)
                 elif ns.size:
                     part = hits.take(ns)
-                    direct = tracer.sample_one_light(part, ids.take(ns), rng, include_area=nee)
+                    direct = tracer.sample_one_light(part, ids.take(ns), rng, nee, mis)
                     direct *= rows_of(beta, ns)
                     add_rows(result, rows.take(ns), direct)
             sc = materials.sample(ids, hits, rng)
@@ -449,6 +469,7 @@ def direct_lighting(
                 sc.pdf[a[h]],
                 sc.specular[a[h]],
                 n_lights,
+                True,
             )
     return result
 

@@ -28,7 +28,7 @@ from tqdm import tqdm
 from ..camera import Camera
 from ..image import RenderedImage
 from ..render_settings import RenderSettings
-from ..renderer import Renderer, Unit
+from ..renderer import PixelSums, Renderer, Unit
 from ..scene import Scene
 from .camera import CameraRays
 from .integrators import BatchIntegrator, Tracer, make_integrator
@@ -133,7 +133,7 @@ class NumpyRenderer(Renderer):
         keep_freed_memory()
         spp = 1 if make_integrator(settings).uses_center_ray else settings.spp
         units = plan_units(camera.width, camera.height, spp)
-        results: dict[tuple[int, int], np.ndarray] = {}
+        results = PixelSums(camera.width, camera.height)
         bar = tqdm(
             total=camera.width * camera.height * spp,
             unit="path",
@@ -148,7 +148,7 @@ class NumpyRenderer(Renderer):
         work = self._run(units)
         try:
             for unit, sums in work:
-                results[(unit.tile, unit.batch)] = sums
+                results.add(unit, sums)
                 bar.update(sums.shape[0] * sums.shape[1] * unit.spp)
         except KeyboardInterrupt:
             interrupted = True
@@ -156,7 +156,7 @@ class NumpyRenderer(Renderer):
             work.close()
             bar.close()
         seconds = time.perf_counter() - start
-        image = self._assemble(units, results, spp, interrupted, seconds)
+        image = self._assemble(results, spp, interrupted, seconds)
         image.stats["backend"] = "numpy"
         image.stats["peak_rss_mb"] = peak_rss_mb()
         return image

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+from statistics import NormalDist
 
 import numpy as np
 import pytest
@@ -19,6 +20,14 @@ from rtpy import (
     Scene,
     Sphere,
     Vec3,
+)
+from rtpy.analytic_scenes import (
+    PLANE_ALBEDO,
+    SPHERE_LIGHT_CENTER,
+    SPHERE_LIGHT_RADIANCE,
+    SPHERE_LIGHT_RADIUS,
+    GlowingLambertian,
+    plane_sphere_light,
 )
 from rtpy.integrators import make_integrator as make_scalar
 from rtpy.numpy_backend.camera import CameraRays
@@ -149,15 +158,8 @@ def test_white_furnace_shows_the_albedo(integrator):
 @pytest.mark.parametrize("nee", [True, False])
 def test_glowing_sphere_converges_to_le_over_one_minus_rho(nee):
     """Inside a sphere of albedo rho emitting Le, radiance is Le / (1 - rho)."""
-
-    class GlowingLambertian(Lambertian):
-        is_emitter = True
-
-        def emitting(self, hit):
-            return Color(0.5, 0.5, 0.5)
-
-    rho = 0.5
-    scene = Scene([Sphere(Vec3(0, 0, 0), 2.0, GlowingLambertian(Color(rho, rho, rho)))])
+    rho, le = 0.5, Color(0.5, 0.5, 0.5)
+    scene = Scene([Sphere(Vec3(0, 0, 0), 2.0, GlowingLambertian(Color(rho, rho, rho), le))])
     n = 20000
     rng = np.random.default_rng(5)
     d = rng.normal(size=(n, 3))
@@ -214,3 +216,63 @@ def test_sphere_light_nee_gives_the_analytic_irradiance():
     L = batched_radiance(scene, RenderSettings(integrator="direct"), o, d, seed=4)
     assert z_score(L, expected).max() < 4.5
     assert abs(L.mean() - expected) < 2e-3 * expected
+
+
+def test_nee_only_matches_scalar_and_the_exact_irradiance():
+    """mis = false (lights by light sampling alone), ray by ray: the numpy and the
+    scalar estimators have the same mean, and both the closed form
+    albedo Le (r/d)^2 cos(theta) of a plane under a sphere light (z-tests against
+    the measured noise, Bonferroni over rays and comparisons)."""
+    analytic = plane_sphere_light()
+    scene = analytic.scene
+    o, d = camera_rays(analytic.camera, 12, stride=17)
+    # each centre ray's exact radiance (red channel)
+    center = np.array([SPHERE_LIGHT_CENTER.e0, SPHERE_LIGHT_CENTER.e1, SPHERE_LIGHT_CENTER.e2])
+    p = o - (o[:, 1] / d[:, 1])[:, None] * d  # on the plane y = 0
+    v = center - p
+    dist = np.linalg.norm(v, axis=1)
+    le = SPHERE_LIGHT_RADIANCE.e0
+    expected = PLANE_ALBEDO * le * (SPHERE_LIGHT_RADIUS / dist) ** 2 * (v[:, 1] / dist)
+    settings = RenderSettings(integrator="path", mis=False, max_depth=4)
+    n_np, n_sc = 4000, 400
+    limit = NormalDist().inv_cdf(1 - 1e-4 / (2 * 3 * len(o)))
+    integrator = make_scalar(settings)
+    for k in range(len(o)):
+        L = batched_radiance(scene, settings, np.tile(o[k], (n_np, 1)), np.tile(d[k], (n_np, 1)))
+        with use_generator(make_generator(k)):
+            ray = Ray(Vec3(*o[k]), Vec3(*d[k]))
+            S = np.array([integrator.radiance(ray, scene).e0 for _ in range(n_sc)])
+        m_np, se_np = L[:, 0].mean(), L[:, 0].std(ddof=1) / math.sqrt(n_np)
+        m_sc, se_sc = S.mean(), S.std(ddof=1) / math.sqrt(n_sc)
+        want = expected[k]
+        assert abs(m_np - m_sc) < limit * math.hypot(se_np, se_sc), (k, m_np, m_sc)
+        assert abs(m_np - want) < limit * se_np, (k, m_np, want)
+        assert abs(m_sc - want) < limit * se_sc, (k, m_sc, want)
+
+
+def test_without_mis_light_samples_weigh_one_and_brdf_found_emission_zero():
+    """The numpy kernels with mis = false, against the MIS ones on the same random
+    numbers: light samples lose their power-heuristic weight (so are larger, and
+    equal where a point light is sampled), and emission found by BRDF sampling after
+    a non-specular bounce gets weight 0 (1 after a specular one, as in the scalar
+    emission_weight)."""
+    scene = plane_sphere_light().scene
+    scene.point_lights = [PointLight(Vec3(0, 2, -1), Color(1, 1, 1))]
+    scene.update_lights()
+    tracer = Tracer(scene)
+    o, d = camera_rays(plane_sphere_light().camera, 16)
+    obj, t = tracer.geometry.closest_hit(o, d)
+    hits = tracer.hits(obj, o, d, t)
+    ids = tracer.geometry.material_id[obj]
+    with_mis = tracer.sample_one_light(hits, ids, np.random.default_rng(3), True, True)
+    without = tracer.sample_one_light(hits, ids, np.random.default_rng(3), True, False)
+    assert np.all(without >= with_mis) and np.any(without > with_mis * 1.01)
+    lights = tracer.lights
+    rng = np.random.default_rng(3)
+    _choice = lights.sample(hits.point, rng, True)
+    point = _choice.delta & _choice.valid
+    assert point.any()
+    np.testing.assert_allclose(without[point], with_mis[point], rtol=1e-12)
+    specular = np.arange(len(obj)) % 2 == 0
+    w = tracer.emission_weight(obj, hits, hits.point, np.ones(len(obj)), specular, 2, mis=False)
+    np.testing.assert_array_equal(w, specular.astype(float))

@@ -1,0 +1,233 @@
+# ruff: noqa: E501  (the assertion messages are prose for students)
+"""Week 05 graders: point lights with 1/r^2, shadow rays, the direct integrator.
+
+Each test names the method it checks and says what is wrong when it fails.
+Run them with `python -m rtpy grade 05`.
+"""
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+import rtpy.testing as rt
+from rtpy import Color, Interval, Lambertian, PointLight, Quad, Ray, Scene, Sphere, Vec3
+from rtpy.grading import assert_render_matches, load_reference, points, render_stack
+from rtpy.integrators import DirectIntegrator
+from rtpy.materials import DiffuseLight
+from rtpy.render_settings import RenderSettings
+
+HERE = Path(__file__).parent
+RNG_SEED = 2005
+
+
+def unit(v):
+    return v / np.linalg.norm(v)
+
+
+@points(3)
+def test_point_light_sample():
+    """PointLight.sample: unit direction, distance, radiance I / d^2"""
+    rng = np.random.default_rng(RNG_SEED)
+    for _ in range(40):
+        pos, p, intensity = rng.uniform(-5, 5, 3), rng.uniform(-5, 5, 3), rng.uniform(0.1, 9, 3)
+        s = PointLight(Vec3(*pos), Color(*intensity)).sample(Vec3(*p))
+        d = pos - p
+        dist = float(np.linalg.norm(d))
+        where = (
+            f"PointLight.sample (rtpy/light.py) with the light at {pos.round(3)}, p = {p.round(3)}"
+        )
+        assert s is not None, f"{where}: returned None"
+        assert np.allclose(list(s.direction), d / dist, rtol=1e-9, atol=1e-12), (
+            f"{where}: direction {s.direction} should be the unit vector from p toward the light "
+            f"{(d / dist).round(6)}"
+        )
+        assert math.isclose(s.distance, dist, rel_tol=1e-9), (
+            f"{where}: distance {s.distance} != {dist}"
+        )
+        ratio = np.array(list(s.radiance)) / intensity
+        assert np.allclose(ratio, 1.0 / dist**2, rtol=1e-9), (
+            f"{where}: radiance is intensity * {ratio.mean():.4g}, expected intensity / d^2 = "
+            f"intensity * {1 / dist**2:.4g} (a point light falls off with the square of the distance)"
+        )
+        assert s.is_delta and s.pdf == 1.0, (
+            f"{where}: a point light is a delta light: is_delta True, pdf 1"
+        )
+
+
+@points(3)
+def test_lambertian_brdf_and_sampling():
+    """Lambertian: BRDF = albedo / pi, cosine sampling, weight = BRDF * cos / pdf"""
+    albedo = Color(0.8, 0.5, 0.2)
+    material = Lambertian(albedo)
+    hit = rt.local_hit(material)
+    for theta in (0.0, 40.0, 80.0):
+        f = material.BRDF(rt.incident_ray(30.0), rt.light_ray(rt.local_direction(theta, 70.0)), hit)
+        assert np.allclose(list(f), np.array(list(albedo)) / math.pi, rtol=1e-9), (
+            f"Lambertian.BRDF (rtpy/materials/lambertian.py) = {f}; f_r is albedo / pi "
+            "(the albedo alone would reflect pi times too much light)"
+        )
+    below = material.BRDF(rt.incident_ray(30.0), rt.light_ray(rt.local_direction(120.0)), hit)
+    assert below.is_black(), "Lambertian.BRDF: light from below the surface must give 0"
+    for theta in (10.0, 60.0):
+        weights = rt.check_weights(material, theta, n=300, seed=5)
+        assert weights.passed, (
+            "Lambertian.scattering: the attenuation must be BRDF * cos / pdf (= albedo with "
+            f"cosine sampling) and pdf = cos / pi: {weights.detail}"
+        )
+        chi2 = rt.chi2_test(material, theta, n_samples=20_000, theta_bins=8, phi_bins=8, seed=5)
+        assert chi2.passed(rt.sidak_alpha(0.01, 2)), (
+            f"Lambertian.scattering: directions do not follow pdf = cos / pi: {chi2.summary()}"
+        )
+
+
+@points(2)
+def test_shadow_rays():
+    """Scene.find_occlusion: blockers between the point and the light only"""
+    m = Lambertian()
+    ray = Ray(Vec3(0, 0, 0), Vec3(0, 0, -1))
+    cases = [
+        (
+            [Sphere(Vec3(0, 0, -2), 0.5, m)],
+            Interval(0.0, 5.0),
+            True,
+            "a sphere halfway to the light",
+        ),
+        ([Sphere(Vec3(0, 0, -8), 0.5, m)], Interval(0.0, 5.0), False, "a sphere beyond the light"),
+        ([Sphere(Vec3(0, 0, 3), 0.5, m)], Interval(0.0, 5.0), False, "a sphere behind the point"),
+        ([Sphere(Vec3(2, 0, -2), 0.5, m)], Interval(0.0, 5.0), False, "a sphere beside the ray"),
+        (
+            [Sphere(Vec3(2, 0, -2), 0.5, m), Sphere(Vec3(0, 0, -3), 0.5, m)],
+            Interval(0.0, 5.0),
+            True,
+            "one blocker among other objects",
+        ),
+    ]
+    for objects, interval, expected, what in cases:
+        got = Scene(objects).find_occlusion(ray, interval)
+        assert got == expected, (
+            f"Scene.find_occlusion (rtpy/scene.py) with {what} returned {got}: any object hit "
+            "with t strictly inside the interval blocks the light, nothing else does"
+        )
+
+
+def lit_plane_scene(occluder: bool):
+    albedo = Color(0.6, 0.4, 0.9)
+    floor = Quad(Vec3(-50, 0, -50), Vec3(0, 0, 100), Vec3(100, 0, 0), Lambertian(albedo))
+    objects = [floor]
+    if occluder:
+        objects.append(Sphere(Vec3(0.5, 1.0, 0.2), 0.3, Lambertian()))
+    light = PointLight(Vec3(0.7, 2.0, 0.3), Color(3.0, 2.0, 1.0))
+    return Scene(objects, [light]), albedo, light
+
+
+@points(4)
+def test_direct_light_on_a_plane_is_exact():
+    """direct integrator: albedo/pi * I cos / d^2 on a plane, 0 in the shadow"""
+    rng = np.random.default_rng(RNG_SEED + 1)
+    scene, albedo, light = lit_plane_scene(occluder=True)
+    integrator = DirectIntegrator(RenderSettings(integrator="direct"))
+    lp = np.array(list(light.position))
+    for k in range(30):
+        target = np.array([rng.uniform(-3, 3), 0.0, rng.uniform(-3, 3)])
+        if k < 3:  # points in the sphere's shadow
+            target = (
+                lp + (np.array([0.5, 1.0, 0.2]) - lp) * (2.0 / 1.0) + rng.uniform(-0.05, 0.05, 3)
+            )
+            target[1] = 0.0
+        # looked at from just above (below the sphere), from a random direction
+        eye = target + 0.05 * unit(np.array([rng.uniform(-1, 1), 1.0, rng.uniform(-1, 1)]))
+        d = unit(target - eye)
+        got = np.array(list(integrator.radiance(Ray(Vec3(*eye), Vec3(*d)), scene)))
+        to_light = lp - target
+        dist2 = to_light @ to_light
+        cos = to_light[1] / math.sqrt(dist2)
+        blocked = (  # computed here, not by the code being graded
+            scene.objects[1].hit_t(
+                Ray(Vec3(*target), Vec3(*unit(to_light))), 1e-9, math.sqrt(dist2)
+            )
+            is not None
+        )
+        expected = 0.0 if blocked else 1.0
+        expected = (
+            expected
+            * np.array(list(albedo))
+            / math.pi
+            * np.array(list(light.intensity))
+            * cos
+            / dist2
+        )
+        assert np.allclose(got, expected, rtol=1e-6, atol=1e-12), (
+            f"direct integrator at floor point {target.round(3)}{' (in shadow)' if blocked else ''}: "
+            f"radiance {got.round(6)}, expected albedo/pi * I cos(theta) / d^2 = {expected.round(6)}. "
+            "Check PointLight.sample (1/d^2), the cosine with the UNIT direction to the light, "
+            "the shadow ray (rtpy/integrators/direct_lighting.py: sample_one_light)"
+        )
+
+
+def area_light_scene():
+    red, white = Lambertian(Color(0.7, 0.2, 0.2)), Lambertian(Color(0.7, 0.7, 0.7))
+    objects = [
+        Quad(Vec3(-3, 0, -5), Vec3(6, 0, 0), Vec3(0, 0, 5), white),
+        Sphere(Vec3(-0.6, 0.5, -2.5), 0.5, red),
+        Sphere(Vec3(0.8, 0.4, -2.0), 0.4, white),
+        Sphere(Vec3(0.0, 2.2, -2.2), 0.4, DiffuseLight(Color(6.0, 6.0, 5.0))),
+    ]
+    camera = rtpy_camera()
+    return Scene(objects, [PointLight(Vec3(1.5, 1.5, -1.0), Color(1.5, 1.5, 1.5))], camera=camera)
+
+
+def rtpy_camera():
+    from rtpy import Camera
+
+    return Camera(Vec3(0, 1.0, 0.5), Vec3(0, 0.6, -2.5), vfov=60, aspect_ratio="16:9", width=32)
+
+
+# The graded render: R seeds at SPP samples per pixel, against the reference
+# (rendered by rtpy's solution with REFERENCE_SEEDS at REFERENCE_SPP).
+RENDER = {"integrator": "direct", "spp": 8, "max_depth": 5}
+SEEDS = (1, 2, 3, 4)
+REFERENCE = {"name": "direct_area_light", "seeds": tuple(range(100, 108)), "spp": 64}
+
+
+def make_reference_summary():
+    from rtpy.grading import summarize
+
+    settings = dict(RENDER, spp=REFERENCE["spp"])
+    return summarize(
+        render_stack(area_light_scene(), REFERENCE["seeds"], **settings), REFERENCE["spp"]
+    )
+
+
+@points(4)
+def test_direct_render_matches_reference():
+    """direct integrator: area and point light render matches the reference (light counted once)"""
+    stack = render_stack(area_light_scene(), SEEDS, **RENDER)
+    reference = load_reference(HERE / "reference" / f"{REFERENCE['name']}.npz")
+    assert_render_matches(
+        stack,
+        RENDER["spp"],
+        reference,
+        "direct integrator (rtpy/integrators/direct_lighting.py) differs from the reference "
+        "beyond its noise. Too bright near the light: light counted twice (the emission a "
+        "BRDF-sampled ray finds must carry the MIS weight); too dark: a missing 1/pdf or "
+        "a shadow ray that hits the light itself",
+    )
+
+
+@points(1)
+def test_direct_sees_emitters_and_background():
+    """direct integrator: emission seen directly, background on a miss"""
+    emit = Color(2.0, 3.0, 4.0)
+    scene = Scene(
+        [Sphere(Vec3(0, 0, -3), 1.0, DiffuseLight(emit))], background=Color(0.1, 0.2, 0.3)
+    )
+    integrator = DirectIntegrator(RenderSettings(integrator="direct"))
+    got = integrator.radiance(Ray(Vec3(0, 0, 0), Vec3(0, 0, -1)), scene)
+    assert np.allclose(list(got), list(emit)), (
+        f"DirectIntegrator.radiance: a camera ray hitting a light returned {got}, expected its emission {emit}"
+    )
+    got = integrator.radiance(Ray(Vec3(0, 0, 0), Vec3(0, 1, 0)), scene)
+    assert np.allclose(list(got), [0.1, 0.2, 0.3]), (
+        f"DirectIntegrator.radiance: a ray that misses everything returned {got}, expected the background"
+    )

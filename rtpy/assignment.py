@@ -1,0 +1,432 @@
+"""Weekly assignment repositories, generated from rtpy's own source.
+
+The reference solutions live in rtpy itself, marked as regions inside method bodies
+(the way nbgrader and otter-grader mark them):
+
+    def sample(self, p):
+        \"\"\"docstring (kept: it is the student's specification)\"\"\"
+        # BEGIN SOLUTION week05: direction, distance and radiance I / d^2 seen from p
+        ...the reference code...
+        # END SOLUTION
+
+The markers are comments, so rtpy runs unchanged. `make_assignment(week, out)` writes
+the student repository of that week: all of rtpy with the solution regions of that
+week and of every later week replaced by
+
+        # TODO(week05): direction, distance and radiance I / d^2 seen from p
+        raise NotImplementedError("week05 task: PointLight.sample ...")
+
+(a later week's region is withheld too: it would hand out that week's answer, and
+several of them contain this week's, such as Cook-Torrance's Schlick factor or the
+path integrator's light sampling), the bundled scenes, `assignments/weekNN/` (README,
+graders, scenes, reference data) and the tests of rtpy that can pass there.
+
+Which tests ship is decided by `assignments/test_weeks.toml`: for each test file,
+the weeks whose solution regions it executes, as recorded by running the suite on
+an instrumented copy of rtpy (`python -m rtpy assignment map-tests`). A file ships
+in week W's repository only when all those weeks are before W (otherwise it would
+fail on the stubs); files not listed run no region and always ship.
+
+The numpy backend is withheld from every student repository: its vectorized twins
+mirror the solutions of weeks 03-08 (camera rays, intersections, point lights,
+textures, the Phong, Blinn-Phong and Cook-Torrance kernels, the path integrator). In
+its place the repository holds a stub whose render raises an error that says so; the
+scalar backend renders everything, a student's own materials included.
+"""
+
+from __future__ import annotations
+
+import ast
+import io
+import json
+import os
+import re
+import shutil
+import tempfile
+import textwrap
+import tokenize
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+WEEKS = ("03", "04", "05", "06", "07", "08")
+BEGIN = re.compile(r"^(?P<indent>[ \t]*)# BEGIN SOLUTION week(?P<week>\d\d)(?::\s*(?P<msg>.*))?$")
+END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
+
+# What the student repository holds besides rtpy/ (top-level names of the source tree).
+COPIED = ("pyproject.toml", ".gitignore", "scenes")
+TEST_WEEKS_FILE = "assignments/test_weeks.toml"
+# Tests of the assignment machinery itself: they grade every week and generate
+# repositories, so they belong to rtpy only (and are not mapped).
+MACHINERY_TESTS = ("tests/test_grade.py", "tests/test_assignment.py")
+# A test file that uses the numpy backend (withheld from student repositories).
+NUMPY_USE = re.compile(r"numpy_backend|[\"']numpy[\"']|rtpy\.BACKENDS")
+
+NUMPY_STUB = '''"""The numpy backend is withheld from the weekly assignment repositories: its
+vectorized twins contain the solutions. Render with the scalar backend (the default)."""
+'''
+NUMPY_RENDER_STUB = '''"""Withheld: see rtpy/numpy_backend/__init__.py."""
+
+
+class NumpyRenderer:
+    def __init__(self, *args, **kwargs) -> None:
+        raise NotImplementedError(
+            "the numpy backend is withheld from the week {week} assignment repository "
+            "(its vectorized code contains the solutions); render with --backend scalar"
+        )
+'''
+
+
+class AssignmentError(Exception):
+    """A bad week, source tree or output directory (the CLI exits with status 2)."""
+
+
+@dataclass(frozen=True)
+class Region:
+    """One solution region: lines [begin, end] (0-based, the marker lines included)."""
+
+    path: Path  # relative to the source root
+    begin: int
+    end: int
+    week: str
+    message: str
+    function: str  # qualified name of the enclosing function, e.g. "PointLight.sample"
+    indent: str
+
+    def stub(self) -> list[str]:
+        """The lines that replace the region: a TODO and a NotImplementedError naming
+        the task, its string split to fit 100 columns."""
+        what = f"{self.function}: {self.message}" if self.message else self.function
+        text = f"week{self.week} task: {what} (see assignments/week{self.week}/README.md)"
+        width = max(40, 92 - len(self.indent))
+        parts = textwrap.wrap(text, width, drop_whitespace=False) or [text]
+        return [
+            f"{self.indent}# TODO(week{self.week}): {self.message or 'implement this'}\n",
+            f"{self.indent}raise NotImplementedError(\n",
+            *(f"{self.indent}    {json.dumps(part)}\n" for part in parts),
+            f"{self.indent})\n",
+        ]
+
+
+def _enclosing_functions(source: str) -> list[tuple[int, int, str]]:
+    """(first line, last line, qualified name) of every function, 1-based."""
+    out = []
+
+    def visit(node: ast.AST, prefix: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+                name = f"{prefix}{child.name}"
+                if not isinstance(child, ast.ClassDef):
+                    out.append((child.lineno, child.end_lineno or child.lineno, name))
+                visit(child, f"{name}.")
+
+    visit(ast.parse(source), "")
+    return out
+
+
+def _comment_lines(source: str) -> set[int]:
+    """0-based numbers of the lines that hold only a comment."""
+    tokens = tokenize.generate_tokens(io.StringIO(source).readline)
+    return {t.start[0] - 1 for t in tokens if t.type == tokenize.COMMENT}
+
+
+def regions_in(path: Path, root: Path) -> list[Region]:
+    """The solution regions of one file; AssignmentError on unbalanced markers."""
+    text = path.read_text()
+    lines = text.splitlines(keepends=True)
+    functions = None
+    regions, open_at = [], None
+    rel = path.relative_to(root)
+    comments = _comment_lines(text)
+    for i, line in enumerate(lines):
+        if i not in comments:
+            continue  # marker text inside a string is not a marker
+        m = BEGIN.match(line.rstrip("\n"))
+        if m:
+            if open_at is not None:
+                raise AssignmentError(f"{rel}:{i + 1}: BEGIN SOLUTION inside another region")
+            open_at = (i, m)
+        elif END.match(line):
+            if open_at is None:
+                raise AssignmentError(f"{rel}:{i + 1}: END SOLUTION without BEGIN")
+            begin, m = open_at
+            if functions is None:
+                functions = _enclosing_functions(text)
+            inner = [f for f in functions if f[0] < begin + 1 <= f[1]]
+            if not inner:
+                raise AssignmentError(f"{rel}:{begin + 1}: a region must lie inside a function")
+            function = max(inner, key=lambda f: f[0])[2]
+            week = m.group("week")
+            msg = (m.group("msg") or "").strip()
+            regions.append(Region(rel, begin, i, week, msg, function, m.group("indent")))
+            open_at = None
+    if open_at is not None:
+        raise AssignmentError(f"{rel}:{open_at[0] + 1}: BEGIN SOLUTION without END")
+    return regions
+
+
+def find_regions(root: Path) -> list[Region]:
+    """Every solution region under root/rtpy, in file and line order."""
+    root = Path(root)
+    out = []
+    for path in sorted((root / "rtpy").rglob("*.py")):
+        out.extend(regions_in(path, root))
+    return out
+
+
+def withheld(region_week: str, week: str) -> bool:
+    """Is a region of region_week replaced by a stub in week's repository?"""
+    return int(region_week) >= int(week)
+
+
+def rewrite(path: Path, root: Path, replace) -> str:
+    """The file's text with every region r replaced by replace(r) (a list of lines,
+    or None to keep the region as it is)."""
+    lines = path.read_text().splitlines(keepends=True)
+    for region in reversed(regions_in(path, root)):
+        new = replace(region)
+        if new is not None:
+            lines[region.begin : region.end + 1] = new
+    return "".join(lines)
+
+
+def check_week(week: str | int) -> str:
+    text = f"{int(week):02d}" if str(week).isdigit() else str(week)
+    if text not in WEEKS:
+        raise AssignmentError(f"week {week!r}: expected one of {', '.join(WEEKS)}")
+    return text
+
+
+def weeks_of_tests(root: Path) -> dict[str, list[str]]:
+    """tests/... path -> the weeks whose solution regions that test file runs."""
+    path = Path(root) / TEST_WEEKS_FILE
+    if not path.exists():
+        return {}
+    with open(path, "rb") as f:
+        table = tomllib.load(f).get("tests", {})
+    return {k: [f"{int(w):02d}" for w in v] for k, v in table.items()}
+
+
+def shipped_tests(root: Path, week: str) -> tuple[list[str], list[str]]:
+    """(test files shipped in week's repository, test files left out), as tests/... paths.
+    Tests of the numpy backend, and any test file that uses it (NUMPY_USE), are left
+    out (the backend is withheld), and so are MACHINERY_TESTS."""
+    mapping = weeks_of_tests(root)
+    kept, left = [], []
+    for path in sorted((Path(root) / "tests").rglob("*.py")):
+        rel = path.relative_to(root).as_posix()
+        needs = mapping.get(rel, [])
+        if (
+            rel.startswith("tests/numpy_backend/")
+            or NUMPY_USE.search(path.read_text())
+            or rel in MACHINERY_TESTS
+            or any(withheld(w, week) for w in needs)
+        ):
+            left.append(rel)
+        else:
+            kept.append(rel)
+    return kept, left
+
+
+def make_assignment(week: str | int, out_dir: str | Path, root: str | Path | None = None) -> Path:
+    """Write week's student repository to out_dir (which must not exist or be empty).
+    Everything is written to a temporary directory next to it and renamed at the end,
+    so a failure leaves nothing half-written."""
+    week = check_week(week)
+    root = Path(root) if root is not None else Path(__file__).resolve().parent.parent
+    out = Path(out_dir)
+    src = root / "assignments" / f"week{week}"
+    if not src.is_dir():
+        raise AssignmentError(f"{src}: no such assignment folder")
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        raise AssignmentError(f"{out}: exists and is not an empty directory")
+    if not out.parent.is_dir():
+        raise AssignmentError(f"{out.parent}: no such directory")
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}-", dir=out.parent))
+    try:
+        _write_repository(root, week, tmp)
+        if out.exists():
+            out.rmdir()
+        os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out
+
+
+def _write_repository(root: Path, week: str, dest: Path) -> None:
+    ignore = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")
+    # rtpy with the stubs, the numpy backend withheld
+    for path in sorted((root / "rtpy").rglob("*.py")):
+        rel = path.relative_to(root)
+        if rel.parts[1] == "numpy_backend":
+            continue
+        target = dest / rel
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(
+            rewrite(path, root, lambda r: r.stub() if withheld(r.week, week) else None)
+        )
+    numpy_dir = dest / "rtpy" / "numpy_backend"
+    (numpy_dir / "materials").mkdir(parents=True)
+    (numpy_dir / "__init__.py").write_text(NUMPY_STUB)
+    (numpy_dir / "materials" / "__init__.py").write_text(NUMPY_STUB)
+    (numpy_dir / "render.py").write_text(NUMPY_RENDER_STUB.replace("{week}", week))
+    for name in COPIED:
+        path = root / name
+        if path.is_dir():
+            shutil.copytree(path, dest / name, ignore=ignore)
+        elif path.exists():
+            shutil.copy2(path, dest / name)
+    # `python -m pytest` runs the graders too
+    pyproject = dest / "pyproject.toml"
+    pyproject.write_text(
+        pyproject.read_text().replace(
+            'testpaths = ["tests"]', 'testpaths = ["tests", "assignments"]'
+        )
+    )
+    # the week's own folder, and the tests that can pass
+    shutil.copytree(
+        root / "assignments" / f"week{week}", dest / "assignments" / f"week{week}", ignore=ignore
+    )
+    kept, left = shipped_tests(root, week)
+    for rel in kept:
+        (dest / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(root / rel, dest / rel)
+    readme = (root / "assignments" / f"week{week}" / "README.md").read_text()
+    (dest / "README.md").write_text(
+        readme
+        + "\n## This repository\n\n"
+        + "Generated by `python -m rtpy assignment make "
+        + f"{week} OUT_DIR` from rtpy. `python -m rtpy grade {week}` runs the graders "
+        + f"(`assignments/week{week}/`) and prints your score; "
+        + f"`python -m pytest assignments/week{week} -x` shows the first failure's traceback, "
+        + "and `python -m pytest` runs the graders with rtpy's own tests that apply this "
+        + "week. Left out because they "
+        + "test code you write this week or later, or the numpy backend (withheld here: "
+        + "its vectorized code contains the solutions; render with the scalar backend):\n\n"
+        + "".join(
+            f"- `{rel}`\n"
+            for rel in left
+            if rel not in MACHINERY_TESTS and not rel.endswith("__init__.py")
+        )
+    )
+    (dest / "rtpy-README.md").write_text((root / "README.md").read_text())
+
+
+# --- which tests need which weeks ---------------------------------------------------
+REGION_LOG_MODULE = '''"""Instrumentation for map_tests: records which regions each test file runs.
+A region's probe costs one dict lookup once its week is recorded for the current test
+file; the plugin re-arms every week when a new file starts."""
+import builtins
+import os
+
+CURRENT = [os.environ.get("RTPY_REGION_TEST", "?")]
+armed = dict.fromkeys(("03", "04", "05", "06", "07", "08"), True)
+
+
+def hit(week):
+    armed[week] = False
+    path = os.environ.get("RTPY_REGION_LOG")
+    if path:
+        with open(path, "a") as f:
+            f.write(CURRENT[0] + "\\t" + week + "\\n")
+
+
+builtins._rtpy_armed, builtins._rtpy_hit = armed, hit  # the probes' names
+'''
+
+REGION_LOG_PLUGIN = """import os
+
+import rtpy._region_log as log
+
+
+def pytest_runtest_setup(item):
+    name = item.nodeid.split("::")[0]
+    if name != log.CURRENT[0]:
+        log.CURRENT[0] = name
+        os.environ["RTPY_REGION_TEST"] = name  # for command-line subprocesses
+        for week in log.armed:
+            log.armed[week] = True
+"""
+
+
+def map_tests(
+    root: str | Path | None = None,
+    pytest_args: tuple[str, ...] = (),
+    files: tuple[str, ...] = (),
+) -> dict[str, set[str]]:
+    """Run rtpy's tests (the numpy backend's excepted) on a copy of the tree whose
+    solution regions record each test file that runs them, also from worker and
+    command-line subprocesses; returns {test file: the weeks it runs} and writes
+    it to assignments/test_weeks.toml. With `files` (tests/... paths) only those
+    run, and only their entries are replaced (the quick way after adding a file)."""
+    import subprocess
+    import sys
+
+    root = Path(root) if root is not None else Path(__file__).resolve().parent.parent
+    with tempfile.TemporaryDirectory(prefix="rtpy-map-tests-") as tmp:
+        dest = Path(tmp)
+        for path in sorted((root / "rtpy").rglob("*.py")):
+            rel = path.relative_to(root)
+            target = dest / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+
+            def record(r: Region) -> list[str]:
+                lines = (root / r.path).read_text().splitlines(keepends=True)
+                probe = f'{r.indent}_rtpy_armed["{r.week}"] and _rtpy_hit("{r.week}")\n'
+                return [probe, *lines[r.begin : r.end + 1]]
+
+            target.write_text(rewrite(path, root, record))
+        (dest / "rtpy" / "_region_log.py").write_text(REGION_LOG_MODULE)
+        init = dest / "rtpy" / "__init__.py"
+        head = "from __future__ import annotations\n"
+        init.write_text(init.read_text().replace(head, head + "from . import _region_log\n", 1))
+        (dest / "region_log_plugin.py").write_text(REGION_LOG_PLUGIN)
+        for name in (*COPIED, "tests", "README.md", "docs"):
+            path = root / name
+            if path.is_dir():
+                shutil.copytree(path, dest / name, ignore=shutil.ignore_patterns("__pycache__"))
+            elif path.exists():
+                shutil.copy2(path, dest / name)
+        log = dest / "regions.log"
+        env = dict(os.environ, RTPY_REGION_LOG=str(log), PYTHONPATH=str(dest))
+        subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "pytest",
+                "-q",
+                "-p",
+                "region_log_plugin",
+                "-p",
+                "no:cacheprovider",
+                "--ignore=tests/numpy_backend",
+                *(f"--ignore={t}" for t in MACHINERY_TESTS),
+                *pytest_args,
+                *(files or ("tests",)),
+            ],
+            cwd=dest,
+            env=env,
+            check=False,
+        )
+        weeks: dict[str, set[str]] = {}
+        if files:  # keep every other file's entry
+            weeks = {k: set(v) for k, v in weeks_of_tests(root).items() if k not in files}
+            weeks.update({Path(f).as_posix(): set() for f in files})
+        for line in log.read_text().splitlines() if log.exists() else []:
+            test, week = line.split("\t")
+            if test.startswith("tests/"):
+                weeks.setdefault(test, set()).add(week)
+        for path in [] if files else sorted((root / "tests").rglob("test_*.py")):
+            rel = path.relative_to(root).as_posix()
+            if not (rel.startswith("tests/numpy_backend/") or rel in MACHINERY_TESTS):
+                weeks.setdefault(rel, set())  # runs no region: ships every week
+    body = "".join(
+        f'"{k}" = [{", ".join(str(int(w)) for w in sorted(v))}]\n' for k, v in sorted(weeks.items())
+    )
+    (root / TEST_WEEKS_FILE).write_text(
+        "# The weeks whose solution regions each test file runs, recorded by\n"
+        "# `python -m rtpy assignment map-tests` (see rtpy/assignment.py). A file ships\n"
+        "# in week W's repository only if all its weeks are before W.\n[tests]\n" + body
+    )
+    return weeks

@@ -1,0 +1,251 @@
+"""Grading the weekly assignments: points, a score table, Gradescope JSON, and a
+noise-aware comparison of renders with a reference.
+
+A grader is a pytest test in `assignments/weekNN/` marked with its points:
+
+    from rtpy.grading import points
+
+    @points(3)
+    def test_point_light_falls_off_with_distance_squared():
+        \"\"\"Point light: 1/r^2 falloff\"\"\"        # the name shown in the score table
+        ...
+        assert ok, "PointLight.sample (rtpy/light.py): ... what is wrong, what to do"
+
+A test scores all its points when it passes and none when it fails; its output is
+the assertion's message (or the exception, such as the NotImplementedError of a
+stub). `python -m rtpy grade WEEK [--json results.json]` runs them in-process
+(`grade()`), prints a table and writes the results in Gradescope's autograder
+format: {"score": ..., "tests": [{"name", "score", "max_score", "output"}, ...]}.
+
+Renders are compared by `assert_render_matches`: R renders with different seeds are
+cut into 8 x 8 pixel blocks and each block mean is compared with a stored reference
+(rendered by rtpy's solution, `assignments/weekNN/reference/*.npz`) by a z-test
+whose variance is the noise both sides measure (each pixel's per-sample variance
+from the spread of its R values), Bonferroni-corrected over blocks and channels:
+a correct renderer fails with probability below ALPHA, while a missing 1/pdf, a
+light counted twice or a missing 1/r^2 shifts whole regions by many sigmas.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from statistics import NormalDist
+
+import numpy as np
+
+ALPHA = 1e-3
+BLOCK = 8
+DEFAULT_POINTS = 1
+
+
+def points(n: float):
+    """Decorator: the test is worth n points."""
+    import pytest
+
+    return pytest.mark.points(n)
+
+
+# --- render comparison ----------------------------------------------------------------
+def render_stack(scene, seeds, **settings) -> np.ndarray:
+    """(R, H, W, 3) linear renders of scene, one per seed (scalar backend)."""
+    import rtpy
+
+    return np.stack([rtpy.render(scene, seed=s, quiet=True, **settings).linear for s in seeds])
+
+
+def summarize(stack: np.ndarray, spp: int) -> dict[str, np.ndarray]:
+    """What a comparison needs of R renders at spp: the mean image, each pixel's
+    per-sample variance (spread of the R values times spp) and the sample count."""
+    stack = np.asarray(stack, dtype=np.float64)
+    if len(stack) < 2:
+        raise ValueError("need at least 2 renders to measure the noise")
+    return {
+        "mean": stack.mean(axis=0),
+        "s2": stack.var(axis=0, ddof=1) * spp,
+        "samples": np.array(spp * len(stack)),
+    }
+
+
+def _blocks(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sums over BLOCK x BLOCK blocks of (H, W, 3) -> (blocks, 3), and pixel counts."""
+    h, w = image.shape[:2]
+    sums, counts = [], []
+    for y in range(0, h, BLOCK):
+        for x in range(0, w, BLOCK):
+            part = image[y : y + BLOCK, x : x + BLOCK]
+            sums.append(part.sum(axis=(0, 1)))
+            counts.append(part.shape[0] * part.shape[1])
+    return np.array(sums), np.array(counts, dtype=np.float64)[:, None]
+
+
+@dataclass
+class Comparison:
+    z: np.ndarray  # (blocks, 3)
+    threshold: float
+    mean: np.ndarray  # block means of the renders being graded
+    reference: np.ndarray  # block means of the reference
+    blocks_x: int
+
+    @property
+    def passed(self) -> bool:
+        return bool(self.z.max() < self.threshold)
+
+    def worst(self) -> str:
+        b, c = np.unravel_index(np.argmax(self.z), self.z.shape)
+        bx, by = b % self.blocks_x, b // self.blocks_x
+        return (
+            f"the {BLOCK}x{BLOCK} block at pixels x={bx * BLOCK}.., y={by * BLOCK}.. "
+            f"({'RGB'[c]}) is {self.mean[b, c]:.4g} where the reference has "
+            f"{self.reference[b, c]:.4g} (z = {self.z[b, c]:.1f}, allowed {self.threshold:.1f}; "
+            f"{int((self.z > self.threshold).any(axis=1).sum())} of {len(self.z)} blocks differ)"
+        )
+
+
+def compare(graded: dict, reference: dict, alpha: float = ALPHA) -> Comparison:
+    """z-test of block means, each side's variance from its own measured noise."""
+    if graded["mean"].shape != reference["mean"].shape:
+        raise ValueError(
+            f"image shapes differ: {graded['mean'].shape} vs {reference['mean'].shape}"
+        )
+    mean_g, n = _blocks(graded["mean"])
+    mean_r, _ = _blocks(reference["mean"])
+    var = _blocks(graded["s2"])[0] / float(graded["samples"]) + _blocks(reference["s2"])[0] / float(
+        reference["samples"]
+    )
+    var = var / (n * n)
+    mean_g, mean_r = mean_g / n, mean_r / n
+    floor = (1e-9 * np.maximum(1.0, np.abs(mean_r))) ** 2  # noiseless blocks: rounding only
+    z = np.abs(mean_g - mean_r) / np.sqrt(var + floor)
+    threshold = NormalDist().inv_cdf(1.0 - alpha / (2 * z.size))
+    blocks_x = -(-graded["mean"].shape[1] // BLOCK)
+    return Comparison(z, threshold, mean_g, mean_r, blocks_x)
+
+
+def load_reference(path: str | Path) -> dict[str, np.ndarray]:
+    with np.load(path) as data:
+        return {k: data[k] for k in data.files}
+
+
+def save_reference(path: str | Path, summary: dict[str, np.ndarray]) -> None:
+    np.savez_compressed(path, **summary)
+
+
+def assert_render_matches(stack: np.ndarray, spp: int, reference: dict, what: str) -> None:
+    """AssertionError naming the worst block unless the renders agree with the reference."""
+    result = compare(summarize(stack, spp), reference)
+    assert result.passed, f"{what}: {result.worst()}"
+
+
+# --- running graders ------------------------------------------------------------------
+@dataclass
+class GraderResult:
+    name: str
+    nodeid: str
+    max_score: float
+    score: float = 0.0
+    output: str = ""
+
+
+@dataclass(eq=False)
+class PointsPlugin:
+    """pytest plugin: every collected test's points, and whether it passed."""
+
+    results: dict[str, GraderResult] = field(default_factory=dict)
+    errors: list[str] = field(default_factory=list)  # graders that could not be loaded
+
+    def pytest_collectreport(self, report) -> None:
+        if report.failed:
+            self.errors.append(f"{report.nodeid}: {failure_message(report)}")
+
+    def pytest_configure(self, config) -> None:
+        config.addinivalue_line("markers", "points(n): points a grader test is worth")
+
+    def pytest_collection_modifyitems(self, items) -> None:
+        for item in items:
+            mark = item.get_closest_marker("points")
+            value = float(mark.args[0]) if mark else DEFAULT_POINTS
+            doc = (getattr(item.function, "__doc__", None) or "").strip().splitlines()
+            name = doc[0] if doc else item.name
+            if "[" in item.name:
+                name += item.name[item.name.index("[") :]
+            self.results[item.nodeid] = GraderResult(name, item.nodeid, value)
+
+    def pytest_runtest_logreport(self, report) -> None:
+        result = self.results.get(report.nodeid)
+        if result is None:
+            return
+        if report.failed:
+            result.score = 0.0
+            result.output = failure_message(report)
+        elif report.when == "call" and report.passed and not result.output:
+            result.score = result.max_score
+
+
+def failure_message(report) -> str:
+    """The exception's message without pytest's reinterpretation of the assert."""
+    crash = getattr(report.longrepr, "reprcrash", None)
+    text = crash.message if crash is not None else str(report.longrepr)
+    return text.split("\nassert ")[0].strip()
+
+
+def grader_dir(week: str, root: Path | None = None) -> Path:
+    """assignments/weekNN under the current directory, else next to the rtpy package."""
+    for base in [root] if root else [Path.cwd(), Path(__file__).resolve().parent.parent]:
+        path = base / "assignments" / f"week{week}"
+        if path.is_dir():
+            return path
+    raise FileNotFoundError(f"assignments/week{week}: not found in {Path.cwd()} or beside rtpy")
+
+
+def grade(week: str, extra_args: tuple[str, ...] = (), root: Path | None = None) -> dict:
+    """Run week's graders in this process; the Gradescope results dictionary."""
+    import pytest
+
+    folder = grader_dir(week, root)
+    plugin = PointsPlugin()
+    start = time.perf_counter()
+    pytest.main(
+        # quiet: the score table shows each failure's message (pytest on the folder
+        # shows the tracebacks)
+        [str(folder), "-qq", "-p", "no:cacheprovider", "--tb=no", "-o", "addopts=", *extra_args],
+        plugins=[plugin],
+    )
+    tests = [
+        {"name": r.name, "score": r.score, "max_score": r.max_score, "output": r.output}
+        for r in plugin.results.values()
+    ]
+    results = {
+        "score": sum(t["score"] for t in tests),
+        "max_score": sum(t["max_score"] for t in tests),
+        "execution_time": round(time.perf_counter() - start, 2),
+        "tests": tests,
+    }
+    if plugin.errors or not tests:
+        # Gradescope shows the top-level output; the score is 0, not 0 of 0.
+        results["score"] = 0
+        results["output"] = "The graders could not be loaded (is rtpy importable?):\n" + (
+            "\n".join(plugin.errors) or f"no tests found in {folder}"
+        )
+    return results
+
+
+def score_table(results: dict) -> str:
+    if "output" in results:
+        return results["output"]
+    rows = [(t["name"], f"{t['score']:g}/{t['max_score']:g}") for t in results["tests"]]
+    width = max([len(r[0]) for r in rows] + [4])
+    lines = [f"{'test':<{width}}  points", "-" * (width + 8)]
+    for (name, pts), t in zip(rows, results["tests"], strict=True):
+        lines.append(f"{name:<{width}}  {pts}")
+        if t["output"]:
+            lines.extend(f"    {line}" for line in t["output"].splitlines()[:6])
+    lines.append("-" * (width + 8))
+    lines.append(f"{'total':<{width}}  {results['score']:g}/{results['max_score']:g}")
+    return "\n".join(lines)
+
+
+def write_json(results: dict, path: str | Path) -> None:
+    Path(path).write_text(json.dumps(results, indent=2) + "\n")

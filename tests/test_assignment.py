@@ -1,0 +1,172 @@
+"""Student repositories generated from the solution regions (rtpy.assignment).
+
+What is checked, for every week 03-08, in a repository written by
+`python -m rtpy assignment make WEEK OUT` (one subprocess per week, with the
+repository's own rtpy first on the path):
+
+- every grader of that week fails (score 0), each with the NotImplementedError of a
+  stub that names the week's task — proof that the graders can fail;
+- a smoke subset of the rtpy tests shipped there passes (SMOKE, those of them the
+  repository holds), and `import rtpy` works;
+- no solution line of that week or a later one is left in the repository, every
+  earlier week's solution is, and the numpy backend's solution code is absent.
+
+The full shipped test suite is not run here (six copies would take most of the CI
+budget); `assignments/test_weeks.toml` decides which tests ship (see rtpy/assignment.py).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rtpy.assignment import (
+    MACHINERY_TESTS,
+    NUMPY_USE,
+    TEST_WEEKS_FILE,
+    WEEKS,
+    AssignmentError,
+    find_regions,
+    make_assignment,
+    map_tests,
+    regions_in,
+    shipped_tests,
+    weeks_of_tests,
+)
+from rtpy.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+# Fast tests of code every week's repository has (where shipped).
+SMOKE = [
+    "tests/test_ray.py",
+    "tests/test_interval.py",
+    "tests/test_light.py",
+    "tests/test_packaging.py",
+]
+
+DRIVER = """
+import json, sys
+import pytest
+from rtpy.grading import grade
+results = grade(sys.argv[1])
+smoke = [p for p in sys.argv[2:]]
+status = pytest.main(["-q", "-p", "no:cacheprovider", *smoke]) if smoke else 0
+print(json.dumps({"grade": results, "smoke": int(status)}))
+"""
+
+
+def test_every_week_has_regions_inside_functions():
+    regions = find_regions(ROOT)
+    assert {r.week for r in regions} == set(WEEKS)
+    for r in regions:
+        assert r.function and r.message, r
+        assert r.end > r.begin + 1, f"{r.path}:{r.begin + 1}: empty region"
+
+
+def test_every_test_file_is_mapped():
+    """assignments/test_weeks.toml covers every test file (a new test file needs
+    `python -m rtpy assignment map-tests`, or it would ship to weeks it fails in)."""
+    mapped = set(weeks_of_tests(ROOT))
+    for path in (ROOT / "tests").rglob("test_*.py"):
+        rel = path.relative_to(ROOT).as_posix()
+        if rel.startswith("tests/numpy_backend/") or rel in MACHINERY_TESTS:
+            continue
+        if NUMPY_USE.search(path.read_text()):
+            continue  # uses the numpy backend: never ships
+        assert rel in mapped, f"{rel} is not in assignments/test_weeks.toml: run map-tests"
+
+
+def test_unbalanced_markers_are_refused(tmp_path):
+    (tmp_path / "rtpy").mkdir()
+    bad = tmp_path / "rtpy" / "bad.py"
+    bad.write_text("def f():\n    # BEGIN SOLUTION week05: x\n    return 1\n")
+    with pytest.raises(AssignmentError, match="without END"):
+        regions_in(bad, tmp_path)
+    bad.write_text("x = 1\n# BEGIN SOLUTION week05: x\nx = 2\n# END SOLUTION\n")
+    with pytest.raises(AssignmentError, match="inside a function"):
+        regions_in(bad, tmp_path)
+
+
+def test_bad_week_and_non_empty_output_are_refused(tmp_path, capsys):
+    assert main(["assignment", "make", "09", str(tmp_path / "out")]) == 2
+    assert "expected one of 03" in capsys.readouterr().err
+    (tmp_path / "full").mkdir()
+    (tmp_path / "full" / "x").write_text("")
+    assert main(["assignment", "make", "05", str(tmp_path / "full")]) == 2
+    assert "not an empty directory" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["full"]  # nothing half-written
+
+
+def check_regions(repo: Path, week: str) -> None:
+    """Week `week` and later: the region's code is gone and a stub naming the week's
+    task and the function stands in its place. Earlier weeks: the code is there."""
+    for r in find_regions(ROOT):
+        block = "".join((ROOT / r.path).read_text().splitlines(keepends=True)[r.begin + 1 : r.end])
+        text = (repo / r.path).read_text()
+        if int(r.week) >= int(week):
+            assert block not in text, f"{r.path}: {r.function}: week {r.week} solution shipped"
+            assert f'"week{r.week} task: {r.function}:' in text, (
+                f"{r.path}: no stub for {r.function}"
+            )
+        else:
+            assert block in text, f"{r.path}: {r.function}: week {r.week} solution missing"
+
+
+@pytest.mark.parametrize("week", WEEKS)
+def test_student_repository(tmp_path, week):
+    repo = make_assignment(week, tmp_path / f"week{week}")
+    check_regions(repo, week)
+    assert not (repo / "rtpy" / "numpy_backend" / "geometry.py").exists()
+    assert (repo / "assignments" / f"week{week}" / "README.md").exists()
+    kept, left = shipped_tests(ROOT, week)
+    assert sorted(str(p.relative_to(repo)) for p in (repo / "tests").rglob("*.py")) == kept
+    assert left and all(not (repo / p).exists() for p in left)
+
+    smoke = [p for p in SMOKE if p in kept]
+    env = dict(os.environ, PYTHONPATH=str(repo))
+    proc = subprocess.run(
+        [sys.executable, "-c", DRIVER, week, *smoke],
+        cwd=repo,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    report = json.loads(proc.stdout.strip().splitlines()[-1])
+    tests = report["grade"]["tests"]
+    assert len(tests) >= 5
+    for t in tests:
+        assert t["score"] == 0, f"week {week}: {t['name']} passes on the stubs"
+        assert "NotImplementedError" in t["output"] and f"week{week} task" in t["output"], t
+    assert report["smoke"] == 0, f"week {week}: smoke tests {smoke} failed:\n{proc.stdout[-3000:]}"
+
+
+def test_map_tests_of_some_files_records_their_weeks_and_keeps_the_rest(tmp_path):
+    """map-tests FILES runs only those files on the instrumented copy: their entries
+    are replaced by the weeks they execute, every other entry is kept."""
+    (tmp_path / "rtpy").mkdir()
+    (tmp_path / "rtpy" / "__init__.py").write_text("from __future__ import annotations\n")
+    (tmp_path / "rtpy" / "shade.py").write_text(
+        "def twice(x):\n"
+        "    # BEGIN SOLUTION week05: twice\n"
+        "    return 2 * x\n"
+        "    # END SOLUTION\n"
+    )
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "test_shade.py").write_text(
+        "from rtpy.shade import twice\n\n\ndef test_twice():\n    assert twice(2) == 4\n"
+    )
+    (tmp_path / "tests" / "test_other.py").write_text("def test_nothing():\n    assert True\n")
+    (tmp_path / "assignments").mkdir()
+    (tmp_path / TEST_WEEKS_FILE).write_text(
+        '[tests]\n"tests/test_other.py" = [7]\n"tests/test_shade.py" = [3]\n'
+    )
+    weeks = map_tests(tmp_path, files=("tests/test_shade.py",))
+    assert weeks == {"tests/test_other.py": {"07"}, "tests/test_shade.py": {"05"}}
+    on_disk = weeks_of_tests(tmp_path)
+    assert on_disk == {"tests/test_other.py": ["07"], "tests/test_shade.py": ["05"]}
