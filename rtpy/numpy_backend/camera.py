@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from ..camera import Camera
+from .arrays import scale
 
 
 def _v(v) -> np.ndarray:
@@ -43,17 +44,26 @@ class CameraRays:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Rays through fractional pixel positions (px, py); with defocus, lens1 and
         lens2 are the two uniform numbers random_in_unit_disk would draw."""
-        target = (self.pixel00 + px[:, None] * self.du) + py[:, None] * self.dv
+        # Component by component (a (3,) row broadcast against (N, 1) columns is
+        # several times slower in numpy), in the scalar code's order of operations.
+        n = len(px)
+        target, origin = np.empty((n, 3)), np.empty((n, 3))
         if self.defocus:
             radius = np.sqrt(lens1)
             phi = 2.0 * math.pi * lens2
             x, y = radius * np.cos(phi), radius * np.sin(phi)
-            origin = (self.look_from + self.disk_u * x[:, None]) + self.disk_v * y[:, None]
-        else:
-            origin = np.broadcast_to(self.look_from, target.shape)
+        for c in range(3):
+            col = target[:, c]
+            np.multiply(px, self.du[c], out=col)
+            col += self.pixel00[c]
+            col += py * self.dv[c]
+            if self.defocus:
+                origin[:, c] = (self.look_from[c] + self.disk_u[c] * x) + self.disk_v[c] * y
+            else:
+                origin[:, c] = self.look_from[c]
         d = target - origin
         k = 1.0 / np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2])
-        return np.ascontiguousarray(origin), d * k[:, None]
+        return origin, scale(d, k)
 
     def center_rays(self, i: np.ndarray, j: np.ndarray, rng=None):
         """Camera.get_center_ray for pixels (i, j); the lens still needs uniforms."""

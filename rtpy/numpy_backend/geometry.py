@@ -33,13 +33,20 @@ from ..sphere import Sphere
 from ..triangle import Triangle
 from ..vec3 import Vec3
 from .arrays import axpy, put_rows, scale
-from .hits import HitBatch
+from .hits import HitBatch, unused
 
 # Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
 BVH_THRESHOLD = 24
 BVH_LEAF_SIZE = 4
-# Rays are intersected in chunks of this many, so (chunk, K) temporaries stay in cache.
+# Rays are intersected in chunks of PAIR_CHUNK // K rays (at least RAY_CHUNK), so
+# (chunk, K) temporaries stay in cache while small sets still make few numpy calls.
 RAY_CHUNK = 1024
+PAIR_CHUNK = 18432
+# A brute-force set of planar primitives culls clusters of them by their bounding box
+# (see cluster_parts): clusters of at least CLUSTER_SIZE primitives whose box has at
+# most CLUSTER_AREA of the surface area of the whole set's box.
+CLUSTER_SIZE = 3
+CLUSTER_AREA = 0.5
 
 INF = math.inf
 # Quads accept hits this little outside their edges (in units of the edge length):
@@ -241,6 +248,7 @@ class PrimitiveSet:
 
     objects: list[Hittable]
     bvh: BVH | None = None
+    parts: list | None = None  # see cluster_parts
 
     def __len__(self) -> int:
         return len(self.objects)
@@ -249,9 +257,12 @@ class PrimitiveSet:
     def pair_t(self, o, d, k, t_min, t_max) -> np.ndarray:
         raise NotImplementedError
 
-    def all_t(self, o: np.ndarray, d: np.ndarray, t_min: float) -> np.ndarray:
+    def all_t(
+        self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray | None = None
+    ) -> np.ndarray:
         """(N, K) ray parameters of every ray against every primitive with t > t_min
-        (inf: miss). The caller compares the smallest with each ray's t_max."""
+        (inf: miss). The caller compares the smallest with each ray's t_max; a set may
+        use t_max (N,), when given, to skip pairs that cannot hit before it."""
         k = np.arange(len(self))[None, :]
         return self.pair_t(o[:, None, :], d[:, None, :], k, t_min, INF)
 
@@ -283,11 +294,14 @@ class PrimitiveSet:
                 return t
 
             return self.bvh.traverse(o, d, t_min, t_max, test, any_hit)
+        if self.parts is not None:
+            return self._closest_by_parts(o, d, t_min, t_max, any_hit, skip)
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(len(o), -1, dtype=np.int64)
-        for s in range(0, len(o), RAY_CHUNK):
-            e = min(s + RAY_CHUNK, len(o))
-            t = self.all_t(o[s:e], d[s:e], t_min)
+        chunk = max(RAY_CHUNK, PAIR_CHUNK // len(self))
+        for s in range(0, len(o), chunk):
+            e = min(s + chunk, len(o))
+            t = self.all_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None)
             if skip is not None:
                 r = np.flatnonzero(skip[s:e] >= 0)
                 t[r, skip[s:e][r]] = INF
@@ -297,6 +311,65 @@ class PrimitiveSet:
             t_best[s:e][hit] = tj[hit]
             idx[s:e][hit] = j[hit]
         return t_best, idx
+
+    def cluster(self) -> None:
+        """Without a BVH: split the set into parts (cluster_parts), when that culls any."""
+        if self.bvh is not None or len(self) < 2 * CLUSTER_SIZE:
+            return
+        lo, hi = self.bounds()
+        groups = cluster_parts(self.corners(), lo, hi)
+        if len(groups) < 2:
+            return
+        # One part per group: (box lo, box hi, the group as a set of its own, members);
+        # the first part, the primitives in no cluster, has no box (every ray tests it).
+        self.parts = []
+        self.part_of = np.empty(len(self), dtype=np.int64)  # primitive -> its part
+        self.part_pos = np.empty(len(self), dtype=np.int64)  # primitive -> index in part
+        for g, members in enumerate(groups):
+            if g == 0 and members.size == 0:
+                continue
+            sub = type(self)([self.objects[i] for i in members], cluster=False)
+            box = (None, None) if g == 0 else _padded_box(lo[members], hi[members])
+            self.part_of[members] = len(self.parts)
+            self.part_pos[members] = np.arange(members.size)
+            self.parts.append((*box, sub, members))
+
+    def _closest_by_parts(self, o, d, t_min, t_max, any_hit, skip):
+        """closest() over self.parts: each clustered part only for the rays that enter
+        its box before the closest hit found so far (so the unclustered part goes first)."""
+        t_best = np.array(t_max, dtype=np.float64, copy=True)
+        idx = np.full(len(o), -1, dtype=np.int64)
+        oc = np.ascontiguousarray(o.T)
+        with np.errstate(divide="ignore"):
+            inv = 1.0 / np.ascontiguousarray(d.T)
+        for p, (lo, hi, part, members) in enumerate(self.parts):
+            if lo is None:
+                rays = None
+                ro, rd, rt = o, d, t_best
+            else:
+                enter = _enters_box(oc, inv, lo, hi, t_min, t_best)
+                if any_hit:
+                    enter &= idx < 0
+                rays = np.flatnonzero(enter)
+                if rays.size == 0:
+                    continue
+                ro, rd, rt = o.take(rays, axis=0), d.take(rays, axis=0), t_best.take(rays)
+            local_skip = None
+            if skip is not None:
+                sk = skip if rays is None else skip.take(rays)
+                k = np.maximum(sk, 0)
+                mine = (sk >= 0) & (self.part_of.take(k) == p)
+                local_skip = np.where(mine, self.part_pos.take(k), -1)
+            t, k = part.closest(ro, rd, t_min, rt, any_hit, local_skip)
+            hit = np.flatnonzero(k >= 0)
+            w = hit if rays is None else rays.take(hit)
+            t_best[w] = t.take(hit)
+            idx[w] = members.take(k.take(hit))
+        return t_best, idx
+
+    def corners(self) -> np.ndarray:
+        """(K, C, 3) corners of the primitives (for clustering)."""
+        raise NotImplementedError
 
     def sample_light(self, k, p, r1, r2):
         direction, pdf, valid = self.sample_direction(k, p, r1, r2)
@@ -325,6 +398,74 @@ class PrimitiveSet:
 
     def sample_point(self, k, r1, r2) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
+
+
+def cluster_parts(corners: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
+    """Groups of primitives worth culling together by one bounding box, as index arrays;
+    the first holds the primitives in no such group (possibly none).
+
+    A group is a connected set of primitives sharing corners (up to 1e-5 of the set's
+    size: the six quads of a box), of at least CLUSTER_SIZE primitives, whose box has
+    at most CLUSTER_AREA of the surface area of the whole set's box. In the Cornell
+    box the two boxes are groups (a ray enters their boxes ~20% and ~15% of the time),
+    the walls (whose box is the whole set's) and the light are not."""
+    k = len(corners)
+    extent = hi.max(axis=0) - lo.min(axis=0)
+    tol = 1e-5 * float(extent.max())
+    root = list(range(k))
+
+    def find(i: int) -> int:
+        while root[i] != i:
+            i = root[i]
+        return i
+
+    for i in range(k):
+        for j in range(i + 1, k):
+            gap = np.abs(corners[i][:, None, :] - corners[j][None, :, :]).max(axis=2)
+            if gap.min() <= tol:
+                root[find(j)] = find(i)
+    comps: dict[int, list[int]] = {}
+    for i in range(k):
+        comps.setdefault(find(i), []).append(i)
+    whole = _box_area(lo.min(axis=0), hi.max(axis=0))
+    free, groups = [], []
+    for members in comps.values():
+        m = np.array(members, dtype=np.int64)
+        small = _box_area(lo[m].min(axis=0), hi[m].max(axis=0)) <= CLUSTER_AREA * whole
+        if len(m) >= CLUSTER_SIZE and small:
+            groups.append(m)
+        else:
+            free.extend(members)
+    return [np.array(sorted(free), dtype=np.int64), *groups] if groups else []
+
+
+def _box_area(lo: np.ndarray, hi: np.ndarray) -> float:
+    e = np.maximum(hi - lo, 0.0)
+    return float(2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]))
+
+
+def _padded_box(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The box around boxes lo, hi (K, 3), padded so rounding in the slab test cannot
+    cull a ray that grazes a primitive on the box's boundary."""
+    lo, hi = lo.min(axis=0), hi.max(axis=0)
+    pad = 1e-7 * (float((hi - lo).max()) + float(np.abs(lo).max()) + float(np.abs(hi).max()))
+    return lo - pad, hi + pad
+
+
+def _enters_box(oc, inv, lo, hi, t_min: float, t_max: np.ndarray) -> np.ndarray:
+    """(N,) bool: rays (origin columns oc (3, N), reciprocal direction columns inv)
+    meet the box lo, hi at some t in (t_min, t_max) (slab test, one axis at a time).
+    A zero direction component gives inv = +-inf; then (lo - o) * inv is nan only for
+    an origin exactly on a slab plane, and nan comparisons count as entering."""
+    near = far = None
+    with np.errstate(invalid="ignore"):
+        for c in range(3):
+            a = (lo[c] - oc[c]) * inv[c]
+            b = (hi[c] - oc[c]) * inv[c]
+            n_c, f_c = np.minimum(a, b), np.maximum(a, b)
+            near = n_c if near is None else np.fmax(near, n_c)
+            far = f_c if far is None else np.fmin(far, f_c)
+        return ~((near > far) | (far <= t_min) | (near >= t_max))
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -407,10 +548,17 @@ class SphereSet(PrimitiveSet):
     def closest(self, o, d, t_min, t_max, any_hit=False, skip=None):
         """As PrimitiveSet.closest. Without a BVH, one sphere at a time over all rays
         (1-D arrays of length N: an (N, K) broadcast runs numpy's inner loop over the
-        K spheres, which is slow for small K). Each sphere first rejects the rays
-        that miss it (the first half of pair_t) and finishes the root only for the
-        rest, against the closest t found so far; the arithmetic per (ray, sphere) is
-        pair_t's, so t is bit-identical and ties keep the lower index (as argmin)."""
+        K spheres, which is slow for small K). Each sphere first rejects, for all rays,
+        those that surely miss it, by a cheaper test than pair_t's (below), and runs
+        pair_t's arithmetic, op for op, only for the rest, against the closest t found
+        so far: t is bit-identical and ties keep the lower index (as argmin).
+
+        The cheap test: pair_t misses where the sphere is behind an origin outside it
+        (h < 0 and |oc|^2 > r^2), or where the line passes farther than r from the
+        centre (f2 > r^2, f2 computed without cancellation). Here f2 is replaced by
+        |oc|^2 - h^2 / a, which cancels but errs by only ~1e-15 |oc|^2, so rays are
+        kept when it is at most r^2 + 1e-9 |oc|^2: a superset of pair_t's hits; the
+        kept rays then get pair_t's exact test."""
         if self.bvh is not None:
             return super().closest(o, d, t_min, t_max, any_hit, skip)
         n = len(o)
@@ -419,18 +567,15 @@ class SphereSet(PrimitiveSet):
         ox, oy, oz = np.ascontiguousarray(o.T)
         dx, dy, dz = np.ascontiguousarray(d.T)
         a_all = dx * dx + dy * dy + dz * dz
+        inv_a = 1.0 / a_all
         for k in range(len(self)):
             cx, cy, cz = self.center[k]
             r, r2 = self.radius[k], self.r2[k]
             ocx, ocy, ocz = cx - ox, cy - oy, cz - oz
             h = dx * ocx + dy * ocy + dz * ocz
-            c_term = ocx * ocx + ocy * ocy + ocz * ocz - r2
-            kk = h / a_all
-            fx = ocx - kk * dx
-            fy = ocy - kk * dy
-            fz = ocz - kk * dz
-            f2 = fx * fx + fy * fy + fz * fz
-            cand = ~(((h < 0.0) & (c_term > 0.0)) | (f2 > r2))
+            oc2 = ocx * ocx + ocy * ocy + ocz * ocz
+            cand = oc2 * (1.0 - 1e-9) - r2 <= h * h * inv_a
+            cand &= (h >= 0.0) | (oc2 <= r2)
             if any_hit:
                 cand &= idx < 0
             if skip is not None:
@@ -438,9 +583,16 @@ class SphereSet(PrimitiveSet):
             j = np.flatnonzero(cand)
             if j.size == 0:
                 continue
-            a, tm = a_all, t_best
+            a, tm, jx, jy, jz = a_all, t_best, dx, dy, dz
             if j.size < n:
-                h, c_term, f2, a, tm = h[j], c_term[j], f2[j], a_all[j], t_best[j]
+                h, oc2, ocx, ocy, ocz = h[j], oc2[j], ocx[j], ocy[j], ocz[j]
+                a, tm, jx, jy, jz = a_all[j], t_best[j], dx[j], dy[j], dz[j]
+            c_term = oc2 - r2
+            kk = h / a
+            fx = ocx - kk * jx
+            fy = ocy - kk * jy
+            fz = ocz - kk * jz
+            f2 = fx * fx + fy * fy + fz * fz
             with np.errstate(invalid="ignore", divide="ignore"):
                 f = np.sqrt(f2)
                 disc = a * (r - f) * (r + f)
@@ -451,7 +603,7 @@ class SphereSet(PrimitiveSet):
             hi = np.maximum(t0, t1)
             t = np.where((t_min < hi) & (hi < tm), hi, INF)
             t = np.where((t_min < lo) & (lo < tm), lo, t)
-            hit = (t < tm) & (q != 0.0)
+            hit = (t < tm) & (q != 0.0) & (f2 <= r2)
             w = j[hit] if j.size < n else np.flatnonzero(hit)
             t_best[w] = t[hit]
             idx[w] = k
@@ -608,7 +760,7 @@ class QuadSet(PlanarSet):
     so for p = o + t d: a = o . A + t (d . A) - q . A with A = v x w (B = w x u likewise).
     """
 
-    def __init__(self, quads: Sequence[Quad]) -> None:
+    def __init__(self, quads: Sequence[Quad], cluster: bool = True) -> None:
         self.objects = list(quads)
         f = np.float64
         self.q = np.array([_v(s.q) for s in quads], dtype=f).reshape(-1, 3)
@@ -632,12 +784,20 @@ class QuadSet(PlanarSet):
         self.Md_a = 2.0 * self.A.T
         self.Md_b = 2.0 * self.B.T
         self.build_bvh()
+        if cluster:
+            self.cluster()
+
+    def corners(self):
+        return np.stack([self.q, self.q + self.u, self.q + self.v, self.q + self.u + self.v], 1)
 
     def bounds(self):
-        corners = np.stack([self.q, self.q + self.u, self.q + self.v, self.q + self.u + self.v])
-        return corners.min(axis=0), corners.max(axis=0)
+        corners = self.corners()
+        return corners.min(axis=1), corners.max(axis=1)
 
-    def all_t(self, o, d, t_min):
+    def all_t(self, o, d, t_min, t_max=None):
+        """As PrimitiveSet.all_t. With t_max (N,) (occlusion), the edges are tested
+        only for the quads whose plane some ray crosses in (t_min, t_max): a shadow
+        ray inside a room crosses none of the walls' planes."""
         # Homogeneous o: one product gives d - o.n and 2 (o.A - q.A) - 1 (and for B),
         # so a' = 2a - 1 and b' = 2b - 1 need one multiply-add each and the test
         # 0 <= a, b <= 1 becomes max(|a'|, |b'|) <= 1.
@@ -646,15 +806,28 @@ class QuadSet(PlanarSet):
         oh[:, 3] = 1.0
         with np.errstate(divide="ignore", invalid="ignore"):
             t = (oh @ self.Mo_n) / (d @ self.Md_n)
-            a = oh @ self.Mo_a
-            a += t * (d @ self.Md_a)
-            b = oh @ self.Mo_b
-            b += t * (d @ self.Md_b)
-            np.abs(a, out=a)
-            np.abs(b, out=b)
-            np.maximum(a, b, out=a)
-            ok = a <= EDGE
-            ok &= t > t_min
+            if t_max is None:
+                return self._inside(oh, d, t, t_min, slice(None))
+            crossed = (t > t_min) & (t < t_max[:, None])
+            cols = np.flatnonzero(crossed.any(axis=0))
+            if cols.size == len(self):
+                return self._inside(oh, d, t, t_min, slice(None))
+            out = np.full(t.shape, INF)
+            if cols.size:
+                out[:, cols] = self._inside(oh, d, t[:, cols], t_min, cols)
+            return out
+
+    def _inside(self, oh, d, t, t_min, cols):
+        """t where the hits at t on the quads cols lie inside them (else inf)."""
+        a = oh @ self.Mo_a[:, cols]
+        a += t * (d @ self.Md_a[:, cols])
+        b = oh @ self.Mo_b[:, cols]
+        b += t * (d @ self.Md_b[:, cols])
+        np.abs(a, out=a)
+        np.abs(b, out=b)
+        np.maximum(a, b, out=a)
+        ok = a <= EDGE
+        ok &= t > t_min
         return np.where(ok, t, INF)
 
     def pair_t(self, o, d, k, t_min, t_max):
@@ -701,7 +874,7 @@ class TriangleSet(PlanarSet):
     are precomputed; the ray-sided ones are (N, 3) x (3, K) products).
     """
 
-    def __init__(self, triangles: Sequence[Triangle]) -> None:
+    def __init__(self, triangles: Sequence[Triangle], cluster: bool = True) -> None:
         self.objects = list(triangles)
         f = np.float64
         self.a = np.array([_v(s.a) for s in triangles], dtype=f).reshape(-1, 3)
@@ -722,10 +895,15 @@ class TriangleSet(PlanarSet):
         self.Md = np.concatenate([self.N, self.e2xa, self.axe1], axis=0).T.copy()
         self.Mm = np.concatenate([self.e2, self.e1], axis=0).T.copy()
         self.build_bvh()
+        if cluster:
+            self.cluster()
+
+    def corners(self):
+        return np.stack([self.a, self.a + self.e1, self.a + self.e2], 1)
 
     def bounds(self):
-        corners = np.stack([self.a, self.a + self.e1, self.a + self.e2])
-        return corners.min(axis=0), corners.max(axis=0)
+        corners = self.corners()
+        return corners.min(axis=1), corners.max(axis=1)
 
     def _finish(self, det, parallel, u_num, v_num, t_num, t_min, t_max):
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -737,7 +915,7 @@ class TriangleSet(PlanarSet):
         ok &= (t > t_min) & (t < t_max)
         return np.where(ok, t, INF)
 
-    def all_t(self, o, d, t_min):
+    def all_t(self, o, d, t_min, t_max=None):
         k = len(self)
         m = np.cross(o, d)
         on = o @ self.Mo
@@ -1014,7 +1192,7 @@ class Geometry:
             for kd, i in groups:
                 u[i], v[i] = self.sets[kd].uv(local[i], point[i])
         else:
-            u = v = np.zeros(n)
+            u = v = unused(n)
         if need_tangent:
             tangent = np.empty((n, 3))
             valid = np.empty(n, dtype=bool)
@@ -1024,7 +1202,7 @@ class Geometry:
                 bad = ~valid
                 tangent[bad] = onb_u(normal[bad])
         else:
-            tangent = np.zeros((n, 3))
+            tangent = unused(n, 3)
         return HitBatch(point, normal, -d, t, front, u, v, tangent)
 
     def set_of(self, obj: np.ndarray):

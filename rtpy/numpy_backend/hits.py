@@ -15,6 +15,23 @@ if TYPE_CHECKING:
     from ..materials.material import Material
 
 
+def unused(*shape: int) -> np.ndarray:
+    """Zeros of the given shape for a field nothing reads (a HitBatch's (u, v) or
+    tangent when the scene does not need them): a read-only broadcast, not allocated,
+    and not copied by HitBatch.take. (np.broadcast_to would do, but costs a few times
+    more than this direct construction, and HitBatches are made very often.)"""
+    return np.ndarray(shape, np.float64, buffer=_ZERO, strides=(0,) * len(shape))
+
+
+_ZERO = bytes(8)  # one float64 0.0, read-only
+
+
+def _rows(a: np.ndarray, k: np.ndarray) -> np.ndarray:
+    if a.strides[0] == 0:  # unused()
+        return unused(len(k), *a.shape[1:])
+    return rows(a, k)
+
+
 @dataclass
 class HitBatch:
     """N surface hits as float64 arrays, with the conventions of the scalar HitInfo.
@@ -27,6 +44,8 @@ class HitBatch:
     u, v        (N,) surface coordinates
     tangent     (N, 3) unit vectors in the surface along increasing u (what the scalar
                 hit.tangent gives: the x axis of the shading frame)
+
+    (u, v) and tangent are unused() zeros when nothing in the scene reads them.
     """
 
     point: np.ndarray
@@ -52,9 +71,9 @@ class HitBatch:
             rows(self.wo, k),
             self.t.take(k),
             self.front_face.take(k),
-            self.u.take(k),
-            self.v.take(k),
-            rows(self.tangent, k),
+            _rows(self.u, k),
+            _rows(self.v, k),
+            _rows(self.tangent, k),
         )
 
     def hit_info(self, i: int, material: Material | None = None) -> HitInfo:

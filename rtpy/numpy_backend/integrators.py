@@ -317,6 +317,12 @@ class PathIntegrator(BatchIntegrator):
             )
             if segment >= max_depth:
                 break
+            inert = materials.inert.take(ids)
+            if inert.any():  # paths end on lights that reflect nothing (no kernel split)
+                k = np.flatnonzero(~inert)
+                rows, ids, hits, beta = rows.take(k), ids.take(k), hits.take(k), rows_of(beta, k)
+                if rows.size == 0:
+                    break
             if n_lights:
                 ns = np.flatnonzero(~materials.specular.take(ids))
                 if ns.size == rows.size:

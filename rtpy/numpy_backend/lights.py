@@ -21,8 +21,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import Scene
-from .arrays import put_rows, rows
+from .arrays import put_rows, rows, where_rows
 from .geometry import Geometry
+from .materials.simple import DiffuseLightKernel
+
+
+def _dot3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
 
 
 @dataclass
@@ -71,6 +76,24 @@ class LightTable:
         self.n_point = len(pl)
         self.n_area = len(self.area_object)
         self.n = self.n_point + self.n_area
+        self.single = self._single_diffuse_light()
+
+    def _single_diffuse_light(self):
+        """(set, local index, object, emit (3,), two_sided) when the scene's only light
+        is one area light whose material is a DiffuseLight (all bundled scenes with an
+        area light), else None. Such a light is sampled by sample_single."""
+        kernels = getattr(self.materials, "kernels", None)
+        if self.n != 1 or self.n_area != 1 or kernels is None:
+            return None
+        obj = int(self.area_object[0])
+        mid = int(self.geometry.material_id[obj])
+        kernel = kernels[self.materials.kind[mid]]
+        if not isinstance(kernel, DiffuseLightKernel):
+            return None
+        slot = self.materials.slot[mid]
+        g = self.geometry
+        prims = g.sets[g.kind[obj]]
+        return prims, int(g.local[obj]), obj, kernel.emit[slot], bool(kernel.two_sided[slot])
 
     def count(self, include_area: bool = True) -> int:
         return self.n if include_area else self.n_point
@@ -82,6 +105,8 @@ class LightTable:
         among all lights (or only the point lights), then a direction toward it."""
         n = len(p)
         n_lights = self.count(include_area)
+        if self.single is not None and include_area:
+            return self.sample_single(p, rng)
         u = rng.random(n)
         choice = np.minimum((u * n_lights).astype(np.int64), n_lights - 1)
         out = LightSamples(
@@ -108,6 +133,26 @@ class LightTable:
             obj = self.area_object.take(choice.take(ar) - self.n_point)
             self.sample_area(rows(p, ar), obj, r[0], r[1], out, ar)
         return out
+
+    def sample_single(self, p: np.ndarray, rng: np.random.Generator) -> LightSamples:
+        """sample() for a single DiffuseLight area light: no light choice, and the
+        emission is `emit` where the sample sees the light's front face (or both faces
+        when two-sided), without building the hits on the light."""
+        prims, local, obj, emit, two_sided = self.single
+        n = len(p)
+        rng.random(n)  # the light choice's number: the general path's random stream
+        r = rng.random((2, n))
+        k = np.full(n, local, dtype=np.int64)
+        direction, pdf, valid, t, point, geo = prims.sample_light(k, p, r[0], r[1])
+        valid &= pdf > 0.0
+        # The front face is the one the geometric normal points to: dot(geo, d) < 0
+        # for the direction d arriving there, as in Geometry.hits_at.
+        on = valid if two_sided else valid & (_dot3(geo, direction) < 0.0)
+        radiance = where_rows(on, np.broadcast_to(emit, (n, 3)))
+        delta = np.zeros(n, dtype=bool)
+        return LightSamples(
+            direction, t, radiance, pdf, delta, point, valid, np.full(n, obj, dtype=np.int64)
+        )
 
     def _sample_point_lights(self, p, choice, idx, out: LightSamples) -> None:
         q = self.point_position[choice[idx]]

@@ -14,6 +14,7 @@ agree up to Monte Carlo noise, not bit for bit.)
 
 from __future__ import annotations
 
+import ctypes
 import math
 import multiprocessing
 import resource
@@ -53,6 +54,31 @@ def plan_units(width: int, height: int, spp: int) -> list[Unit]:
     ]
 
 
+def keep_freed_memory() -> None:
+    """Ask glibc's malloc to keep freed blocks of up to 32 MB in the heap (Linux; a
+    no-op elsewhere). The backend allocates and frees the same temporaries of a few
+    hundred KB (arrays over a unit's rays) thousands of times per second; by default
+    glibc maps each one freshly from the kernel and unmaps it when it is freed, so
+    every page of every temporary faults on first touch: ~1/4 of the render time on
+    the development machine. This is malloc's documented tuning (mallopt, the
+    MALLOC_MMAP_THRESHOLD_ and MALLOC_TRIM_THRESHOLD_ variables), process-wide: the
+    process keeps up to 128 MB of freed memory for reuse instead of returning it."""
+    global _malloc_tuned
+    if _malloc_tuned or not sys.platform.startswith("linux"):
+        return
+    _malloc_tuned = True
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+        libc.mallopt(M_MMAP_THRESHOLD, 32 << 20)
+        libc.mallopt(M_TRIM_THRESHOLD, 128 << 20)
+    except (OSError, AttributeError):  # not glibc: keep the allocator's defaults
+        pass
+
+
+M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3  # glibc's <malloc.h>
+_malloc_tuned = False
+
+
 def unit_generator(seed: int, unit: Unit) -> np.random.Generator:
     return np.random.default_rng([int(seed), unit.tile, unit.batch])
 
@@ -81,6 +107,7 @@ _worker_state: tuple | None = None
 def _init_worker(scene: Scene, camera: Camera, settings: RenderSettings) -> None:
     global _worker_state
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
+    keep_freed_memory()
     _worker_state = (Tracer(scene), CameraRays(camera), make_integrator(settings), settings.seed)
 
 
@@ -103,6 +130,7 @@ class NumpyRenderer(Renderer):
 
     def render(self) -> RenderedImage:
         settings, camera = self.settings, self.camera
+        keep_freed_memory()
         spp = 1 if make_integrator(settings).uses_center_ray else settings.spp
         units = plan_units(camera.width, camera.height, spp)
         results = PixelSums(camera.width, camera.height)

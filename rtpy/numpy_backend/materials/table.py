@@ -50,6 +50,7 @@ class MaterialTable:
 
     specular  (M,) bool: Material.is_specular per id (delta scattering only)
     emitter   (M,) bool: Material.is_emitter per id
+    inert     (M,) bool: no BRDF and no scattering (eval and sample give only zeros)
     """
 
     def __init__(self, materials: Sequence[Material]) -> None:
@@ -67,6 +68,11 @@ class MaterialTable:
             self.slot[ids] = np.arange(len(ids))
         self.specular = np.array([bool(m.is_specular) for m in self.materials], dtype=bool)
         self.emitter = np.array([bool(m.is_emitter) for m in self.materials], dtype=bool)
+        # Neither a BRDF nor scattering (a DiffuseLight): light arriving there ends.
+        self.inert = np.array(
+            [not (k.evaluates or k.scatters) for k in (self.kernels[i] for i in self.kind)],
+            dtype=bool,
+        )
 
     def _groups(
         self, ids: np.ndarray, hits: HitBatch, flag: str | None = None
