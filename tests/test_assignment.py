@@ -21,6 +21,7 @@ import json
 import os
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -123,6 +124,11 @@ def test_student_repository(tmp_path, week):
     repo = make_assignment(week, tmp_path / f"week{week}")
     check_regions(repo, week)
     assert not (repo / "rtpy" / "numpy_backend" / "geometry.py").exists()
+    with open(repo / "pyproject.toml", "rb") as f:  # pip install needs every listed package
+        setup = tomllib.load(f)["tool"]["setuptools"]
+    for package in setup["packages"]:
+        folder = setup["package-dir"].get(package, package.replace(".", "/"))
+        assert (repo / folder).is_dir() and any((repo / folder).iterdir()), package
     assert (repo / "assignments" / f"week{week}" / "README.md").exists()
     kept, left = shipped_tests(ROOT, week)
     assert sorted(str(p.relative_to(repo)) for p in (repo / "tests").rglob("*.py")) == kept
