@@ -139,6 +139,22 @@ def assert_render_matches(stack: np.ndarray, spp: int, reference: dict, what: st
     assert result.passed, f"{what}: {result.worst()}"
 
 
+def assert_image_matches(
+    image: np.ndarray, reference: np.ndarray, what: str, hint: str, rtol: float, atol: float
+) -> None:
+    """For deterministic renders: at most 1 % of the pixels may differ from the
+    reference beyond rtol/atol (a pixel centre exactly on an edge may round either
+    way); otherwise an AssertionError naming the first wrong pixel and `hint`."""
+    wrong = ~np.isclose(image, reference, rtol=rtol, atol=atol).all(axis=2)
+    if wrong.mean() <= 0.01:
+        return
+    row, column = np.argwhere(wrong)[0]
+    raise AssertionError(
+        f"{what}: {wrong.sum()} of {wrong.size} pixels differ from the reference "
+        f"(first at row {row}, column {column}): {hint}"
+    )
+
+
 # --- running graders ------------------------------------------------------------------
 @dataclass
 class GraderResult:

@@ -10,7 +10,7 @@ import numpy as np
 import rtpy.materials.dielectric as dielectric
 import rtpy.vec3 as vec3
 from rtpy import Camera, Color, HitInfo, Lambertian, PointLight, Quad, Ray, Scene, Sphere, Vec3
-from rtpy.grading import points, render_stack
+from rtpy.grading import assert_image_matches, points, render_stack
 from rtpy.materials import Dielectric, Mirror
 from rtpy.sampling import make_generator, use_generator
 
@@ -190,10 +190,8 @@ def test_whitted_render_matches_reference():
     # each pixel's jittered sample, so the seed fixes the image.
     image = render_stack(optics_scene(), (0,), integrator="whitted", spp=1, max_depth=8)[0]
     reference = np.load(HERE / "reference" / f"{REFERENCE['name']}.npy")
-    wrong = ~np.isclose(image, reference, rtol=1e-6, atol=1e-9).all(axis=2)
-    assert wrong.mean() <= 0.01, (
-        f"whitted render: {wrong.sum()} of {wrong.size} pixels differ from the reference "
-        f"(e.g. row {np.argwhere(wrong)[0][0]}, column {np.argwhere(wrong)[0][1]}): glass "
-        "that renders dark or opaque means refracted rays are lost; check reflect, refract, "
-        "schlick and Dielectric._split"
-    )
+    assert_image_matches(
+        image, reference, "whitted render", "glass that renders dark or opaque means "
+        "refracted rays are lost; check reflect, refract, schlick and Dielectric._split",
+        rtol=1e-6, atol=1e-9,
+    )  # fmt: skip

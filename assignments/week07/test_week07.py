@@ -19,7 +19,7 @@ from rtpy import (
     Sphere,
     Vec3,
 )
-from rtpy.grading import points, render_stack
+from rtpy.grading import assert_image_matches, points, render_stack
 from rtpy.materials import Lambertian, Metal
 from rtpy.sampling import make_generator, use_generator
 
@@ -196,9 +196,7 @@ def test_texture_render_matches_reference():
     """center render of checker and image textures matches the reference"""
     image = render_stack(texture_scene(), (0,), integrator="center", spp=1)[0]
     reference = np.load(HERE / "reference" / f"{REFERENCE['name']}.npy")
-    wrong = ~np.isclose(image, reference, rtol=1e-9, atol=1e-12).all(axis=2)
-    assert wrong.mean() <= 0.01, (
-        f"center render with textures: {wrong.sum()} of {wrong.size} pixels differ from the "
-        f"reference (e.g. row {np.argwhere(wrong)[0][0]}, column {np.argwhere(wrong)[0][1]}): "
-        "check the (u, v) of spheres and quads and the texture lookups"
-    )
+    assert_image_matches(
+        image, reference, "center render with textures",
+        "check the (u, v) of spheres and quads and the texture lookups", rtol=1e-9, atol=1e-12,
+    )  # fmt: skip
