@@ -32,7 +32,7 @@ from ..ray import SPAWN_ABSOLUTE_OFFSET, SPAWN_RELATIVE_OFFSET, Ray
 from ..sphere import Sphere
 from ..triangle import Triangle
 from ..vec3 import Vec3
-from .arrays import axpy, put_rows, scale
+from .arrays import axpy, put_rows, rows, scale
 from .hits import HitBatch, unused
 
 # Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
@@ -1104,7 +1104,11 @@ class Geometry:
         n = len(o)
         t_best = np.full(n, INF) if t_max is None else np.array(t_max, dtype=np.float64)
         obj = np.full(n, -1, dtype=np.int64)
-        for kd in self._order():
+        order = self._order()
+        if len(order) == 1:  # one kind of primitive: its answer as it is
+            t, k = self.sets[order[0]].closest(o, d, 0.0, t_best)
+            return np.where(k >= 0, self.members[order[0]].take(k), -1), t
+        for kd in order:
             t, k = self.sets[kd].closest(o, d, 0.0, t_best)
             hit = k >= 0
             t_best[hit] = t[hit]
@@ -1132,8 +1136,12 @@ class Geometry:
                 local_skip = np.where((sk >= 0) & (self.kind[sk] == kd), self.local[sk], -1)
                 if not (local_skip >= 0).any():
                     local_skip = None
+            if live.size == len(o):  # no gathers
+                _, k = self.sets[kd].closest(o, d, 0.0, t_max, any_hit=True, skip=local_skip)
+                blocked = k >= 0
+                continue
             _, k = self.sets[kd].closest(
-                o[live], d[live], 0.0, t_max[live], any_hit=True, skip=local_skip
+                rows(o, live), rows(d, live), 0.0, t_max[live], any_hit=True, skip=local_skip
             )
             blocked[live[k >= 0]] = True
         return blocked
