@@ -310,8 +310,8 @@ class PrimitiveSet:
             j = np.argmin(t, axis=1)
             tj = t[np.arange(e - s), j]
             hit = tj < t_best[s:e]
-            t_best[s:e][hit] = tj[hit]
-            idx[s:e][hit] = j[hit]
+            np.copyto(t_best[s:e], tj, where=hit)
+            np.copyto(idx[s:e], j, where=hit)
         return t_best, idx
 
     def cluster(self) -> None:
