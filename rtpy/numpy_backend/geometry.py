@@ -301,6 +301,7 @@ class PrimitiveSet:
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(len(o), -1, dtype=np.int64)
         chunk = max(RAY_CHUNK, PAIR_CHUNK // len(self))
+        row_start = np.arange(0, min(chunk, len(o)) * len(self), len(self))  # in t.ravel()
         for s in range(0, len(o), chunk):
             e = min(s + chunk, len(o))
             t = self.all_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None)
@@ -308,7 +309,7 @@ class PrimitiveSet:
                 r = np.flatnonzero(skip[s:e] >= 0)
                 t[r, skip[s:e][r]] = INF
             j = np.argmin(t, axis=1)
-            tj = t[np.arange(e - s), j]
+            tj = t.ravel().take(row_start[: e - s] + j)  # t[i, j[i]]
             hit = tj < t_best[s:e]
             np.copyto(t_best[s:e], tj, where=hit)
             np.copyto(idx[s:e], j, where=hit)
