@@ -31,6 +31,12 @@ def rows(a: np.ndarray, index: np.ndarray) -> np.ndarray:
     return a.take(index, axis=0)
 
 
+def at(table: np.ndarray, k: np.ndarray | int) -> np.ndarray:
+    """table.take(k, axis=0): rows of a table per index; for one int k, that row
+    alone (a scalar or a (3,) row, which broadcasts against the (N,) columns)."""
+    return table[k] if isinstance(k, int) else table.take(k, axis=0)
+
+
 def _as_items(a: np.ndarray) -> np.ndarray | None:
     """a (N, 3) float64 C-contiguous viewed as (N,) 24-byte items, else None."""
     if a.ndim == 2 and a.shape[1] == 3 and a.dtype == np.float64 and a.flags.c_contiguous:
@@ -81,13 +87,13 @@ def where_rows(mask: np.ndarray, a: np.ndarray) -> np.ndarray:
 
 
 def axpy(s: np.ndarray, d: np.ndarray, o: np.ndarray) -> np.ndarray:
-    """o + s[:, None] * d for o, d (N, 3) and s (N,), column by column (each
-    component rounded as in the broadcast form)."""
-    out = np.empty(d.shape)
+    """o + s[:, None] * d for o, d (N, 3) (either may be one (3,) row) and s (N,),
+    column by column (each component rounded as in the broadcast form)."""
+    out = np.empty(d.shape if d.ndim == 2 else o.shape if o.ndim == 2 else (len(s), 3))
     for c in range(3):
         col = out[:, c]
-        np.multiply(s, d[:, c], out=col)
-        np.add(o[:, c], col, out=col)
+        np.multiply(s, d[..., c], out=col)
+        np.add(o[..., c], col, out=col)
     return out
 
 

@@ -32,7 +32,7 @@ from ..ray import SPAWN_ABSOLUTE_OFFSET, SPAWN_RELATIVE_OFFSET, Ray
 from ..sphere import Sphere
 from ..triangle import Triangle
 from ..vec3 import Vec3
-from .arrays import axpy, put_rows, scale
+from .arrays import at, axpy, put_rows, rows, scale
 from .hits import HitBatch, unused
 
 # Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
@@ -248,6 +248,8 @@ class PrimitiveSet:
 
     objects: list[Hittable]
     bvh: BVH | None = None
+    # sample_light accepts one int k for all rows (no per-row gathers of the shape)
+    one_index_lights = False
     parts: list | None = None  # see cluster_parts
 
     def __len__(self) -> int:
@@ -299,6 +301,7 @@ class PrimitiveSet:
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(len(o), -1, dtype=np.int64)
         chunk = max(RAY_CHUNK, PAIR_CHUNK // len(self))
+        row_start = np.arange(0, min(chunk, len(o)) * len(self), len(self))  # in t.ravel()
         for s in range(0, len(o), chunk):
             e = min(s + chunk, len(o))
             t = self.all_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None)
@@ -306,10 +309,10 @@ class PrimitiveSet:
                 r = np.flatnonzero(skip[s:e] >= 0)
                 t[r, skip[s:e][r]] = INF
             j = np.argmin(t, axis=1)
-            tj = t[np.arange(e - s), j]
+            tj = t.ravel().take(row_start[: e - s] + j)  # t[i, j[i]]
             hit = tj < t_best[s:e]
-            t_best[s:e][hit] = tj[hit]
-            idx[s:e][hit] = j[hit]
+            np.copyto(t_best[s:e], tj, where=hit)
+            np.copyto(idx[s:e], j, where=hit)
         return t_best, idx
 
     def cluster(self) -> None:
@@ -505,6 +508,8 @@ def area_direction_pdf(p: np.ndarray, q: np.ndarray, n: np.ndarray, area: np.nda
 class SphereSet(PrimitiveSet):
     """Spheres: center (K, 3), radius (K,). Geometric normal outward."""
 
+    one_index_lights = True
+
     def __init__(self, spheres: Sequence[Sphere]) -> None:
         self.objects = list(spheres)
         self.center = np.array([_v(s.center) for s in spheres], dtype=np.float64).reshape(-1, 3)
@@ -518,7 +523,7 @@ class SphereSet(PrimitiveSet):
 
     def pair_t(self, o, d, k, t_min, t_max):
         # Sphere.hit_t, operation for operation (see rtpy/sphere.py for the maths).
-        c, r, r2 = self.center.take(k, axis=0), self.radius.take(k), self.r2.take(k)
+        c, r, r2 = at(self.center, k), at(self.radius, k), at(self.r2, k)
         dx, dy, dz = d[..., 0], d[..., 1], d[..., 2]
         ocx = c[..., 0] - o[..., 0]
         ocy = c[..., 1] - o[..., 1]
@@ -610,7 +615,7 @@ class SphereSet(PrimitiveSet):
         return t_best, idx
 
     def geometric(self, k, o, d, t):
-        c, r = self.center.take(k, axis=0), self.radius.take(k)
+        c, r = at(self.center, k), at(self.radius, k)
         p = axpy(t, d, o)
         nv = p - c
         inv = 1.0 / np.sqrt(_dot(nv, nv))
@@ -653,9 +658,9 @@ class SphereSet(PrimitiveSet):
     def cone(self, k, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Sphere._cone: (outside (N,) bool, cos_max, 1 - cos_max) of the cone the
         sphere subtends at p; only meaningful where outside."""
-        dv = self.center.take(k, axis=0) - p
+        dv = at(self.center, k) - p
         d2 = _dot(dv, dv)
-        r2 = self.r2.take(k)
+        r2 = at(self.r2, k)
         outside = ~(d2 <= r2 * 1.0000001)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inside: unused
             sin2 = r2 / d2
@@ -673,12 +678,12 @@ class SphereSet(PrimitiveSet):
         if o.size:
             every = o.size == len(p)  # all outside (the usual case): no gathers
             om = omc if every else omc.take(o)
-            ko = k if every else k.take(o)
+            ko = k if every or isinstance(k, int) else k.take(o)
             po = p if every else p.take(o, axis=0)
             cos_t = 1.0 - (r1 if every else r1.take(o)) * om
             sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
             phi = 2.0 * math.pi * (r2 if every else r2.take(o))
-            axis = self.center.take(ko, axis=0) - po
+            axis = at(self.center, ko) - po
             axis = scale(axis, 1.0 / np.sqrt(_dot(axis, axis)))
             x, y = sin_t * np.cos(phi), sin_t * np.sin(phi)
             # onb.local_to_world(axis, x, y, cos_t)
@@ -701,6 +706,8 @@ class SphereSet(PrimitiveSet):
             valid[o] = True
         i = np.flatnonzero(~outside)
         if i.size:
+            if isinstance(k, int):
+                k = np.full(len(p), k)
             q, n = self.sample_point(k[i], r1[i], r2[i])
             direction[i], pdf[i], valid[i] = area_direction(p[i], q, n, self.area(k[i]))
         return direction, pdf, valid
@@ -718,6 +725,8 @@ class PlanarSet(PrimitiveSet):
     """Quads and triangles: a plane with unit normal n and two edge vectors. The
     all-pairs test is written as (N, 3) x (3, K) matrix products."""
 
+    one_index_lights = True
+
     normal: np.ndarray
     origin: np.ndarray  # q or a
     tan: np.ndarray  # unit tangent (along u)
@@ -727,7 +736,7 @@ class PlanarSet(PrimitiveSet):
         return self.tan[k], np.ones(len(k), dtype=bool)
 
     def area(self, k):
-        return self._area.take(k)
+        return at(self._area, k)
 
     def geometric(self, k, o, d, t):
         return axpy(t, d, o), self.normal.take(k, axis=0)
@@ -859,10 +868,11 @@ class QuadSet(PlanarSet):
 
     def sample_point(self, k, r1, r2):
         # q + r1 u + r2 v, column by column
-        p = axpy(r1, self.u.take(k, axis=0), self.q.take(k, axis=0))
-        for c, vc in enumerate(self.v.take(k, axis=0).T):
-            p[:, c] += r2 * vc
-        return p, self.normal.take(k, axis=0)
+        p = axpy(r1, at(self.u, k), at(self.q, k))
+        v = at(self.v, k)
+        for c in range(3):
+            p[:, c] += r2 * v[..., c]
+        return p, at(self.normal, k)
 
 
 class TriangleSet(PlanarSet):
@@ -1104,7 +1114,11 @@ class Geometry:
         n = len(o)
         t_best = np.full(n, INF) if t_max is None else np.array(t_max, dtype=np.float64)
         obj = np.full(n, -1, dtype=np.int64)
-        for kd in self._order():
+        order = self._order()
+        if len(order) == 1:  # one kind of primitive: its answer as it is
+            t, k = self.sets[order[0]].closest(o, d, 0.0, t_best)
+            return np.where(k >= 0, self.members[order[0]].take(k), -1), t
+        for kd in order:
             t, k = self.sets[kd].closest(o, d, 0.0, t_best)
             hit = k >= 0
             t_best[hit] = t[hit]
@@ -1132,8 +1146,12 @@ class Geometry:
                 local_skip = np.where((sk >= 0) & (self.kind[sk] == kd), self.local[sk], -1)
                 if not (local_skip >= 0).any():
                     local_skip = None
+            if live.size == len(o):  # no gathers
+                _, k = self.sets[kd].closest(o, d, 0.0, t_max, any_hit=True, skip=local_skip)
+                blocked = k >= 0
+                continue
             _, k = self.sets[kd].closest(
-                o[live], d[live], 0.0, t_max[live], any_hit=True, skip=local_skip
+                rows(o, live), rows(d, live), 0.0, t_max[live], any_hit=True, skip=local_skip
             )
             blocked[live[k >= 0]] = True
         return blocked

@@ -27,7 +27,7 @@ from .materials.simple import DiffuseLightKernel
 
 
 def _dot3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
 @dataclass
@@ -142,7 +142,7 @@ class LightTable:
         n = len(p)
         rng.random(n)  # the light choice's number: the general path's random stream
         r = rng.random((2, n))
-        k = np.full(n, local, dtype=np.int64)
+        k = int(local) if prims.one_index_lights else np.full(n, local, dtype=np.int64)
         direction, pdf, valid, t, point, geo = prims.sample_light(k, p, r[0], r[1])
         valid &= pdf > 0.0
         # The front face is the one the geometric normal points to: dot(geo, d) < 0
