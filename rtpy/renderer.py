@@ -147,11 +147,21 @@ class Renderer:
         self.workers = workers
         self.quiet = quiet
 
+    # What a backend changes: the progress bar's label, how the image is cut into
+    # units of work, and the integrator that says whether it traces only centre rays.
+    backend_label = ""
+
+    def plan_units(self, width: int, height: int, spp: int) -> list[Unit]:
+        return plan_units(width, height, spp)
+
+    def uses_center_ray(self) -> bool:
+        return make_integrator(self.settings).uses_center_ray
+
     def render(self) -> RenderedImage:
         """Render; on Ctrl-C return what was finished (image.interrupted is True)."""
         settings, camera = self.settings, self.camera
-        spp = 1 if make_integrator(settings).uses_center_ray else settings.spp
-        units = plan_units(camera.width, camera.height, spp)
+        spp = 1 if self.uses_center_ray() else settings.spp
+        units = self.plan_units(camera.width, camera.height, spp)
         results = PixelSums(camera.width, camera.height)
         total_paths = camera.width * camera.height * spp
         bar = tqdm(
@@ -160,7 +170,7 @@ class Renderer:
             unit_scale=True,
             file=sys.stderr,
             disable=self.quiet,
-            desc=f"{self.scene.name} ({settings.integrator})",
+            desc=f"{self.scene.name} ({settings.integrator}{self.backend_label})",
             dynamic_ncols=True,
         )
         start = time.perf_counter()

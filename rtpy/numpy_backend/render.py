@@ -20,15 +20,13 @@ import multiprocessing
 import resource
 import signal
 import sys
-import time
 
 import numpy as np
-from tqdm import tqdm
 
 from ..camera import Camera
 from ..image import RenderedImage
 from ..render_settings import RenderSettings
-from ..renderer import PixelSums, Renderer, Unit
+from ..renderer import Renderer, Unit
 from ..scene import Scene
 from .camera import CameraRays
 from .integrators import BatchIntegrator, Tracer, make_integrator
@@ -131,35 +129,17 @@ class NumpyRenderer(Renderer):
     """Renders with the numpy backend; the interface and the result are those of
     rtpy.renderer.Renderer (stats also hold "backend" and "peak_rss_mb")."""
 
+    backend_label = ", numpy"
+
+    def plan_units(self, width: int, height: int, spp: int) -> list[Unit]:
+        return plan_units(width, height, spp)
+
+    def uses_center_ray(self) -> bool:
+        return make_integrator(self.settings).uses_center_ray
+
     def render(self) -> RenderedImage:
-        settings, camera = self.settings, self.camera
         keep_freed_memory()
-        spp = 1 if make_integrator(settings).uses_center_ray else settings.spp
-        units = plan_units(camera.width, camera.height, spp)
-        results = PixelSums(camera.width, camera.height)
-        bar = tqdm(
-            total=camera.width * camera.height * spp,
-            unit="path",
-            unit_scale=True,
-            file=sys.stderr,
-            disable=self.quiet,
-            desc=f"{self.scene.name} ({settings.integrator}, numpy)",
-            dynamic_ncols=True,
-        )
-        start = time.perf_counter()
-        interrupted = False
-        work = self._run(units)
-        try:
-            for unit, sums in work:
-                results.add(unit, sums)
-                bar.update(sums.shape[0] * sums.shape[1] * unit.spp)
-        except KeyboardInterrupt:
-            interrupted = True
-        finally:
-            work.close()
-            bar.close()
-        seconds = time.perf_counter() - start
-        image = self._assemble(results, spp, interrupted, seconds)
+        image = super().render()
         image.stats["backend"] = "numpy"
         image.stats["peak_rss_mb"] = peak_rss_mb()
         return image
