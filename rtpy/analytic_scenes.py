@@ -148,6 +148,8 @@ class GlowingLambertian(Lambertian):
 
     def emitting(self, hit):
         return self.emit
+
+
 # --------------------------------------------------------------------------- scenes
 
 

@@ -42,14 +42,18 @@ class Unit:
     spp: int
 
 
-def plan_units(width: int, height: int, spp: int) -> list[Unit]:
-    """All units of work, batch-major (every tile of batch 0 first)."""
-    n_batches = min(spp, MAX_BATCHES)
+def plan_units(
+    width: int, height: int, spp: int, n_batches: int | None = None, tile: int = TILE_SIZE
+) -> list[Unit]:
+    """All units of work, batch-major (every tile of batch 0 first): tile x tile pixel
+    tiles, each tile's spp split into n_batches batches (default min(spp, MAX_BATCHES))
+    that differ by at most 1."""
+    n_batches = min(spp, MAX_BATCHES) if n_batches is None else n_batches
     batch_spp = [spp // n_batches + (1 if b < spp % n_batches else 0) for b in range(n_batches)]
     tiles = [
-        (x0, y0, min(x0 + TILE_SIZE, width), min(y0 + TILE_SIZE, height))
-        for y0 in range(0, height, TILE_SIZE)
-        for x0 in range(0, width, TILE_SIZE)
+        (x0, y0, min(x0 + tile, width), min(y0 + tile, height))
+        for y0 in range(0, height, tile)
+        for x0 in range(0, width, tile)
     ]
     return [
         Unit(t, b, *tiles[t], batch_spp[b]) for b in range(n_batches) for t in range(len(tiles))

@@ -27,6 +27,7 @@ from ..camera import Camera
 from ..image import RenderedImage
 from ..render_settings import RenderSettings
 from ..renderer import Renderer, Unit
+from ..renderer import plan_units as scalar_plan_units
 from ..scene import Scene
 from .camera import CameraRays
 from .integrators import BatchIntegrator, Tracer, make_integrator
@@ -41,18 +42,8 @@ MAX_RAYS = 65536
 def plan_units(width: int, height: int, spp: int) -> list[Unit]:
     """All units of work, batch-major: each tile's spp split into the fewest batches
     that keep a unit at or under MAX_RAYS samples."""
-    tile_px = TILE_SIZE * TILE_SIZE
-    n_batches = max(1, math.ceil(spp * tile_px / MAX_RAYS))
-    n_batches = min(n_batches, spp)
-    batch_spp = [spp // n_batches + (1 if b < spp % n_batches else 0) for b in range(n_batches)]
-    tiles = [
-        (x0, y0, min(x0 + TILE_SIZE, width), min(y0 + TILE_SIZE, height))
-        for y0 in range(0, height, TILE_SIZE)
-        for x0 in range(0, width, TILE_SIZE)
-    ]
-    return [
-        Unit(t, b, *tiles[t], batch_spp[b]) for b in range(n_batches) for t in range(len(tiles))
-    ]
+    n_batches = max(1, math.ceil(spp * TILE_SIZE * TILE_SIZE / MAX_RAYS))
+    return scalar_plan_units(width, height, spp, min(n_batches, spp), TILE_SIZE)
 
 
 def keep_freed_memory() -> None:
