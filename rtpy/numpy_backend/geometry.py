@@ -505,6 +505,23 @@ def area_direction_pdf(p: np.ndarray, q: np.ndarray, n: np.ndarray, area: np.nda
     return np.where((dist2 == 0.0) | ~(cos_light >= 1e-12), 0.0, pdf)
 
 
+def _sphere_roots(h, c_term, a, r, f2, t_min, t_max):
+    """Sphere.hit_t's root step, op for op (see rtpy/sphere.py): the nearer root of
+    a t^2 - 2 h t + c_term = 0 inside (t_min, t_max), else INF; and q, which is 0
+    where the roots are undefined. f2 is |f|^2, f the offset from the centre to the
+    line's closest point, so disc = a (r - f)(r + f) needs no cancelling difference."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        f = np.sqrt(f2)
+        disc = a * (r - f) * (r + f)
+        q = h + np.copysign(np.sqrt(disc), h)
+        t0 = c_term / q
+        t1 = q / a
+    lo = np.minimum(t0, t1)
+    hi = np.maximum(t0, t1)
+    t = np.where((t_min < hi) & (hi < t_max), hi, INF)
+    return np.where((t_min < lo) & (lo < t_max), lo, t), q
+
+
 class SphereSet(PrimitiveSet):
     """Spheres: center (K, 3), radius (K,). Geometric normal outward."""
 
@@ -537,17 +554,8 @@ class SphereSet(PrimitiveSet):
         fz = ocz - kk * dz
         f2 = fx * fx + fy * fy + fz * fz
         miss = ((h < 0.0) & (c_term > 0.0)) | (f2 > r2)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            f = np.sqrt(f2)
-            disc = a * (r - f) * (r + f)
-            q = h + np.copysign(np.sqrt(disc), h)
-            t0 = c_term / q
-            t1 = q / a
+        t, q = _sphere_roots(h, c_term, a, r, f2, t_min, t_max)
         miss |= q == 0.0
-        lo = np.minimum(t0, t1)
-        hi = np.maximum(t0, t1)
-        t = np.where((t_min < hi) & (hi < t_max), hi, INF)
-        t = np.where((t_min < lo) & (lo < t_max), lo, t)
         return np.where(miss, INF, t)
 
     def closest(self, o, d, t_min, t_max, any_hit=False, skip=None):
@@ -598,16 +606,7 @@ class SphereSet(PrimitiveSet):
             fy = ocy - kk * jy
             fz = ocz - kk * jz
             f2 = fx * fx + fy * fy + fz * fz
-            with np.errstate(invalid="ignore", divide="ignore"):
-                f = np.sqrt(f2)
-                disc = a * (r - f) * (r + f)
-                q = h + np.copysign(np.sqrt(disc), h)
-                t0 = c_term / q
-                t1 = q / a
-            lo = np.minimum(t0, t1)
-            hi = np.maximum(t0, t1)
-            t = np.where((t_min < hi) & (hi < tm), hi, INF)
-            t = np.where((t_min < lo) & (lo < tm), lo, t)
+            t, q = _sphere_roots(h, c_term, a, r, f2, t_min, tm)
             hit = (t < tm) & (q != 0.0) & (f2 <= r2)
             w = j[hit] if j.size < n else np.flatnonzero(hit)
             t_best[w] = t[hit]
