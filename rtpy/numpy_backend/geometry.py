@@ -34,6 +34,7 @@ from ..triangle import Triangle
 from ..vec3 import Vec3
 from .arrays import at, axpy, put_rows, rows, scale
 from .hits import HitBatch, unused
+from .trig import cos_sin_2pi
 
 # Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
 BVH_THRESHOLD = 24
@@ -42,6 +43,9 @@ BVH_LEAF_SIZE = 4
 # (chunk, K) temporaries stay in cache while small sets still make few numpy calls.
 RAY_CHUNK = 1024
 PAIR_CHUNK = 18432
+# Brute-force spheres take rays in chunks of this many: their dozen (chunk,) float64
+# temporaries then stay in a 1 MiB L2 cache (2.5x faster than 65,536 at once).
+SPHERE_CHUNK = 8192
 # A brute-force set of planar primitives culls clusters of them by their bounding box
 # (see cluster_parts): clusters of at least CLUSTER_SIZE primitives whose box has at
 # most CLUSTER_AREA of the surface area of the whole set's box.
@@ -532,6 +536,7 @@ class SphereSet(PrimitiveSet):
         self.center = np.array([_v(s.center) for s in spheres], dtype=np.float64).reshape(-1, 3)
         self.radius = np.array([float(s.radius) for s in spheres], dtype=np.float64)
         self.r2 = self.radius * self.radius
+        self.center_columns = [self.center[:, c, None].copy() for c in range(3)]  # (K, 1)
         self.build_bvh()
 
     def bounds(self):
@@ -577,18 +582,45 @@ class SphereSet(PrimitiveSet):
         n = len(o)
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(n, -1, dtype=np.int64)
+        for s in range(0, n, SPHERE_CHUNK):
+            e = min(s + SPHERE_CHUNK, n)
+            self._closest_chunk(
+                o[s:e],
+                d[s:e],
+                t_min,
+                t_best[s:e],
+                idx[s:e],
+                any_hit,
+                None if skip is None else skip[s:e],
+            )
+        return t_best, idx
+
+    def _closest_chunk(self, o, d, t_min, t_best, idx, any_hit, skip) -> None:
+        """closest for one chunk of rays, updating t_best and idx (views into
+        closest's results) in place. The chunk's components are copied to columns of
+        their own (slices of columns of the whole batch would lie a power of two
+        apart in memory and evict each other from the cache)."""
+        n = len(o)
         ox, oy, oz = np.ascontiguousarray(o.T)
         dx, dy, dz = np.ascontiguousarray(d.T)
         a_all = dx * dx + dy * dy + dz * dz
         inv_a = 1.0 / a_all
+        # The cheap test for all spheres at once: (K, n) arrays, sphere by row.
+        cx, cy, cz = self.center_columns
+        r2_col = self.r2[:, None]
+        ocx_all, ocy_all, ocz_all = cx - ox, cy - oy, cz - oz
+        h_all = dx * ocx_all
+        h_all += dy * ocy_all
+        h_all += dz * ocz_all
+        oc2_all = ocx_all * ocx_all
+        oc2_all += ocy_all * ocy_all
+        oc2_all += ocz_all * ocz_all
+        cand_all = oc2_all * (1.0 - 1e-9) - r2_col <= h_all * h_all * inv_a
+        cand_all &= (h_all >= 0.0) | (oc2_all <= r2_col)
         for k in range(len(self)):
-            cx, cy, cz = self.center[k]
             r, r2 = self.radius[k], self.r2[k]
-            ocx, ocy, ocz = cx - ox, cy - oy, cz - oz
-            h = dx * ocx + dy * ocy + dz * ocz
-            oc2 = ocx * ocx + ocy * ocy + ocz * ocz
-            cand = oc2 * (1.0 - 1e-9) - r2 <= h * h * inv_a
-            cand &= (h >= 0.0) | (oc2 <= r2)
+            h, oc2, cand = h_all[k], oc2_all[k], cand_all[k]
+            ocx, ocy, ocz = ocx_all[k], ocy_all[k], ocz_all[k]
             if any_hit:
                 cand &= idx < 0
             if skip is not None:
@@ -611,7 +643,6 @@ class SphereSet(PrimitiveSet):
             w = j[hit] if j.size < n else np.flatnonzero(hit)
             t_best[w] = t[hit]
             idx[w] = k
-        return t_best, idx
 
     def geometric(self, k, o, d, t):
         c, r = at(self.center, k), at(self.radius, k)
@@ -650,8 +681,8 @@ class SphereSet(PrimitiveSet):
         # sampling.uniform_sphere, then center + n * radius.
         z = 1.0 - 2.0 * r1
         s = np.sqrt(np.maximum(0.0, 1.0 - z * z))
-        phi = 2.0 * math.pi * r2
-        n = np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
+        cos_phi, sin_phi = cos_sin_2pi(r2)
+        n = np.stack([s * cos_phi, s * sin_phi, z], axis=1)
         return self.center[k] + n * self.radius[k][:, None], n
 
     def cone(self, k, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -681,10 +712,10 @@ class SphereSet(PrimitiveSet):
             po = p if every else p.take(o, axis=0)
             cos_t = 1.0 - (r1 if every else r1.take(o)) * om
             sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
-            phi = 2.0 * math.pi * (r2 if every else r2.take(o))
+            cos_phi, sin_phi = cos_sin_2pi(r2 if every else r2.take(o))
             axis = at(self.center, ko) - po
             axis = scale(axis, 1.0 / np.sqrt(_dot(axis, axis)))
-            x, y = sin_t * np.cos(phi), sin_t * np.sin(phi)
+            x, y = sin_t * cos_phi, sin_t * sin_phi
             # onb.local_to_world(axis, x, y, cos_t)
             w0, w1, w2 = axis[:, 0], axis[:, 1], axis[:, 2]
             sign = np.copysign(1.0, w2)
@@ -710,6 +741,57 @@ class SphereSet(PrimitiveSet):
             q, n = self.sample_point(k[i], r1[i], r2[i])
             direction[i], pdf[i], valid[i] = area_direction(p[i], q, n, self.area(k[i]))
         return direction, pdf, valid
+
+    def sample_light(self, k, p, r1, r2):
+        """PrimitiveSet.sample_light fused for one sphere (int k) that every point p
+        sees from outside (a sphere lamp): the offset from p to the centre, computed
+        once, serves the cone, its axis and the trace back to the sphere. Each step is
+        op for op that of cone(), sample_direction(), pair_t() and geometric(), so the
+        result is bit-identical to the general path (which handles the rest)."""
+        if not isinstance(k, int):
+            return super().sample_light(k, p, r1, r2)
+        (cx, cy, cz), r, rr = self.center[k], self.radius[k], self.r2[k]
+        px, py, pz = p[:, 0], p[:, 1], p[:, 2]
+        ocx, ocy, ocz = cx - px, cy - py, cz - pz
+        d2 = ocx * ocx + ocy * ocy + ocz * ocz
+        if not (d2 > rr * 1.0000001).all():  # some point inside: the general path
+            return super().sample_light(k, p, r1, r2)
+        # The cone (cone()) and a direction in it (sample_direction()).
+        sin2 = rr / d2
+        omc = sin2 / (1.0 + np.sqrt(1.0 - sin2))  # 1 - cos_max
+        cos_t = 1.0 - r1 * omc
+        sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+        cos_phi, sin_phi = cos_sin_2pi(r2)
+        x, y = sin_t * cos_phi, sin_t * sin_phi
+        inv = 1.0 / np.sqrt(d2)
+        w0, w1, w2 = ocx * inv, ocy * inv, ocz * inv  # the cone's axis
+        sign = np.copysign(1.0, w2)
+        a = -1.0 / (sign + w2)
+        b = w0 * w1 * a
+        dx = x * (1.0 + sign * w0 * w0 * a) + y * b + cos_t * w0
+        dy = x * sign * b + y * (sign + w1 * w1 * a) + cos_t * w1
+        dz = -x * sign * w0 - y * w1 + cos_t * w2
+        pdf = 1.0 / (2.0 * math.pi * omc)
+        # Traced from p back to the sphere (pair_t with t_min 0).
+        h = dx * ocx + dy * ocy + dz * ocz
+        c_term = d2 - rr
+        a = dx * dx + dy * dy + dz * dz
+        kk = h / a
+        fx, fy, fz = ocx - kk * dx, ocy - kk * dy, ocz - kk * dz
+        f2 = fx * fx + fy * fy + fz * fz
+        t, q = _sphere_roots(h, c_term, a, r, f2, 0.0, INF)
+        valid = ~(((h < 0.0) & (c_term > 0.0)) | (f2 > rr) | (q == 0.0)) & (t < INF)
+        t = np.where(valid, t, INF)
+        # The point and its normal (geometric()), at t = 0 where the trace missed.
+        t0 = np.where(valid, t, 0.0)
+        qx, qy, qz = px + t0 * dx, py + t0 * dy, pz + t0 * dz
+        nx, ny, nz = qx - cx, qy - cy, qz - cz
+        inv_n = 1.0 / np.sqrt(nx * nx + ny * ny + nz * nz)
+        nx, ny, nz = nx * inv_n, ny * inv_n, nz * inv_n
+        point = np.stack([cx + r * nx, cy + r * ny, cz + r * nz], axis=1)
+        normal = np.stack([nx, ny, nz], axis=1)
+        direction = np.stack([dx, dy, dz], axis=1)
+        return direction, pdf, valid, t, point, normal
 
     def direction_pdf(self, k, p, q, n):
         outside, _, omc = self.cone(k, p)

@@ -213,3 +213,22 @@ def test_single_light_fast_path_matches_the_general_path(name):
     # Both faces are seen: lit samples and samples from behind a one-sided light.
     lit = fast.radiance[v].max(axis=1) > 0
     assert lit.any() and (name == "week08_three_balls" or not lit.all())
+
+
+@settings(max_examples=100)
+@given(vec, st.floats(0.05, 3.0), st.lists(st.tuples(vec, unit, unit), min_size=1, max_size=20))
+def test_sphere_fused_sample_light_is_the_general_path(center, radius, samples):
+    """SphereSet.sample_light for one sphere (int k) gives, bit for bit, what the
+    general PrimitiveSet.sample_light gives (sample_direction, pair_t, geometric),
+    whether every point is outside the sphere (the fused path) or some are inside."""
+    from rtpy.numpy_backend.geometry import PrimitiveSet
+
+    geo = Geometry([Sphere(V(center), radius, LIGHT)])
+    prims = geo.sets[0]
+    p = np.array([s[0] for s in samples], dtype=np.float64)
+    r1 = np.array([s[1] for s in samples])
+    r2 = np.array([s[2] for s in samples])
+    fused = prims.sample_light(0, p, r1, r2)
+    general = PrimitiveSet.sample_light(prims, 0, p, r1, r2)
+    for a, b in zip(fused, general, strict=True):
+        np.testing.assert_array_equal(a, b)

@@ -9,13 +9,12 @@ last bit wherever numpy's elementary functions agree with the C library's.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
+
+from ..trig import cos_sin_2pi
 
 Local = tuple[np.ndarray, np.ndarray, np.ndarray]
 
-TWO_PI = 2.0 * math.pi
 
 
 def components(a: np.ndarray) -> Local:
@@ -86,17 +85,17 @@ def local_to_world(w: Local, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Loc
 
 def cosine_direction(r1: np.ndarray, r2: np.ndarray) -> Local:
     """rtpy.sampling.random_cosine_direction from its two uniform numbers."""
-    phi = TWO_PI * r1
+    cos_phi, sin_phi = cos_sin_2pi(r1)
     s = np.sqrt(r2)
-    return s * np.cos(phi), s * np.sin(phi), np.sqrt(np.maximum(0.0, 1.0 - r2))
+    return s * cos_phi, s * sin_phi, np.sqrt(np.maximum(0.0, 1.0 - r2))
 
 
 def uniform_sphere(r1: np.ndarray, r2: np.ndarray) -> Local:
     """rtpy.sampling.uniform_sphere: uniform on the unit sphere."""
     z = 1.0 - 2.0 * r1
     s = np.sqrt(np.maximum(0.0, 1.0 - z * z))
-    phi = TWO_PI * r2
-    return s * np.cos(phi), s * np.sin(phi), z
+    cos_phi, sin_phi = cos_sin_2pi(r2)
+    return s * cos_phi, s * sin_phi, z
 
 
 class Frame:

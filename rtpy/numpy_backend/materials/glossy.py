@@ -23,8 +23,8 @@ from ...materials.glossy import MAX_PDF
 from ...materials.phong import INV_TWO_PI
 from ...materials.ward import MAX_EXPONENT, MIN_COS_PRODUCT
 from ..hits import HitBatch
+from ..trig import cos_sin_2pi
 from .frame import (
-    TWO_PI,
     Frame,
     Local,
     compose,
@@ -172,8 +172,8 @@ def sample_cosine_power(n: np.ndarray, r1: np.ndarray, r2: np.ndarray) -> Local:
     """rtpy.materials.phong.sample_cosine_power: density (n + 1) / (2 pi) cos^n about z."""
     cos_theta = r1 ** (1.0 / (n + 1.0))
     sin_theta = np.sqrt(np.maximum(0.0, 1.0 - cos_theta * cos_theta))
-    phi = TWO_PI * r2
-    return sin_theta * np.cos(phi), sin_theta * np.sin(phi), cos_theta
+    cos_phi, sin_phi = cos_sin_2pi(r2)
+    return sin_theta * cos_phi, sin_theta * sin_phi, cos_theta
 
 
 def cosine_power_pdf(n: np.ndarray, cos_theta: np.ndarray) -> np.ndarray:
@@ -290,8 +290,8 @@ class CookTorranceKernel(GlossyKernel):
         tan2 = self.tan2_half_vector(self.alpha[slots], r1)
         cos = 1.0 / np.sqrt(1.0 + tan2)
         sin = np.sqrt(tan2) * cos
-        phi = TWO_PI * r2
-        return reflect_about(wo, (sin * np.cos(phi), sin * np.sin(phi), cos))
+        cos_phi, sin_phi = cos_sin_2pi(r2)
+        return reflect_about(wo, (sin * cos_phi, sin * sin_phi, cos))
 
     def specular_pdf(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
         h, ok = half_vector(wo, wi)
@@ -396,8 +396,8 @@ class WardKernel(GlossyKernel):
         self, slots: np.ndarray, wo: Local, r1: np.ndarray, r2: np.ndarray
     ) -> tuple[Local, np.ndarray]:
         ax, ay = self.ax[slots], self.ay[slots]
-        angle = TWO_PI * r2
-        phi = np.arctan2(ay * np.sin(angle), ax * np.cos(angle))
+        cos_angle, sin_angle = cos_sin_2pi(r2)
+        phi = np.arctan2(ay * sin_angle, ax * cos_angle)
         cos_phi, sin_phi = np.cos(phi), np.sin(phi)
         a = cos_phi * cos_phi / (ax * ax) + sin_phi * sin_phi / (ay * ay)
         tan2 = -np.log1p(-r1) / a
