@@ -61,20 +61,13 @@ class HitBatch:
         return len(self.t)
 
     def take(self, mask_or_index: np.ndarray) -> HitBatch:
-        """The hits selected by a boolean mask or an integer index array."""
+        """The hits selected by a boolean mask or an integer index array. Each field is
+        gathered when it is first read (a material kernel reads only some of them);
+        the fields of a HitBatch are never modified in place, so this is the same."""
         k = mask_or_index
         if k.dtype == np.bool_:
             k = np.flatnonzero(k)
-        return HitBatch(
-            rows(self.point, k),
-            rows(self.normal, k),
-            rows(self.wo, k),
-            self.t.take(k),
-            self.front_face.take(k),
-            _rows(self.u, k),
-            _rows(self.v, k),
-            _rows(self.tangent, k),
-        )
+        return _HitRows(self, k)
 
     def hit_info(self, i: int, material: Material | None = None) -> HitInfo:
         """Hit i as a scalar HitInfo (for scalar fallbacks and tests); its tangent is
@@ -92,3 +85,25 @@ class HitBatch:
         )
         hit.tangent = Vec3(float(s[0]), float(s[1]), float(s[2]))
         return hit
+
+
+_FIELDS = frozenset(("point", "normal", "wo", "t", "front_face", "u", "v", "tangent"))
+
+
+class _HitRows(HitBatch):
+    """HitBatch.take's result: rows k of the parent's fields, each gathered on first
+    read and then kept as an ordinary attribute."""
+
+    def __init__(self, parent: HitBatch, k: np.ndarray) -> None:  # no dataclass fields yet
+        self._parent = parent
+        self._k = k
+
+    def __len__(self) -> int:
+        return len(self._k)
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        if name not in _FIELDS:
+            raise AttributeError(name)
+        value = _rows(getattr(self._parent, name), self._k)
+        setattr(self, name, value)
+        return value
