@@ -523,8 +523,8 @@ def _sphere_roots(h, c_term, a, r, f2, t_min, t_max):
         t1 = q / a
     lo = np.minimum(t0, t1)
     hi = np.maximum(t0, t1)
-    t = np.where((t_min < hi) & (hi < t_max), hi, INF)
-    return np.where((t_min < lo) & (lo < t_max), lo, t), q
+    t = np.where(t_min < lo, lo, hi)  # the nearer root past t_min (hi >= lo)
+    return np.where((t_min < t) & (t < t_max), t, INF), q
 
 
 class SphereSet(PrimitiveSet):
@@ -626,9 +626,9 @@ class SphereSet(PrimitiveSet):
                 cand &= idx < 0
             if skip is not None:
                 cand &= skip != k
-            j = np.flatnonzero(cand)
-            if j.size == 0:
+            if not cand.any():
                 continue
+            j = np.flatnonzero(cand)
             a, tm, jx, jy, jz = a_all, t_best, dx, dy, dz
             if j.size < n:
                 h, oc2, ocx, ocy, ocz = h[j], oc2[j], ocx[j], ocy[j], ocz[j]
