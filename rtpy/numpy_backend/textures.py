@@ -82,7 +82,8 @@ class TextureTable:
                     size += tex.width * tex.height
                 self.offset[k] = placed[id(tex.pixels)]
         self.atlas = np.concatenate(images) if images else np.zeros((0, 3))
-        self.kinds_present = frozenset(int(k) for k in np.unique(self.kind))
+        # (not np.unique: its first call imports a module, ~25 ms in every worker)
+        self.kinds_present = frozenset(self.kind.tolist())
 
     def value(
         self, ids: np.ndarray, hits: HitBatch, rows: np.ndarray | slice = slice(None)
