@@ -16,7 +16,6 @@ from ..trig import cos_sin_2pi
 Local = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
-
 def components(a: np.ndarray) -> Local:
     """The columns of an (n, 3) array."""
     return a[:, 0], a[:, 1], a[:, 2]
