@@ -34,6 +34,7 @@ from ..triangle import Triangle
 from ..vec3 import Vec3
 from .arrays import at, axpy, put_rows, rows, scale
 from .hits import HitBatch, unused
+from .materials.frame import local_to_world
 from .trig import cos_sin_2pi
 
 # Sets with more primitives than this are culled by a BVH; fewer are tested brute force.
@@ -565,12 +566,12 @@ class SphereSet(PrimitiveSet):
         return np.where(miss, INF, t)
 
     def closest(self, o, d, t_min, t_max, any_hit=False, skip=None):
-        """As PrimitiveSet.closest. Without a BVH, one sphere at a time over all rays
-        (1-D arrays of length N: an (N, K) broadcast runs numpy's inner loop over the
-        K spheres, which is slow for small K). Each sphere first rejects, for all rays,
-        those that surely miss it, by a cheaper test than pair_t's (below), and runs
-        pair_t's arithmetic, op for op, only for the rest, against the closest t found
-        so far: t is bit-identical and ties keep the lower index (as argmin).
+        """As PrimitiveSet.closest. Without a BVH, rays in chunks of SPHERE_CHUNK: a
+        cheaper test than pair_t's (below) rejects, for every sphere and ray at once in
+        (K, chunk) arrays (sphere by row, so numpy's inner loop runs over the rays),
+        the pairs that surely miss; then sphere by sphere, pair_t's arithmetic, op for
+        op, runs only for the rest, against the closest t found so far: t is
+        bit-identical and ties keep the lower index (as argmin).
 
         The cheap test: pair_t misses where the sphere is behind an origin outside it
         (h < 0 and |oc|^2 > r^2), or where the line passes farther than r from the
@@ -717,16 +718,7 @@ class SphereSet(PrimitiveSet):
             axis = at(self.center, ko) - po
             axis = scale(axis, 1.0 / np.sqrt(_dot(axis, axis)))
             x, y = sin_t * cos_phi, sin_t * sin_phi
-            # onb.local_to_world(axis, x, y, cos_t)
-            w0, w1, w2 = axis[:, 0], axis[:, 1], axis[:, 2]
-            sign = np.copysign(1.0, w2)
-            a = -1.0 / (sign + w2)
-            b = w0 * w1 * a
-            dirs = (
-                x * (1.0 + sign * w0 * w0 * a) + y * b + cos_t * w0,
-                x * sign * b + y * (sign + w1 * w1 * a) + cos_t * w1,
-                -x * sign * w0 - y * w1 + cos_t * w2,
-            )
+            dirs = local_to_world((axis[:, 0], axis[:, 1], axis[:, 2]), x, y, cos_t)
             if every:
                 direction = np.stack(dirs, axis=1)
                 pdf = 1.0 / (2.0 * math.pi * om)
@@ -772,13 +764,8 @@ class SphereSet(PrimitiveSet):
         x, y = sin_t * cos_phi, sin_t * sin_phi
         dist = np.sqrt(d2)
         inv = 1.0 / dist
-        w0, w1, w2 = ocx * inv, ocy * inv, ocz * inv  # the cone's axis
-        sign = np.copysign(1.0, w2)
-        a = -1.0 / (sign + w2)
-        b = w0 * w1 * a
-        dx = x * (1.0 + sign * w0 * w0 * a) + y * b + cos_t * w0
-        dy = x * sign * b + y * (sign + w1 * w1 * a) + cos_t * w1
-        dz = -x * sign * w0 - y * w1 + cos_t * w2
+        axis = (ocx * inv, ocy * inv, ocz * inv)
+        dx, dy, dz = local_to_world(axis, x, y, cos_t)
         pdf = 1.0 / (2.0 * math.pi * omc)
         # The distance to the sphere along the sampled direction (see above); inside
         # the cone, r^2 - D^2 sin^2 >= 0 but for rounding.
