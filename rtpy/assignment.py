@@ -62,6 +62,13 @@ MACHINERY_TESTS = ("tests/test_grade.py", "tests/test_assignment.py")
 # A test file that uses the numpy backend (withheld from student repositories).
 NUMPY_USE = re.compile(r"numpy_backend|[\"']numpy[\"']|rtpy\.BACKENDS")
 
+
+def never_mapped(rel: str) -> bool:
+    """Test files (tests/... paths) that map-tests leaves out and no week ships: the
+    numpy backend's (the backend is withheld) and the assignment machinery's."""
+    return rel.startswith("tests/numpy_backend/") or rel in MACHINERY_TESTS
+
+
 NUMPY_STUB = '''"""The numpy backend is withheld from the weekly assignment repositories: its
 vectorized twins contain the solutions. Render with the scalar backend (the default)."""
 '''
@@ -217,9 +224,8 @@ def shipped_tests(root: Path, week: str) -> tuple[list[str], list[str]]:
         rel = path.relative_to(root).as_posix()
         needs = mapping.get(rel, [])
         if (
-            rel.startswith("tests/numpy_backend/")
+            never_mapped(rel)
             or NUMPY_USE.search(path.read_text())
-            or rel in MACHINERY_TESTS
             or any(withheld(w, week) for w in needs)
         ):
             left.append(rel)
@@ -366,9 +372,7 @@ def map_tests(
     root = Path(root) if root is not None else Path(__file__).resolve().parent.parent
     if files:  # the numpy backend's tests and the machinery's are never mapped
         given = [Path(f).as_posix() for f in files]
-        files = tuple(
-            f for f in given if not (f.startswith("tests/numpy_backend/") or f in MACHINERY_TESTS)
-        )
+        files = tuple(f for f in given if not never_mapped(f))
         if not files:
             return {k: set(v) for k, v in weeks_of_tests(root).items()}
     with tempfile.TemporaryDirectory(prefix="rtpy-map-tests-") as tmp:
@@ -426,7 +430,7 @@ def map_tests(
                 weeks.setdefault(test, set()).add(week)
         for path in [] if files else sorted((root / "tests").rglob("test_*.py")):
             rel = path.relative_to(root).as_posix()
-            if not (rel.startswith("tests/numpy_backend/") or rel in MACHINERY_TESTS):
+            if not never_mapped(rel):
                 weeks.setdefault(rel, set())  # runs no region: ships every week
     body = "".join(
         f'"{k}" = [{", ".join(str(int(w)) for w in sorted(v))}]\n' for k, v in sorted(weeks.items())

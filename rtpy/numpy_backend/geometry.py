@@ -528,6 +528,24 @@ def _sphere_roots(h, c_term, a, r, f2, t_min, t_max):
     return np.where((t_min < t) & (t < t_max), t, INF), q
 
 
+def _cone_omc(d2, r2):
+    """1 - cos_max of the cone that a sphere of squared radius r2 subtends at squared
+    distance d2 from its centre (Sphere._cone), written without cancellation."""
+    sin2 = r2 / d2
+    return sin2 / (1.0 + np.sqrt(1.0 - sin2))
+
+
+def _cone_direction(axis, omc, r1, r2):
+    """Sphere.sample_direction inside the cone: ((x, y, z) world direction, cos_t,
+    sin_t^2) at angle cos_t = 1 - r1 omc from the unit axis (from the shading point
+    toward the centre), azimuth 2 pi r2 in the frame ONB(axis)."""
+    cos_t = 1.0 - r1 * omc
+    sin2_t = np.maximum(0.0, 1.0 - cos_t * cos_t)
+    sin_t = np.sqrt(sin2_t)
+    cos_phi, sin_phi = cos_sin_2pi(r2)
+    return local_to_world(axis, sin_t * cos_phi, sin_t * sin_phi, cos_t), cos_t, sin2_t
+
+
 class SphereSet(PrimitiveSet):
     """Spheres: center (K, 3), radius (K,). Geometric normal outward."""
 
@@ -687,22 +705,20 @@ class SphereSet(PrimitiveSet):
         n = np.stack([s * cos_phi, s * sin_phi, z], axis=1)
         return self.center[k] + n * self.radius[k][:, None], n
 
-    def cone(self, k, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Sphere._cone: (outside (N,) bool, cos_max, 1 - cos_max) of the cone the
-        sphere subtends at p; only meaningful where outside."""
+    def cone(self, k, p) -> tuple[np.ndarray, np.ndarray]:
+        """Sphere._cone: (outside (N,) bool, 1 - cos_max) of the cone the sphere
+        subtends at p; only meaningful where outside."""
         dv = at(self.center, k) - p
         d2 = _dot(dv, dv)
         r2 = at(self.r2, k)
         outside = ~(d2 <= r2 * 1.0000001)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inside: unused
-            sin2 = r2 / d2
-            cos_max = np.sqrt(1.0 - sin2)
-            return outside, cos_max, sin2 / (1.0 + cos_max)
+            return outside, _cone_omc(d2, r2)
 
     def sample_direction(self, k, p, r1, r2):
         """Sphere.sample_direction: by solid angle inside the cone seen from outside,
         by area from inside. Returns (direction, pdf, valid)."""
-        outside, _, omc = self.cone(k, p)
+        outside, omc = self.cone(k, p)
         direction = np.empty_like(p)
         pdf = np.zeros(len(p))
         valid = np.zeros(len(p), dtype=bool)
@@ -712,13 +728,14 @@ class SphereSet(PrimitiveSet):
             om = omc if every else omc.take(o)
             ko = k if every or isinstance(k, int) else k.take(o)
             po = p if every else p.take(o, axis=0)
-            cos_t = 1.0 - (r1 if every else r1.take(o)) * om
-            sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
-            cos_phi, sin_phi = cos_sin_2pi(r2 if every else r2.take(o))
             axis = at(self.center, ko) - po
             axis = scale(axis, 1.0 / np.sqrt(_dot(axis, axis)))
-            x, y = sin_t * cos_phi, sin_t * sin_phi
-            dirs = local_to_world((axis[:, 0], axis[:, 1], axis[:, 2]), x, y, cos_t)
+            dirs, _, _ = _cone_direction(
+                (axis[:, 0], axis[:, 1], axis[:, 2]),
+                om,
+                r1 if every else r1.take(o),
+                r2 if every else r2.take(o),
+            )
             if every:
                 direction = np.stack(dirs, axis=1)
                 pdf = 1.0 / (2.0 * math.pi * om)
@@ -754,18 +771,13 @@ class SphereSet(PrimitiveSet):
         d2 = ocx * ocx + ocy * ocy + ocz * ocz
         if not (d2 > rr * 1.0000001).all():  # some point inside: the general path
             return super().sample_light(k, p, r1, r2)
-        # The cone (cone()) and a direction in it (sample_direction()).
-        sin2 = rr / d2
-        omc = sin2 / (1.0 + np.sqrt(1.0 - sin2))  # 1 - cos_max
-        cos_t = 1.0 - r1 * omc
-        sin2_t = np.maximum(0.0, 1.0 - cos_t * cos_t)
-        sin_t = np.sqrt(sin2_t)
-        cos_phi, sin_phi = cos_sin_2pi(r2)
-        x, y = sin_t * cos_phi, sin_t * sin_phi
+        # The cone and a direction in it, as cone() and sample_direction().
+        omc = _cone_omc(d2, rr)
         dist = np.sqrt(d2)
         inv = 1.0 / dist
-        axis = (ocx * inv, ocy * inv, ocz * inv)
-        dx, dy, dz = local_to_world(axis, x, y, cos_t)
+        (dx, dy, dz), cos_t, sin2_t = _cone_direction(
+            (ocx * inv, ocy * inv, ocz * inv), omc, r1, r2
+        )
         pdf = 1.0 / (2.0 * math.pi * omc)
         # The distance to the sphere along the sampled direction (see above); inside
         # the cone, r^2 - D^2 sin^2 >= 0 but for rounding.
@@ -782,7 +794,7 @@ class SphereSet(PrimitiveSet):
         return direction, pdf, valid, t, point, normal
 
     def direction_pdf(self, k, p, q, n):
-        outside, _, omc = self.cone(k, p)
+        outside, omc = self.cone(k, p)
         with np.errstate(divide="ignore"):
             cone_pdf = 1.0 / (2.0 * math.pi * omc)
         if outside.all():
