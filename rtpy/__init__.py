@@ -14,8 +14,8 @@ from __future__ import annotations
 
 from .camera import Camera
 from .hit_info import HitInfo
-from .image import RenderedImage
 from .interval import Interval
+from .io.image import RenderedImage
 from .light import PointLight
 from .materials import (
     Dielectric,
@@ -44,8 +44,8 @@ BACKENDS = ("scalar", "numpy")
 
 def load_scene(path_or_name: str):
     """Load a scene file (TOML, see the README) or a bundled scene by name."""
-    from .bundled import resolve_scene
-    from .scene_file import load_scene as _load
+    from .io.bundled import resolve_scene
+    from .io.scene_file import load_scene as _load
 
     return _load(resolve_scene(str(path_or_name)))
 

@@ -1,7 +1,7 @@
-"""`python -m rtpy`: see rtpy.cli."""
+"""`python -m rtpy`: see rtpy.io.cli."""
 
 import sys
 
-from .cli import main
+from .io.cli import main
 
 sys.exit(main())

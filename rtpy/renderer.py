@@ -21,8 +21,8 @@ import numpy as np
 from tqdm import tqdm
 
 from .camera import Camera
-from .image import RenderedImage
 from .integrators import make_integrator
+from .io.image import RenderedImage
 from .render_settings import RenderSettings
 from .sampling import make_generator, use_generator
 from .scene import Scene

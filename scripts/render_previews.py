@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 import rtpy
-from rtpy.bundled import bundled_scenes
+from rtpy.io.bundled import bundled_scenes
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "scenes"
 

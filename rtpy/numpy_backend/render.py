@@ -24,7 +24,7 @@ import sys
 import numpy as np
 
 from ..camera import Camera
-from ..image import RenderedImage
+from ..io.image import RenderedImage
 from ..render_settings import RenderSettings
 from ..renderer import Renderer, Unit
 from ..renderer import plan_units as scalar_plan_units

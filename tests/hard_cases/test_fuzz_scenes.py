@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from PIL import Image
-from test_scene_file import to_toml
 
 import rtpy
-from rtpy.scene_file import SceneError, load_scene_text
+from rtpy.io.scene_file import SceneError, load_scene_text
+from tests.io.test_scene_file import to_toml
 
 from .scene_strategies import examples, random_scene, seeds
 

@@ -32,7 +32,7 @@ import numpy as np
 import pytest
 
 import rtpy
-from rtpy.bundled import bundled_scenes
+from rtpy.io.bundled import bundled_scenes
 from rtpy.numpy_backend.integrators import Tracer
 
 ALPHA = 1e-3

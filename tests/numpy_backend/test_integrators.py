@@ -21,14 +21,6 @@ from rtpy import (
     Sphere,
     Vec3,
 )
-from rtpy.analytic_scenes import (
-    PLANE_ALBEDO,
-    SPHERE_LIGHT_CENTER,
-    SPHERE_LIGHT_RADIANCE,
-    SPHERE_LIGHT_RADIUS,
-    GlowingLambertian,
-    plane_sphere_light,
-)
 from rtpy.integrators import make_integrator as make_scalar
 from rtpy.numpy_backend.camera import CameraRays
 from rtpy.numpy_backend.integrators import Tracer, make_integrator, power_heuristic
@@ -36,6 +28,14 @@ from rtpy.ray import Ray
 from rtpy.render_settings import RenderSettings
 from rtpy.sampling import make_generator, use_generator
 from rtpy.sampling import power_heuristic as scalar_power_heuristic
+from rtpy.testing.analytic_scenes import (
+    PLANE_ALBEDO,
+    SPHERE_LIGHT_CENTER,
+    SPHERE_LIGHT_RADIANCE,
+    SPHERE_LIGHT_RADIUS,
+    GlowingLambertian,
+    plane_sphere_light,
+)
 
 
 def camera_rays(camera, width=24, stride=1):

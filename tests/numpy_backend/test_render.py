@@ -8,7 +8,7 @@ import pytest
 
 import rtpy
 from rtpy import Camera, Color, DiffuseLight, Lambertian, Metal, Scene, Sphere, Vec3
-from rtpy.cli import main
+from rtpy.io.cli import main
 from rtpy.materials.material import Material
 from rtpy.numpy_backend.render import MAX_RAYS, plan_units
 from rtpy.ray import spawn_ray

@@ -7,8 +7,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ...analytic_scenes import GlowingLambertian
 from ...materials import Dielectric, DiffuseLight, Lambertian, Metal, Mirror
+from ...testing.analytic_scenes import GlowingLambertian
 from ..arrays import put_rows, where_rows
 from ..hits import HitBatch
 from .frame import (

@@ -36,15 +36,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .camera import Camera
-from .environment import SkyBand
-from .light import PointLight
-from .materials import DiffuseLight, Lambertian
-from .quad import Quad
-from .render_settings import RenderSettings
-from .scene import Scene
-from .sphere import Sphere
-from .vec3 import Color, Vec3
+from ..camera import Camera
+from ..environment import SkyBand
+from ..light import PointLight
+from ..materials import DiffuseLight, Lambertian
+from ..quad import Quad
+from ..render_settings import RenderSettings
+from ..scene import Scene
+from ..sphere import Sphere
+from ..vec3 import Color, Vec3
 
 FOOTPRINT_ORDER = 8  # Gauss-Legendre nodes per pixel side for pixel averages
 

@@ -58,7 +58,7 @@ COPIED = ("pyproject.toml", ".gitignore", "scenes")
 TEST_WEEKS_FILE = "assignments/test_weeks.toml"
 # Tests of the assignment machinery itself: they grade every week and generate
 # repositories, so they belong to rtpy only (and are not mapped).
-MACHINERY_TESTS = ("tests/test_grade.py", "tests/test_assignment.py")
+MACHINERY_TESTS = ("tests/grading/test_graders.py", "tests/grading/test_assignment.py")
 # A test file that uses the numpy backend (withheld from student repositories).
 NUMPY_USE = re.compile(r"numpy_backend|[\"']numpy[\"']|rtpy\.BACKENDS")
 
@@ -239,7 +239,7 @@ def make_assignment(week: str | int, out_dir: str | Path, root: str | Path | Non
     Everything is written to a temporary directory next to it and renamed at the end,
     so a failure leaves nothing half-written."""
     week = check_week(week)
-    root = Path(root) if root is not None else Path(__file__).resolve().parent.parent
+    root = Path(root) if root is not None else Path(__file__).resolve().parents[2]
     out = Path(out_dir)
     src = root / "assignments" / f"week{week}"
     if not src.is_dir():
@@ -369,7 +369,7 @@ def map_tests(
     import subprocess
     import sys
 
-    root = Path(root) if root is not None else Path(__file__).resolve().parent.parent
+    root = Path(root) if root is not None else Path(__file__).resolve().parents[2]
     if files:  # the numpy backend's tests and the machinery's are never mapped
         given = [Path(f).as_posix() for f in files]
         files = tuple(f for f in given if not never_mapped(f))
@@ -437,7 +437,7 @@ def map_tests(
     )
     (root / TEST_WEEKS_FILE).write_text(
         "# The weeks whose solution regions each test file runs, recorded by\n"
-        "# `python -m rtpy assignment map-tests` (see rtpy/assignment.py). A file ships\n"
+        "# `python -m rtpy assignment map-tests` (see rtpy/grading/assignment.py). A file ships\n"
         "# in week W's repository only if all its weeks are before W.\n[tests]\n" + body
     )
     return weeks

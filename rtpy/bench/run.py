@@ -1,5 +1,5 @@
 """`python -m rtpy bench`: speed against error, measured against references
-that are known to be right (rtpy.reference, rtpy.analytic_scenes).
+that are known to be right (rtpy.testing.reference, rtpy.testing.analytic_scenes).
 
 For every scene, backend and integrator variant, each spp level is rendered
 `repeats` times with independent seeds. A level records: the wall time of one
@@ -39,10 +39,10 @@ from statistics import NormalDist
 
 import numpy as np
 
-from .analytic_scenes import ANALYTIC_SCENES, analytic_scene
-from .camera import Camera
-from .reference import DEFAULT_REFERENCE_SPP, Reference, analytic_reference, get_reference
-from .scene import Scene
+from ..camera import Camera
+from ..scene import Scene
+from ..testing.analytic_scenes import ANALYTIC_SCENES, analytic_scene
+from ..testing.reference import DEFAULT_REFERENCE_SPP, Reference, analytic_reference, get_reference
 
 # Integrator variants: render settings on top of the scene's own.
 VARIANTS: dict[str, dict] = {
@@ -98,8 +98,8 @@ def load_bench_scene(
             a.settings.russian_roulette,
             lambda depth: analytic_reference(a, camera, depth),
         )
-    from . import load_scene
-    from .bundled import resolve_scene
+    from .. import load_scene
+    from ..io.bundled import resolve_scene
 
     path = resolve_scene(name)
     scene = load_scene(path)
@@ -147,7 +147,7 @@ def _peak_rss_mb(reset_ok: bool) -> float:
 
 def render_once(bs: BenchScene, backend: str, variant: str, spp: int, seed: int, workers: int):
     """(linear image, seconds, peak RSS in MB) of one render."""
-    from . import render
+    from .. import render
 
     reset_ok = _reset_peak_rss()
     start = time.perf_counter()
@@ -701,7 +701,7 @@ def _spp_list(text: str) -> list[int]:
         raise BenchUsageError(
             f"--spp: expected whole numbers such as 1,4,16,64; got {text!r}"
         ) from None
-    from .scene_file import MAX_SPP
+    from ..io.scene_file import MAX_SPP
 
     if len(values) < 1 or any(not 1 <= v <= MAX_SPP for v in values):
         raise BenchUsageError(f"--spp: expected numbers from 1 to {MAX_SPP}; got {text!r}")
@@ -709,7 +709,7 @@ def _spp_list(text: str) -> list[int]:
 
 
 def command_bench(args: argparse.Namespace) -> int:
-    from .scene_file import SceneError
+    from ..io.scene_file import SceneError
 
     def log(msg: str) -> None:
         print(msg, file=sys.stderr)
@@ -721,7 +721,7 @@ def command_bench(args: argparse.Namespace) -> int:
         repeats = args.repeats or (QUICK["repeats"] if args.quick else 4)
         if repeats < 2:
             raise BenchUsageError("--repeats: at least 2 (the bias test needs the spread)")
-        from .scene_file import MAX_WIDTH
+        from ..io.scene_file import MAX_WIDTH
 
         if not 1 <= width <= MAX_WIDTH:
             raise BenchUsageError(f"--width: expected a whole number from 1 to {MAX_WIDTH}")
@@ -733,7 +733,7 @@ def command_bench(args: argparse.Namespace) -> int:
         scenes = args.scenes or list(ANALYTIC_SCENES)
         for name in scenes:
             if name not in ANALYTIC_SCENES:
-                from .bundled import resolve_scene
+                from ..io.bundled import resolve_scene
 
                 resolve_scene(name)
         out = Path(args.out)

@@ -1,4 +1,4 @@
-"""Tests for rtpy.image: 8-bit conversion, file formats, atomic writes, path checks."""
+"""Tests for rtpy.io.image: 8-bit conversion, file formats, atomic writes, path checks."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from PIL import Image
 
-from rtpy.image import (
+from rtpy.io.image import (
     OutputError,
     RenderedImage,
     atomic_write,

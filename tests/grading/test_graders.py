@@ -30,14 +30,14 @@ import rtpy.materials.dielectric as dielectric
 import rtpy.materials.mirror as mirror
 import rtpy.vec3 as vec3
 from rtpy import Camera, CheckerTexture, ImageTexture, PointLight, Quad, Ray, Scene, Sphere
-from rtpy.assignment import WEEKS
-from rtpy.cli import main
 from rtpy.grading import compare, summarize
+from rtpy.grading.assignment import WEEKS
+from rtpy.io.cli import main
 from rtpy.materials import BlinnPhong, Lambertian, Metal, Phong
 from rtpy.materials.glossy import GlossyMaterial
 from rtpy.vec3 import Color, Vec3
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @cache

@@ -32,16 +32,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .camera import Camera
-from .light import PointLight
-from .materials import MATERIALS
-from .quad import Quad
-from .render_settings import INTEGRATOR_NAMES, RenderSettings
-from .scene import Scene
-from .sphere import Sphere
-from .texture import CheckerTexture, ImageTexture, SolidColor, Texture
-from .triangle import Triangle
-from .vec3 import Color, Vec3, cross
+from ..camera import Camera
+from ..light import PointLight
+from ..materials import MATERIALS
+from ..quad import Quad
+from ..render_settings import INTEGRATOR_NAMES, RenderSettings
+from ..scene import Scene
+from ..sphere import Sphere
+from ..texture import CheckerTexture, ImageTexture, SolidColor, Texture
+from ..triangle import Triangle
+from ..vec3 import Color, Vec3, cross
 
 __all__ = [
     "MAX_HEIGHT",

@@ -25,10 +25,10 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from rtpy.hit_info import HitInfo
+from rtpy.io.scene_file import SceneError, load_scene_text
 from rtpy.materials import MATERIALS, CookTorrance
 from rtpy.ray import Ray
 from rtpy.sampling import make_generator, use_generator
-from rtpy.scene_file import SceneError, load_scene_text
 from rtpy.vec3 import Color, Vec3
 
 ALBEDO = (0.8, 0.5, 0.25)

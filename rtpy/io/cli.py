@@ -12,8 +12,8 @@ import sys
 import tomllib
 from pathlib import Path
 
+from ..render_settings import INTEGRATOR_NAMES
 from .image import OutputError, check_image_path, check_linear_path
-from .render_settings import INTEGRATOR_NAMES
 from .scene_file import MAX_MAX_DEPTH, MAX_RADIANCE, MAX_SPP, MAX_WIDTH
 
 EXIT_BAD_INPUT = 2
@@ -123,7 +123,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sub.add_parser("scenes", help="list the bundled scenes")
 
-    from .bench import add_parser as add_bench_parser
+    from ..bench.run import add_parser as add_bench_parser
 
     add_bench_parser(sub)
     add_assignment_commands(sub)
@@ -145,7 +145,7 @@ def add_assignment_commands(sub) -> None:
 
 
 def command_assignment(args: argparse.Namespace) -> int:
-    from .assignment import AssignmentError, check_week, make_assignment, map_tests
+    from ..grading.assignment import AssignmentError, check_week, make_assignment, map_tests
 
     try:
         if args.command == "grade":
@@ -164,7 +164,7 @@ def command_assignment(args: argparse.Namespace) -> int:
 
 def command_grade(week: str, json_path: str | None) -> int:
     """0 when every grader passes, 1 otherwise."""
-    from .grading import grade, score_table, write_json
+    from ..grading.graders import grade, score_table, write_json
 
     results = grade(week)
     print(score_table(results))
@@ -222,7 +222,7 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
     returns them with background turned into a Color."""
     import math
 
-    from .vec3 import Color
+    from ..vec3 import Color
 
     def fail(key: str, expected: str, value) -> UsageError:
         option = f"--{key.replace('_', '-')}" if as_flags else f"--set {key}"
@@ -330,7 +330,7 @@ def command_render(args: argparse.Namespace) -> int:
 
 
 def _render(args: argparse.Namespace) -> int:
-    from . import render
+    from .. import render
     from .bundled import resolve_scene
     from .scene_file import SceneError, load_scene
 
@@ -385,7 +385,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "scenes":
         return command_scenes()
     if args.command == "bench":
-        from .bench import command_bench
+        from ..bench.run import command_bench
 
         return command_bench(args)
     if args.command in ("assignment", "grade"):

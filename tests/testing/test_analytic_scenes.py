@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from rtpy.analytic_scenes import (
+from rtpy.testing.analytic_scenes import (
     ANALYTIC_SCENES,
     GLOW_LE,
     GLOW_RHO,

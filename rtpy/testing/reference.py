@@ -3,7 +3,7 @@
 A Reference is the expected image of an unbiased estimator at a given max_depth,
 with the variance of its own pixels and the mask of pixels it holds for:
 
-- analytic_reference: an rtpy.analytic_scenes scene's closed form (variance 0);
+- analytic_reference: an rtpy.testing.analytic_scenes scene's closed form (variance 0);
 - rendered_reference: for any other scene, made once by rtpy at high spp with
   the most efficient integrator (numpy backend, "path" with next-event
   estimation and MIS, the scene's max_depth) as REFERENCE_RENDERS independent
@@ -30,8 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..camera import Camera
 from .analytic_scenes import AnalyticScene
-from .camera import Camera
 
 REFERENCE_RENDERS = 4
 DEFAULT_REFERENCE_SPP = 1024
@@ -130,7 +130,7 @@ def render_reference(
 ) -> tuple[np.ndarray, np.ndarray, dict]:
     """(image, variance of the image, settings) by REFERENCE_RENDERS independent
     numpy-backend renders with path tracing, next-event estimation and MIS."""
-    from . import load_scene, render
+    from .. import load_scene, render
 
     scene = load_scene(str(scene_path))
     per = max(1, -(-spp // REFERENCE_RENDERS))

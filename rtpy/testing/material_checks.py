@@ -57,12 +57,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .hit_info import HitInfo
-from .materials.material import Material
-from .ray import Ray
-from .sampling import generator, make_generator, use_generator
-from .texture import Texture
-from .vec3 import Vec3
+from ..hit_info import HitInfo
+from ..materials.material import Material
+from ..ray import Ray
+from ..sampling import generator, make_generator, use_generator
+from ..texture import Texture
+from ..vec3 import Vec3
 
 __all__ = [
     "AdaptiveSimpson2D",

@@ -209,7 +209,7 @@ def failure_message(report) -> str:
 
 def grader_dir(week: str, root: Path | None = None) -> Path:
     """assignments/weekNN under the current directory, else next to the rtpy package."""
-    for base in [root] if root else [Path.cwd(), Path(__file__).resolve().parent.parent]:
+    for base in [root] if root else [Path.cwd(), Path(__file__).resolve().parents[2]]:
         path = base / "assignments" / f"week{week}"
         if path.is_dir():
             return path

@@ -27,7 +27,7 @@ import sys
 import numpy as np
 import pytest
 
-from rtpy.bench import (
+from rtpy.bench.run import (
     ROUNDING,
     SLOPE_TOLERANCE,
     VARIANTS,
@@ -35,7 +35,7 @@ from rtpy.bench import (
     fit_slope,
     run_bench,
 )
-from rtpy.cli import main
+from rtpy.io.cli import main
 
 SPP = (1, 4, 16, 64)
 REPEATS = 4

@@ -1,4 +1,4 @@
-"""Tests for rtpy.scene_file (loading and checking scene files) and rtpy.bundled."""
+"""Tests for rtpy.io.scene_file (loading and checking scene files) and rtpy.io.bundled."""
 
 from __future__ import annotations
 
@@ -12,15 +12,10 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
-from rtpy import bundled
-from rtpy.bundled import bundled_dir, bundled_scenes, resolve_scene
 from rtpy.camera import MAX_PIXELS, Camera
-from rtpy.light import PointLight
-from rtpy.materials import Dielectric, DiffuseLight, Lambertian, Metal, Mirror
-from rtpy.quad import Quad
-from rtpy.render_settings import RenderSettings
-from rtpy.scene import Scene
-from rtpy.scene_file import (
+from rtpy.io import bundled
+from rtpy.io.bundled import bundled_dir, bundled_scenes, resolve_scene
+from rtpy.io.scene_file import (
     MAX_HEIGHT,
     MAX_SPP,
     MAX_WIDTH,
@@ -28,6 +23,11 @@ from rtpy.scene_file import (
     load_scene,
     load_scene_text,
 )
+from rtpy.light import PointLight
+from rtpy.materials import Dielectric, DiffuseLight, Lambertian, Metal, Mirror
+from rtpy.quad import Quad
+from rtpy.render_settings import RenderSettings
+from rtpy.scene import Scene
 from rtpy.sphere import Sphere
 from rtpy.texture import CheckerTexture, ImageTexture, SolidColor
 from rtpy.triangle import Triangle
@@ -981,7 +981,7 @@ def test_bundled_dir_is_the_scenes_folder():
     assert (folder / "__init__.py").exists() or any(folder.glob("*.toml"))
 
 
-REPO_SCENES = Path(__file__).resolve().parent.parent / "scenes"
+REPO_SCENES = Path(__file__).resolve().parents[2] / "scenes"
 BUNDLED_FILES = sorted(REPO_SCENES.glob("*.toml"))
 
 

@@ -1,4 +1,4 @@
-"""Student repositories generated from the solution regions (rtpy.assignment).
+"""Student repositories generated from the solution regions (rtpy.grading.assignment).
 
 What is checked, for every week 03-08, in a repository written by
 `python -m rtpy assignment make WEEK OUT` (one subprocess per week, with the
@@ -12,7 +12,7 @@ repository's own rtpy first on the path):
 - no solution line of that week or a later one is left in the repository, every
   earlier week's solution is, and the numpy backend's solution code is absent.
 
-`assignments/test_weeks.toml` decides which tests ship (see rtpy/assignment.py).
+`assignments/test_weeks.toml` decides which tests ship (see rtpy/grading/assignment.py).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from pathlib import Path
 
 import pytest
 
-from rtpy.assignment import (
+from rtpy.grading.assignment import (
     MACHINERY_TESTS,
     NUMPY_USE,
     TEST_WEEKS_FILE,
@@ -39,9 +39,9 @@ from rtpy.assignment import (
     shipped_tests,
     weeks_of_tests,
 )
-from rtpy.cli import main
+from rtpy.io.cli import main
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def first_shipped(week: str) -> list[str]:

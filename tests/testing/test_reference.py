@@ -8,9 +8,9 @@ import json
 import numpy as np
 import pytest
 
-from rtpy import reference as reference_module
-from rtpy.analytic_scenes import analytic_scene
-from rtpy.reference import (
+from rtpy.testing import reference as reference_module
+from rtpy.testing.analytic_scenes import analytic_scene
+from rtpy.testing.reference import (
     StaleReference,
     analytic_reference,
     file_sha256,

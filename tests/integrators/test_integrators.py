@@ -29,7 +29,9 @@ from rtpy import (
     Sphere,
     Vec3,
 )
-from rtpy.analytic_scenes import (
+from rtpy.integrators import INTEGRATORS, make_integrator
+from rtpy.sampling import make_generator, use_generator
+from rtpy.testing.analytic_scenes import (
     PLANE_ALBEDO,
     POINT_LIGHT_INTENSITY,
     POINT_LIGHT_POSITION,
@@ -39,8 +41,6 @@ from rtpy.analytic_scenes import (
     pixels_fully_on_sphere,
     plane_point_light,
 )
-from rtpy.integrators import INTEGRATORS, make_integrator
-from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import dot, unit_vector
 
 

@@ -14,9 +14,9 @@ import pytest
 from PIL import Image
 
 import rtpy
-from rtpy.bundled import bundled_scenes
-from rtpy.cli import main
-from rtpy.image import read_pfm
+from rtpy.io.bundled import bundled_scenes
+from rtpy.io.cli import main
+from rtpy.io.image import read_pfm
 
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
 

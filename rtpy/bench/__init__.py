@@ -1,0 +1,1 @@
+"""Speed against error: `python -m rtpy bench`."""

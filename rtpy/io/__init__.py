@@ -1,0 +1,1 @@
+"""Scene files, images, the bundled scenes and the command line."""
