@@ -64,7 +64,7 @@ def render_unit(scene: Scene, camera: Camera, integrator, seed: int, unit: Unit)
     """Sum of `unit.spp` radiance samples for each pixel of the unit's tile:
     an array (tile height, tile width, 3)."""
     out = np.zeros((unit.y1 - unit.y0, unit.x1 - unit.x0, 3))
-    radiance = integrator.radiance
+    radiance = integrator.compute_scattering
     get_ray = camera.get_center_ray if integrator.uses_center_ray else camera.get_ray
     with use_generator(make_generator(seed, unit.tile, unit.batch)):
         for j in range(unit.y0, unit.y1):

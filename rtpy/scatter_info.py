@@ -9,26 +9,28 @@ from .vec3 import Color
 class ScatterInfo:
     """The result of Material.scattering().
 
-    ray          the scattered ray, leaving the surface (direction is a unit vector)
-    attenuation  the Monte Carlo weight of this sample: BRDF * cos(theta) / pdf,
-                 or for a specular (delta) bounce the fraction of light carried
-    pdf          solid-angle density the direction was drawn with (0 for specular)
-    is_specular  True for delta bounces (mirror, metal, glass): no light sampling
-                 there, and the pdf is not a density
+    scattered_ray  the scattered ray, leaving the surface (direction is a unit vector)
+    attenuation    the Monte Carlo weight of this sample: BRDF * cos(theta) / pdf,
+                   or for a specular (delta) bounce the fraction of light carried.
+                   (The course's attenuation_color is the BRDF value alone; here the
+                   cosine and the pdf are already in, as in RTIOW.)
+    pdf            solid-angle density the direction was drawn with (0 for specular)
+    is_specular    True for delta bounces (mirror, metal, glass): no light sampling
+                   there, and the pdf is not a density
     """
 
-    __slots__ = ("ray", "attenuation", "pdf", "is_specular")
+    __slots__ = ("scattered_ray", "attenuation", "pdf", "is_specular")
 
     def __init__(
-        self, ray: Ray, attenuation: Color, pdf: float = 0.0, is_specular: bool = False
+        self, scattered_ray: Ray, attenuation: Color, pdf: float = 0.0, is_specular: bool = False
     ) -> None:
-        self.ray = ray
+        self.scattered_ray = scattered_ray
         self.attenuation = attenuation
         self.pdf = pdf
         self.is_specular = is_specular
 
     def __repr__(self) -> str:
         return (
-            f"ScatterInfo(ray={self.ray!r}, attenuation={self.attenuation!r}, "
+            f"ScatterInfo(scattered_ray={self.scattered_ray!r}, attenuation={self.attenuation!r}, "
             f"pdf={self.pdf!r}, is_specular={self.is_specular!r})"
         )

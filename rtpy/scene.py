@@ -30,7 +30,7 @@ class Scene:
     With bvh_min_objects objects or more, the queries walk a bounding volume
     hierarchy (rtpy.bvh) instead of testing every object. It is built on the first
     query and rebuilt when `objects` no longer equals the list it was built from
-    (Scene.add, or any change to the list). Its answers are exactly those of
+    (Scene.add_object, or any change to the list). Its answers are exactly those of
     testing every object in list order (the queries' brute_force=True).
 
     background  radiance of rays that escape (a constant environment)
@@ -70,7 +70,7 @@ class Scene:
     # even at 8 to 10 objects). 0: always use the BVH.
     bvh_min_objects: int = 10
 
-    def add(self, obj: Hittable) -> None:
+    def add_object(self, obj: Hittable) -> None:
         self.objects.append(obj)
         self.update_lights()
 

@@ -610,7 +610,7 @@ def test_bvh_is_built_once_and_rebuilt_when_objects_change():
     assert scene.bvh() is bvh  # cached
 
     nearer = Sphere(V(0, 0, -2), 0.5, MAT)
-    scene.add(nearer)  # Scene.add
+    scene.add_object(nearer)  # Scene.add_object
     assert scene.find_intersection(ray, FORWARD).obj is nearer
     assert scene.bvh() is not bvh
 

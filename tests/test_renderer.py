@@ -72,7 +72,7 @@ class InterruptAfter(Sphere):
 def test_ctrl_c_keeps_finished_samples():
     scene, camera = small_scene()
     pixels = camera.width * camera.height
-    scene.add(InterruptAfter(calls=pixels * 8))  # about a quarter of the work
+    scene.add_object(InterruptAfter(calls=pixels * 8))  # about a quarter of the work
     image = rtpy.render(scene, camera=camera, spp=8, seed=1)
     assert image.interrupted
     assert 1 <= image.samples_min < 8

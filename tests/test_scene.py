@@ -107,9 +107,9 @@ def test_area_lights_collects_emitters():
     assert [a.shape for a in scene.area_lights] == [lamp1, lamp2]
     # Adding an emitter later updates the list.
     lamp3 = Triangle(V(0, 4, 0), V(1, 4, 0), V(0, 4, 1), DiffuseLight(Color(1, 1, 1)))
-    scene.add(lamp3)
+    scene.add_object(lamp3)
     assert [a.shape for a in scene.area_lights] == [lamp1, lamp2, lamp3]
-    scene.add(Sphere(V(3, 1, 0), 1.0, GREY))
+    scene.add_object(Sphere(V(3, 1, 0), 1.0, GREY))
     assert len(scene.area_lights) == 3
 
 

@@ -138,7 +138,7 @@ def test_direct_light_on_a_plane_is_exact():
         # looked at from just above (below the sphere), from a random direction
         eye = target + 0.05 * unit(np.array([rng.uniform(-1, 1), 1.0, rng.uniform(-1, 1)]))
         d = unit(target - eye)
-        got = np.array(list(integrator.radiance(Ray(Vec3(*eye), Vec3(*d)), scene)))
+        got = np.array(list(integrator.compute_scattering(Ray(Vec3(*eye), Vec3(*d)), scene)))
         to_light = lp - target
         dist2 = to_light @ to_light
         cos = to_light[1] / math.sqrt(dist2)
@@ -223,11 +223,11 @@ def test_direct_sees_emitters_and_background():
         [Sphere(Vec3(0, 0, -3), 1.0, DiffuseLight(emit))], background=Color(0.1, 0.2, 0.3)
     )
     integrator = DirectIntegrator(RenderSettings(integrator="direct"))
-    got = integrator.radiance(Ray(Vec3(0, 0, 0), Vec3(0, 0, -1)), scene)
+    got = integrator.compute_scattering(Ray(Vec3(0, 0, 0), Vec3(0, 0, -1)), scene)
     assert np.allclose(list(got), list(emit)), (
-        f"DirectIntegrator.radiance: a camera ray hitting a light returned {got}, expected its emission {emit}"
+        f"DirectIntegrator.compute_scattering: a camera ray hitting a light returned {got}, expected its emission {emit}"
     )
-    got = integrator.radiance(Ray(Vec3(0, 0, 0), Vec3(0, 1, 0)), scene)
+    got = integrator.compute_scattering(Ray(Vec3(0, 0, 0), Vec3(0, 1, 0)), scene)
     assert np.allclose(list(got), [0.1, 0.2, 0.3]), (
-        f"DirectIntegrator.radiance: a ray that misses everything returned {got}, expected the background"
+        f"DirectIntegrator.compute_scattering: a ray that misses everything returned {got}, expected the background"
     )

@@ -108,7 +108,7 @@ def test_total_internal_reflection():
         for theta in (critical + 1, 60.0, 85.0):
             for _ in range(50):
                 s = glass.scattering(incoming(theta), glass_hit(False, glass))
-                d = arr(s.ray.direction)
+                d = arr(s.scattered_ray.direction)
                 assert d[2] > 0, (
                     f"Dielectric.scattering (rtpy/materials/dielectric.py): inside glass at {theta:.1f} "
                     f"degrees (critical angle {critical:.1f}) a ray refracted out: beyond the critical "
@@ -117,7 +117,7 @@ def test_total_internal_reflection():
         refracted = 0
         for _ in range(50):
             s = glass.scattering(incoming(critical - 5), glass_hit(False, glass))
-            refracted += arr(s.ray.direction)[2] < 0
+            refracted += arr(s.scattered_ray.direction)[2] < 0
         assert refracted > 0, (
             "Dielectric.scattering: below the critical angle light must also leave the glass"
         )
@@ -138,7 +138,7 @@ def test_dielectric_reflects_with_probability_schlick():
                     "Dielectric.scattering: the weight is the albedo, with no cosine and no R factor "
                     f"(R is the probability of reflecting); got {s.attenuation}"
                 )
-                reflected += arr(s.ray.direction)[2] > 0
+                reflected += arr(s.scattered_ray.direction)[2] > 0
             cos = math.cos(math.radians(theta))
             r = dielectric.schlick(cos, 1 / 1.5)
             z = (reflected / n - r) / math.sqrt(r * (1 - r) / n)
@@ -155,7 +155,7 @@ def test_mirror():
     for theta in (0.0, 45.0, 80.0):
         s = m.scattering(incoming(theta), glass_hit(True, m))
         t = math.radians(theta)
-        assert np.allclose(arr(s.ray.direction), [-math.sin(t), 0, math.cos(t)], atol=1e-12), (
+        assert np.allclose(arr(s.scattered_ray.direction), [-math.sin(t), 0, math.cos(t)], atol=1e-12), (
             f"Mirror.scattering (rtpy/materials/mirror.py) at {theta} degrees: not the mirror direction"
         )
         assert np.allclose(arr(s.attenuation), [0.9, 0.8, 0.7]), (

@@ -119,7 +119,7 @@ def test_metal_fuzz():
     hit = HitInfo(Vec3(0, 0, 0), v(n), 1.0, True, None)
     where = "Metal.scattering (rtpy/materials/metal.py)"
     s = Metal(Color(0.8, 0.6, 0.4), 0.0).scattering(ray, hit)
-    assert np.allclose(arr(s.ray.direction), r, atol=1e-12), (
+    assert np.allclose(arr(s.scattered_ray.direction), r, atol=1e-12), (
         f"{where}: fuzz 0 must be a perfect mirror"
     )
     for fuzz in (0.1, 0.5):
@@ -131,7 +131,7 @@ def test_metal_fuzz():
                 if s is None:
                     absorbed += 1
                     continue
-                d = arr(s.ray.direction)
+                d = arr(s.scattered_ray.direction)
                 assert abs(np.linalg.norm(d) - 1) < 1e-9, (
                     f"{where}: the direction must be a unit vector"
                 )

@@ -236,7 +236,7 @@ def test_path_furnace():
     mean, se = values.mean(), values.std(ddof=1) / math.sqrt(values.size)
     z = (mean - le / (1 - rho)) / se
     assert abs(z) < 4.5, (
-        f"PathIntegrator.radiance (rtpy/integrators/path.py): inside a closed sphere of albedo "
+        f"PathIntegrator.compute_scattering (rtpy/integrators/path.py): inside a closed sphere of albedo "
         f"{rho} emitting {le}, every pixel must converge to Le / (1 - albedo) = "
         f"{le / (1 - rho):g}; got {mean:.4f} +- {se:.4f} (z = {z:.1f}). Too low: Russian "
         "roulette survivors not divided by their survival probability, or paths cut short; "

@@ -30,5 +30,5 @@ class CenterIntegrator(Integrator):
     name = "center"
     uses_center_ray = True
 
-    def radiance(self, ray: Ray, scene: Scene) -> Color:
+    def compute_scattering(self, ray: Ray, scene: Scene) -> Color:
         return flat_color(ray, scene)

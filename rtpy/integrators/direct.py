@@ -17,7 +17,7 @@ class DirectIntegrator(Integrator):
 
     name = "direct"
 
-    def radiance(self, ray: Ray, scene: Scene) -> Color:
+    def compute_scattering(self, ray: Ray, scene: Scene) -> Color:
         # BEGIN SOLUTION week05: emission plus direct lighting at the first hit
         hit = scene.find_intersection(ray, FORWARD)
         if hit is None:

@@ -96,9 +96,11 @@ def direct_lighting(scene: Scene, ray_in: Ray, hit: HitInfo, mis: bool = True) -
     scatter = material.scattering(ray_in, hit)
     if scatter is None:
         return result
-    next_hit = scene.find_intersection(scatter.ray, FORWARD)
+    next_hit = scene.find_intersection(scatter.scattered_ray, FORWARD)
     if next_hit is None:
-        return result + scatter.attenuation * scene.background_radiance(scatter.ray.direction)
+        return result + scatter.attenuation * scene.background_radiance(
+            scatter.scattered_ray.direction
+        )
     if next_hit.material.is_emitter:
         emitted = next_hit.material.emitting(next_hit)
         if not emitted.is_black():

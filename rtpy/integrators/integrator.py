@@ -26,5 +26,5 @@ class Integrator:
     def __init__(self, settings: RenderSettings | None = None) -> None:
         self.settings = settings or RenderSettings()
 
-    def radiance(self, ray: Ray, scene: Scene) -> Color:
+    def compute_scattering(self, ray: Ray, scene: Scene) -> Color:
         raise NotImplementedError

@@ -13,5 +13,5 @@ from .integrator import Integrator
 class JitteredIntegrator(Integrator):
     name = "jittered"
 
-    def radiance(self, ray: Ray, scene: Scene) -> Color:
+    def compute_scattering(self, ray: Ray, scene: Scene) -> Color:
         return flat_color(ray, scene)

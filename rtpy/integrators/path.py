@@ -31,7 +31,7 @@ class PathIntegrator(Integrator):
 
     name = "path"
 
-    def radiance(self, ray: Ray, scene: Scene) -> Color:
+    def compute_scattering(self, ray: Ray, scene: Scene) -> Color:
         # BEGIN SOLUTION week08: path loop: emission (MIS), light sampling, throughput, roulette
         settings = self.settings
         max_depth, rr_start = settings.max_depth, settings.russian_roulette
@@ -64,7 +64,7 @@ class PathIntegrator(Integrator):
             if not beta.max_component() > 0.0:
                 break
             prev_point, prev_pdf, prev_specular = hit.point, scatter.pdf, scatter.is_specular
-            ray = scatter.ray
+            ray = scatter.scattered_ray
             if rr_start and segment >= rr_start:
                 survive = min(0.95, beta.max_component())
                 if random_double() >= survive:

@@ -22,7 +22,7 @@ class WhittedIntegrator(Integrator):
 
     name = "whitted"
 
-    def radiance(self, ray: Ray, scene: Scene, depth: int = 1) -> Color:
+    def compute_scattering(self, ray: Ray, scene: Scene, depth: int = 1) -> Color:
         hit = scene.find_intersection(ray, FORWARD)
         if hit is None:
             return scene.background_radiance(ray.direction)
@@ -33,5 +33,5 @@ class WhittedIntegrator(Integrator):
         if not material.is_specular:
             return result + direct_lighting(scene, ray, hit)
         for next_ray, weight in material.specular_rays(ray, hit):
-            result = result + weight * self.radiance(next_ray, scene, depth + 1)
+            result = result + weight * self.compute_scattering(next_ray, scene, depth + 1)
         return result

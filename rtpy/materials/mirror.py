@@ -29,4 +29,4 @@ class Mirror(Material):
 
     def specular_rays(self, ray_in: Ray, hit: HitInfo) -> list[tuple[Ray, Color]]:
         s = self.scattering(ray_in, hit)
-        return [(s.ray, s.attenuation)]
+        return [(s.scattered_ray, s.attenuation)]

@@ -230,7 +230,7 @@ class BatchIntegrator:
     def __init__(self, settings: RenderSettings | None = None) -> None:
         self.settings = settings or RenderSettings()
 
-    def radiance(
+    def compute_scattering(
         self, tracer: Tracer, o: np.ndarray, d: np.ndarray, rng: np.random.Generator
     ) -> np.ndarray:
         raise NotImplementedError
@@ -241,7 +241,7 @@ class FlatIntegrator(BatchIntegrator):
 
     name = "jittered"
 
-    def radiance(self, tracer, o, d, rng):
+    def compute_scattering(self, tracer, o, d, rng):
         out = np.empty((len(o), 3))
         obj, t = tracer.geometry.closest_hit(o, d)
         miss = obj < 0
@@ -281,7 +281,7 @@ class PathIntegrator(BatchIntegrator):
         s = self.settings
         return s.max_depth, s.russian_roulette, s.nee
 
-    def radiance(self, tracer, o, d, rng):
+    def compute_scattering(self, tracer, o, d, rng):
         max_depth, rr_start, nee = self._limits()
         n = len(o)
         result = np.zeros((n, 3))
@@ -376,7 +376,7 @@ class WhittedIntegrator(BatchIntegrator):
 
     name = "whitted"
 
-    def radiance(self, tracer, o, d, rng):
+    def compute_scattering(self, tracer, o, d, rng):
         n = len(o)
         result = np.zeros((n, 3))
         max_depth = self.settings.max_depth

@@ -88,7 +88,7 @@ def render_unit(
         o, d = rays.center_rays(i, j, rng)
     else:
         o, d = rays.jittered_rays(i, j, rng)
-    radiance = integrator.radiance(tracer, o, d, rng)
+    radiance = integrator.compute_scattering(tracer, o, d, rng)
     return radiance.reshape(h, w, unit.spp, 3).sum(axis=2)
 
 

@@ -268,7 +268,7 @@ def draw_samples(
                 rows.append(none_row)
                 status.append(SPECULAR)
             else:
-                d, a = s.ray.direction, s.attenuation
+                d, a = s.scattered_ray.direction, s.attenuation
                 rows.append((d.e0, d.e1, d.e2, a.e0, a.e1, a.e2, s.pdf))
                 status.append(SCATTERED)
     seconds = time.perf_counter() - start
@@ -1092,7 +1092,7 @@ def check_non_negative_finite(
                     s = material.scattering(ray_in, hit)
                     if s is None:
                         continue
-                    d = s.ray.direction
+                    d = s.scattered_ray.direction
                     if bad_color(s.attenuation) or bad_number(s.pdf):
                         problems.append(
                             f"incident {theta:g} deg: sample weight {_fmt(s.attenuation)}, "

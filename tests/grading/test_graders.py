@@ -114,14 +114,14 @@ def cosine_with_unnormalised_vector(mp):
 
 
 def roulette_not_divided(mp):
-    plant(mp, path_module.PathIntegrator, "radiance", "beta = beta / survive", "pass")
+    plant(mp, path_module.PathIntegrator, "compute_scattering", "beta = beta / survive", "pass")
 
 
 def path_counts_light_twice(mp):
     plant(
         mp,
         path_module.PathIntegrator,
-        "radiance",
+        "compute_scattering",
         "result = result + beta * emitted * w",
         "result = result + beta * emitted",
     )
@@ -134,7 +134,7 @@ def albedo_as_brdf(mp):
 def lambertian_no_pdf(mp):
     def change(self, s, ray_in, hit):
         if s is not None:
-            cos = vec3.dot(s.ray.direction, hit.normal)
+            cos = vec3.dot(s.scattered_ray.direction, hit.normal)
             s.attenuation = self.albedo.value(hit) * (cos / math.pi)  # BRDF * cos, no 1/pdf
         return s
 
@@ -272,7 +272,7 @@ def no_total_internal_reflection(mp):
 
 def mirror_with_cosine(mp):
     def change(self, s, ray_in, hit):
-        s.attenuation = s.attenuation * abs(vec3.dot(s.ray.direction, hit.normal))
+        s.attenuation = s.attenuation * abs(vec3.dot(s.scattered_ray.direction, hit.normal))
         return s
 
     mp.setattr(mirror.Mirror, "scattering", wrap(mirror.Mirror, "scattering", change))

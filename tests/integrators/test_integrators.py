@@ -70,7 +70,7 @@ def test_point_light_on_plane_is_exact_per_pixel():
         for j in range(camera.height):
             for i in range(camera.width):
                 ray = camera.get_center_ray(i, j)
-                got = integrator.radiance(ray, scene)
+                got = integrator.compute_scattering(ray, scene)
                 o, d = ray.origin, ray.direction
                 if d.e1 >= 0:
                     assert got == Color(0, 0, 0)
@@ -180,7 +180,7 @@ def sample_mean(integrator, ray, scene, n, seed):
     values = []
     with use_generator(make_generator(seed)):
         for _ in range(n):
-            values.append(integrator.radiance(ray, scene).e1)
+            values.append(integrator.compute_scattering(ray, scene).e1)
     return statistics.fmean(values), statistics.stdev(values) / math.sqrt(n)
 
 

@@ -242,7 +242,7 @@ def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, n, theta_o):
             if s is None:
                 continue
             scattered += 1
-            wi = s.ray.direction.tolist()
+            wi = s.scattered_ray.direction.tolist()
             assert math.isclose(math.sqrt(dot3(wi, wi)), 1.0, abs_tol=1e-12)
             cos_i = dot3(wi, NORMAL)
             assert cos_i > 0.0
@@ -357,7 +357,7 @@ def test_grazing_angles_and_huge_exponents_give_finite_values(n):
             for _ in range(300):
                 s = m.scattering(view_ray(wo), hit)
                 if s is not None:
-                    values = [*s.attenuation.tolist(), s.pdf, *s.ray.direction.tolist()]
+                    values = [*s.attenuation.tolist(), s.pdf, *s.scattered_ray.direction.tolist()]
                     assert all(math.isfinite(x) for x in values)
                     assert min(s.attenuation.tolist()) >= 0.0 and s.pdf > 0.0
     wo = direction(NORMAL, 89.99, 10.0)

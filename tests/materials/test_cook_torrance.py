@@ -405,7 +405,7 @@ def test_scattering_weight_is_brdf_cos_over_pdf(dist, kd, ks, a, theta_o):
             if s is None:
                 absorbed += 1
                 continue
-            wi = s.ray.direction.tolist()
+            wi = s.scattered_ray.direction.tolist()
             cos_i = dot3(NORMAL, wi)
             assert cos_i > 0.0
             assert math.sqrt(dot3(wi, wi)) == pytest.approx(1.0, abs=1e-12)

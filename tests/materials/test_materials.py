@@ -103,7 +103,7 @@ def test_lambertian_scattering_weight_pdf_and_hemisphere(normal):
             s = m.scattering(view, hit)
             assert s is not None
             assert s.is_specular is False
-            d = s.ray.direction.tolist()
+            d = s.scattered_ray.direction.tolist()
             assert math.isclose(norm3(d), 1.0, abs_tol=1e-12)
             cos = dot3(d, normal)
             assert cos >= -1e-15
@@ -111,12 +111,12 @@ def test_lambertian_scattering_weight_pdf_and_hemisphere(normal):
             assert s.pdf == pytest.approx(cos / math.pi, rel=1e-9, abs=1e-15)
             # The Monte Carlo weight is consistent with BRDF and pdf.
             if cos > 1e-6:
-                f = m.BRDF(view, s.ray, hit)
+                f = m.BRDF(view, s.scattered_ray, hit)
                 w = [fi * cos / s.pdf for fi in f.tolist()]
                 assert w == pytest.approx(s.attenuation.tolist(), abs=1e-12)
-                assert m.pdf(view, s.ray, hit) == pytest.approx(s.pdf, rel=1e-12)
+                assert m.pdf(view, s.scattered_ray, hit) == pytest.approx(s.pdf, rel=1e-12)
             # The ray starts on the side of the surface it leaves to.
-            off = [s.ray.origin.tolist()[i] - hit.point.tolist()[i] for i in range(3)]
+            off = [s.scattered_ray.origin.tolist()[i] - hit.point.tolist()[i] for i in range(3)]
             assert dot3(off, normal) >= 0.0
             cos_sum += cos
     # Cosine-weighted: E[cos] = 2/3, var = 1/2 - 4/9.
@@ -159,8 +159,8 @@ def test_mirror_reflects_exactly(d, n, r):
     s = m.scattering(incoming(d, hit), hit)
     assert s.is_specular is True
     assert s.attenuation.tolist() == ALBEDO.tolist()
-    assert s.ray.direction.tolist() == pytest.approx(list(unit3(r)), abs=1e-15)
-    off = [s.ray.origin.tolist()[i] - hit.point.tolist()[i] for i in range(3)]
+    assert s.scattered_ray.direction.tolist() == pytest.approx(list(unit3(r)), abs=1e-15)
+    off = [s.scattered_ray.origin.tolist()[i] - hit.point.tolist()[i] for i in range(3)]
     assert dot3(off, n) > 0.0
     rays = m.specular_rays(incoming(d, hit), hit)
     assert len(rays) == 1
@@ -181,8 +181,8 @@ def test_metal_with_zero_fuzz_is_a_mirror():
         for d in ((1, -1, 0), (0.3, -0.2, 0.9), (0, -1, 0)):
             a = metal.scattering(incoming(d, hit), hit)
             b = mirror.scattering(incoming(d, hit), hit)
-            assert a.ray.direction.tolist() == b.ray.direction.tolist()
-            assert a.ray.origin.tolist() == b.ray.origin.tolist()
+            assert a.scattered_ray.direction.tolist() == b.scattered_ray.direction.tolist()
+            assert a.scattered_ray.origin.tolist() == b.scattered_ray.origin.tolist()
             assert a.attenuation.tolist() == ALBEDO.tolist()
             assert a.is_specular is True
 
@@ -201,7 +201,7 @@ def test_metal_fuzz_stays_near_the_reflection_and_above_the_surface(fuzz):
             s = m.scattering(incoming(d, hit), hit)
             if s is None:
                 continue
-            out = s.ray.direction.tolist()
+            out = s.scattered_ray.direction.tolist()
             assert math.isclose(norm3(out), 1.0, abs_tol=1e-12)
             assert dot3(out, n) > 0.0
             ang = math.acos(max(-1.0, min(1.0, dot3(out, perfect))))
@@ -225,7 +225,7 @@ def test_rough_metal_at_grazing_incidence_absorbs_some_rays():
             if s is None:
                 none += 1
             else:
-                assert s.ray.direction.e1 > 0.0
+                assert s.scattered_ray.direction.e1 > 0.0
     assert 0 < none < 400
 
 
@@ -261,16 +261,16 @@ def test_dielectric_normal_incidence_from_outside():
             s = m.scattering(ray, hit)
             assert s is not None and s.is_specular
             assert s.attenuation.tolist() == [1.0, 1.0, 1.0]
-            out = s.ray.direction
+            out = s.scattered_ray.direction
             assert abs(out.e0) < 1e-15 and abs(out.e1) < 1e-15
             if out.e2 > 0.0:
                 reflected += 1
                 assert abs(out.e2 - 1.0) < 1e-15
-                assert s.ray.origin.e2 > 0.0
+                assert s.scattered_ray.origin.e2 > 0.0
             else:
                 # Transmitted straight through, starting below the surface.
                 assert abs(out.e2 + 1.0) < 1e-15
-                assert s.ray.origin.e2 < 0.0
+                assert s.scattered_ray.origin.e2 < 0.0
     sigma = math.sqrt(trials * R * (1 - R))
     assert abs(reflected - trials * R) < 4 * sigma
 
@@ -316,7 +316,9 @@ def test_total_internal_reflection_from_inside():
         with use_generator(make_generator(5)):
             for _ in range(200):
                 s = m.scattering(ray, hit)
-                assert s.ray.direction.tolist() == pytest.approx([d[0], -d[1], 0.0], abs=1e-14)
+                assert s.scattered_ray.direction.tolist() == pytest.approx(
+                    [d[0], -d[1], 0.0], abs=1e-14
+                )
                 assert s.attenuation.tolist() == ALBEDO.tolist()
         rays = m.specular_rays(ray, hit)
         assert len(rays) == 1

@@ -182,7 +182,9 @@ def test_sigma_zero_is_exactly_lambertian():
     for s, t in zip(ours, theirs, strict=True):
         assert s.attenuation == t.attenuation
         assert s.pdf == t.pdf
-        assert s.ray.direction.tolist() == pytest.approx(t.ray.direction.tolist(), abs=1e-12)
+        assert s.scattered_ray.direction.tolist() == pytest.approx(
+            t.scattered_ray.direction.tolist(), abs=1e-12
+        )
 
 
 # --- sampling -------------------------------------------------------------------------
@@ -199,7 +201,7 @@ def test_scattering_weight_is_brdf_cos_over_pdf(sigma, theta_o):
         for _ in range(n):
             s = m.scattering(view_ray(wo), hit)
             assert s is not None and s.is_specular is False
-            wi = s.ray.direction.tolist()
+            wi = s.scattered_ray.direction.tolist()
             assert math.isclose(math.sqrt(dot3(wi, wi)), 1.0, abs_tol=1e-12)
             cos_i = dot3(wi, NORMAL)
             assert cos_i > 0.0
@@ -207,7 +209,10 @@ def test_scattering_weight_is_brdf_cos_over_pdf(sigma, theta_o):
             f = expected_brdf(sigma, wo, wi)
             weight = [x * cos_i / (cos_i / math.pi) for x in f]
             assert s.attenuation.tolist() == pytest.approx(weight, rel=1e-8, abs=1e-12)
-            assert dot3([s.ray.origin.tolist()[i] - POINT[i] for i in range(3)], NORMAL) >= 0.0
+            assert (
+                dot3([s.scattered_ray.origin.tolist()[i] - POINT[i] for i in range(3)], NORMAL)
+                >= 0.0
+            )
             cos_sum += cos_i
     # Cosine-weighted: E[cos] = 2/3, variance 1/2 - 4/9.
     assert abs(cos_sum / n - 2 / 3) < 5 * math.sqrt((0.5 - 4 / 9) / n)

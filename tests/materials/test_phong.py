@@ -241,7 +241,7 @@ def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, n, theta_o):
             if s is None:
                 continue
             scattered += 1
-            wi = s.ray.direction.tolist()
+            wi = s.scattered_ray.direction.tolist()
             assert math.isclose(math.sqrt(dot3(wi, wi)), 1.0, abs_tol=1e-12)
             cos_i = dot3(wi, NORMAL)
             assert cos_i > 0.0
@@ -251,7 +251,10 @@ def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, n, theta_o):
             f = expected_brdf(kd, ks, n, wo, wi)
             weight = [x * cos_i / pdf for x in f]
             assert s.attenuation.tolist() == approx3(weight, rel=1e-7)
-            assert dot3([s.ray.origin.tolist()[i] - POINT[i] for i in range(3)], NORMAL) >= 0.0
+            assert (
+                dot3([s.scattered_ray.origin.tolist()[i] - POINT[i] for i in range(3)], NORMAL)
+                >= 0.0
+            )
     assert scattered > 500
 
 
@@ -340,7 +343,7 @@ def test_grazing_angles_and_huge_exponents_give_finite_values(n):
             for _ in range(300):
                 s = m.scattering(view_ray(wo), hit)
                 if s is not None:
-                    values = [*s.attenuation.tolist(), s.pdf, *s.ray.direction.tolist()]
+                    values = [*s.attenuation.tolist(), s.pdf, *s.scattered_ray.direction.tolist()]
                     assert all(math.isfinite(x) for x in values)
                     assert min(s.attenuation.tolist()) >= 0.0 and s.pdf > 0.0
     # At the mirror direction the huge lobe is large but finite.

@@ -350,7 +350,7 @@ def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, ax, ay, theta_o):
             s = m.scattering(view_ray(wo), hit)
             if s is None:
                 continue
-            wi = s.ray.direction.tolist()
+            wi = s.scattered_ray.direction.tolist()
             cos_i = dot3(NORMAL, wi)
             assert cos_i > 0.0
             expected_pdf = ref_pdf(kd, ks, ax, ay, wo, wi)

@@ -238,7 +238,7 @@ def test_clustered_quads_give_the_brute_force_answer():
 def test_hit_batch_matches_hit_info_uv_and_tangent():
     rng = np.random.default_rng(3)
     scene = random_scene(rng, 20, 10, 10)
-    scene.add(Sphere(Vec3(0, 0, 0), 1.0, MAT))  # rays from inside hit the back face
+    scene.add_object(Sphere(Vec3(0, 0, 0), 1.0, MAT))  # rays from inside hit the back face
     geo = Geometry(scene.objects)
     o, d = random_rays(rng, 1000)
     o[:100] = rng.uniform(-0.3, 0.3, (100, 3))
@@ -274,7 +274,7 @@ class ScalarOnlySphere(Sphere):
 def test_unknown_shapes_use_their_scalar_methods():
     rng = np.random.default_rng(5)
     scene = random_scene(rng, 4, 2, 2)
-    scene.add(ScalarOnlySphere(Vec3(0, 0, 0), 1.5, MAT))
+    scene.add_object(ScalarOnlySphere(Vec3(0, 0, 0), 1.5, MAT))
     geo = Geometry(scene.objects)
     assert geo.sets[3] is not None
     o, d = random_rays(rng, 200)

@@ -49,13 +49,15 @@ def scalar_radiance(scene, settings, o, d):
     out = np.empty((len(o), 3))
     with use_generator(make_generator(1)):
         for k in range(len(o)):
-            c = integrator.radiance(Ray(Vec3(*o[k]), Vec3(*d[k])), scene)
+            c = integrator.compute_scattering(Ray(Vec3(*o[k]), Vec3(*d[k])), scene)
             out[k] = (c.e0, c.e1, c.e2)
     return out
 
 
 def batched_radiance(scene, settings, o, d, seed=0):
-    return make_integrator(settings).radiance(Tracer(scene), o, d, np.random.default_rng(seed))
+    return make_integrator(settings).compute_scattering(
+        Tracer(scene), o, d, np.random.default_rng(seed)
+    )
 
 
 def test_power_heuristic_matches_scalar():
@@ -241,7 +243,7 @@ def test_nee_only_matches_scalar_and_the_exact_irradiance():
         L = batched_radiance(scene, settings, np.tile(o[k], (n_np, 1)), np.tile(d[k], (n_np, 1)))
         with use_generator(make_generator(k)):
             ray = Ray(Vec3(*o[k]), Vec3(*d[k]))
-            S = np.array([integrator.radiance(ray, scene).e0 for _ in range(n_sc)])
+            S = np.array([integrator.compute_scattering(ray, scene).e0 for _ in range(n_sc)])
         m_np, se_np = L[:, 0].mean(), L[:, 0].std(ddof=1) / math.sqrt(n_np)
         m_sc, se_sc = S.mean(), S.std(ddof=1) / math.sqrt(n_sc)
         want = expected[k]

@@ -511,7 +511,7 @@ def test_mirror_and_sharp_metal_reflect_exactly_as_scalar():
     s = MaterialTable(materials).sample(ids, hits, rng)
     expected = scalar_scatter(materials, ids, hits)
     assert s.alive.all() and s.specular.all() and not s.pdf.any()
-    np.testing.assert_array_equal(s.direction, [tuple(e.ray.direction) for e in expected])
+    np.testing.assert_array_equal(s.direction, [tuple(e.scattered_ray.direction) for e in expected])
     np.testing.assert_array_equal(s.weight, [tuple(e.attenuation) for e in expected])
 
 
@@ -562,7 +562,7 @@ def test_dielectric_reflects_with_probability_schlick():
         b = table.sample(np.zeros(20_000, int), one, rng)
         back_b = b.direction[:, 2] > 0.0
         scalar = scalar_scatter([glass], np.zeros(4000, int), one.take(np.arange(4000)), seed=3)
-        back_s = np.array([e.ray.direction.e2 > 0.0 for e in scalar])
+        back_s = np.array([e.scattered_ray.direction.e2 > 0.0 for e in scalar])
         assert abs(z_two_samples(back_b.astype(float), back_s.astype(float))) < Z_MAX
 
 
@@ -578,7 +578,7 @@ def test_fuzzy_metal_agrees_with_scalar(fuzz, theta):
     assert (b.direction[b.alive, 2] > 0.0).all() and b.specular[b.alive].all()
     np.testing.assert_allclose(np.linalg.norm(b.direction[b.alive], axis=1), 1.0, rtol=1e-12)
     assert not b.weight[~b.alive].any()
-    d_s = np.array([tuple(e.ray.direction) for e in scalar if e is not None])
+    d_s = np.array([tuple(e.scattered_ray.direction) for e in scalar if e is not None])
     for c in range(3):
         assert abs(z_two_samples(b.direction[b.alive, c], d_s[:, c])) < Z_MAX
 
@@ -655,7 +655,7 @@ def test_fallback_gives_exactly_the_scalar_results():
     for row, e in zip(rows, expected, strict=True):
         assert s1.alive[row] == (e is not None)
         if e is not None:
-            np.testing.assert_array_equal(s1.direction[row], tuple(e.ray.direction))
+            np.testing.assert_array_equal(s1.direction[row], tuple(e.scattered_ray.direction))
             np.testing.assert_array_equal(s1.weight[row], tuple(e.attenuation))
             assert s1.pdf[row] == e.pdf and s1.specular[row] == e.is_specular
     assert 0.1 < 1 - s1.alive[ids == 0].mean() < 0.4

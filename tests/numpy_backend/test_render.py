@@ -83,7 +83,7 @@ class InterruptAfter(Sphere):
 def test_ctrl_c_keeps_finished_tiles():
     scene, camera = small_scene()
     camera = camera.with_width(64)  # 64 x 36: tiles of 32 x 32, 32 x 32, 32 x 4, 32 x 4
-    scene.add(InterruptAfter(calls=32 * 32 * 2 + 100))  # during the second tile
+    scene.add_object(InterruptAfter(calls=32 * 32 * 2 + 100))  # during the second tile
     image = rtpy.render(scene, camera=camera, spp=2, seed=1, integrator="jittered", backend="numpy")
     assert image.interrupted
     assert image.samples_min == 0 and image.samples_max == 2

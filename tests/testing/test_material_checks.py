@@ -108,7 +108,7 @@ class HalfSampler(Lambertian):
 
     def scattering(self, ray_in, hit):
         s = super().scattering(ray_in, hit)
-        return s if s.ray.direction.e0 > 0.0 else None
+        return s if s.scattered_ray.direction.e0 > 0.0 else None
 
     def pdf(self, ray_view, ray_light, hit):
         return super().pdf(ray_view, ray_light, hit) if ray_light.direction.e0 > 0.0 else 0.0
@@ -119,7 +119,7 @@ class ForgetsPdf(Lambertian):
 
     def scattering(self, ray_in, hit):
         s = super().scattering(ray_in, hit)
-        s.attenuation = s.attenuation * s.ray.direction.e2
+        s.attenuation = s.attenuation * s.scattered_ray.direction.e2
         return s
 
 

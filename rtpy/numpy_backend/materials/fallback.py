@@ -75,7 +75,7 @@ class ScalarFallback(Kernel):
                 s = material.scattering(ray_in, hit)
                 if s is None:
                     continue
-                out.direction[i] = tuple(s.ray.direction)
+                out.direction[i] = tuple(s.scattered_ray.direction)
                 out.weight[i] = tuple(s.attenuation)
                 out.pdf[i] = s.pdf
                 out.alive[i] = True
