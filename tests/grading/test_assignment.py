@@ -123,7 +123,7 @@ def check_regions(repo: Path, week: str) -> None:
 def test_student_repository(tmp_path, week):
     repo = make_assignment(week, tmp_path / f"week{week}")
     check_regions(repo, week)
-    assert not (repo / "rtpy" / "numpy_backend" / "geometry.py").exists()
+    assert not (repo / "rtpy" / "numpy_backend" / "scene.py").exists()
     with open(repo / "pyproject.toml", "rb") as f:  # pip install needs every listed package
         setup = tomllib.load(f)["tool"]["setuptools"]
     for package in setup["packages"]:

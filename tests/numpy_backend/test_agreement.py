@@ -33,7 +33,7 @@ import pytest
 
 import rtpy
 from rtpy.io.bundled import bundled_scenes
-from rtpy.numpy_backend.integrators import Tracer
+from rtpy.numpy_backend.integrators import direct_lighting
 
 ALPHA = 1e-3
 BLOCK = 8
@@ -139,7 +139,7 @@ def test_a_biased_kernel_is_flagged(monkeypatch):
     lights are also sampled) brightens every lit block: the comparison flags it."""
     name, integrator, spp = "cornell", "path", SPP["path"]
     scalar = renders(name, integrator, "scalar", spp)
-    monkeypatch.setattr(Tracer, "emission_weight", lambda self, obj, *args: np.ones(len(obj)))
+    monkeypatch.setattr(direct_lighting, "emission_weight", lambda _, obj, *a: np.ones(len(obj)))
     biased = [
         rtpy.render(
             rtpy.load_scene(name),
