@@ -43,13 +43,17 @@ def sample_one_light(
     part = hits if whole else hits.take(idx)
     ids = ids if whole else ids.take(idx)
     wi = s.direction if whole else rows(s.direction, idx)
-    f = scene.materials.BRDF(ids, part, wi)
-    lit = max3(f) > 0.0
-    if not lit.all():
-        k = np.flatnonzero(lit)
-        idx, ids, wi, f, part = idx.take(k), ids.take(k), rows(wi, k), rows(f, k), part.take(k)
-    if idx.size == 0:
+    # f_r, and for the MIS weight the density with which BRDF sampling picks wi
+    if mis:
+        f, brdf_pdf = scene.materials.BRDF_and_pdf(ids, part, wi)
+    else:
+        f, brdf_pdf = scene.materials.BRDF(ids, part, wi), None
+    keep = np.flatnonzero(max3(f) > 0.0)
+    if keep.size == 0:
         return out
+    if keep.size < idx.size:
+        idx, wi, f, part = idx.take(keep), rows(wi, keep), rows(f, keep), part.take(keep)
+        brdf_pdf = None if brdf_pdf is None else brdf_pdf.take(keep)
     origin = spawn_origins(part.point, part.normal, wi)
     # Stop the shadow ray just short of the light's surface, and let the light
     # itself not block it: the spawned origin is off the point the light was
@@ -59,17 +63,14 @@ def sample_one_light(
     t_max = s.distance.take(idx) - offset_scale(rows(s.point, idx)) - offset_scale(part.point)
     blocked = scene.find_occlusion(origin, wi, t_max, ignore=s.obj.take(idx))
     if blocked.any():
-        k = np.flatnonzero(~blocked)
-        idx, ids, wi, f, part = idx.take(k), ids.take(k), rows(wi, k), rows(f, k), part.take(k)
+        keep = np.flatnonzero(~blocked)
+        idx, f = idx.take(keep), rows(f, keep)
+        brdf_pdf = None if brdf_pdf is None else brdf_pdf.take(keep)
     pdf = s.pdf.take(idx) / n_lights  # choosing this light, then this direction
-    weight = np.ones(idx.size)
     if mis:
-        area = np.flatnonzero(~s.is_delta.take(idx))
-        if area.size == idx.size:
-            weight = power_heuristic(pdf, scene.materials.pdf(ids, part, wi))
-        elif area.size:
-            brdf_pdf = scene.materials.pdf(ids.take(area), part.take(area), rows(wi, area))
-            weight[area] = power_heuristic(pdf.take(area), brdf_pdf)
+        weight = np.where(s.is_delta.take(idx), 1.0, power_heuristic(pdf, brdf_pdf))
+    else:
+        weight = np.ones(idx.size)
     contrib = scale(f * rows(s.radiance, idx), cos_i.take(idx) * weight / pdf)
     put_rows(out, idx, contrib)
     return out

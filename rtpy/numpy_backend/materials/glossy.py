@@ -105,26 +105,31 @@ class GlossyKernel(AlbedoKernel):
         pdf[mixed] = pdf[mixed] + (1.0 - p_diffuse[mixed]) * p_specular
         return np.minimum(pdf, MAX_PDF, out=pdf)
 
-    def _above(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray):
-        """(rows, their slots, wo, wi, albedo) of the hits where both directions lie
-        above the surface (reflection only): what BRDF() and pdf() evaluate."""
+    def _evaluate(self, slots, hits: HitBatch, wi: np.ndarray, want_f: bool, want_pdf: bool):
+        """(f_r or None, pdf or None): BRDF() and pdf() in the shading frame, non-zero
+        only where both directions lie above the surface (reflection only)."""
         frame = ONB.from_normal_tangent(hits.normal, hits.tangent)
         wo_l, wi_l = frame.to_local(hits.wo), frame.to_local(wi)
         up = select((wo_l[2] > 0.0) & (wi_l[2] > 0.0))
-        s = slots[up]
-        return up, s, take(wo_l, up), take(wi_l, up), self.albedo(s, hits, up)
+        s, wo_l, wi_l = slots[up], take(wo_l, up), take(wi_l, up)
+        albedo = self.albedo(s, hits, up)
+        f = pdf = None
+        if want_f:
+            f = np.zeros((len(slots), 3))
+            f[up] = self._f(s, albedo, wo_l, wi_l)
+        if want_pdf:
+            pdf = np.zeros(len(slots))
+            pdf[up] = self._pdf(s, self.diffuse_probability(s, albedo), wo_l, wi_l)
+        return f, pdf
 
     def BRDF(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
-        f = np.zeros((len(slots), 3))
-        up, s, wo_l, wi_l, albedo = self._above(slots, hits, wi)
-        f[up] = self._f(s, albedo, wo_l, wi_l)
-        return f
+        return self._evaluate(slots, hits, wi, True, False)[0]
 
     def pdf(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
-        pdf = np.zeros(len(slots))
-        up, s, wo_l, wi_l, albedo = self._above(slots, hits, wi)
-        pdf[up] = self._pdf(s, self.diffuse_probability(s, albedo), wo_l, wi_l)
-        return pdf
+        return self._evaluate(slots, hits, wi, False, True)[1]
+
+    def BRDF_and_pdf(self, slots, hits, wi):
+        return self._evaluate(slots, hits, wi, True, True)
 
     def scattering(
         self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator

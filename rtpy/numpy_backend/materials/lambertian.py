@@ -33,15 +33,27 @@ class LambertianKernel(AlbedoKernel):
         return ScatterBatch(direction, self.albedo(slots, hits), z * INV_PI, alive, ~alive)
 
     def BRDF(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
-        up = select(dot(components(hits.normal), components(wi)) > 0.0)
+        return self._brdf(slots, hits, self._cos(hits, wi))
+
+    def pdf(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
+        return np.maximum(0.0, self._cos(hits, wi)) * INV_PI
+
+    def BRDF_and_pdf(self, slots, hits, wi):
+        cos = self._cos(hits, wi)
+        return self._brdf(slots, hits, cos), np.maximum(0.0, cos) * INV_PI
+
+    @staticmethod
+    def _cos(hits: HitBatch, wi: np.ndarray) -> np.ndarray:
+        return dot(components(hits.normal), components(wi))
+
+    def _brdf(self, slots: np.ndarray, hits: HitBatch, cos: np.ndarray) -> np.ndarray:
+        """albedo / pi where the light is above the surface (cos > 0), else 0."""
+        up = select(cos > 0.0)
         if isinstance(up, slice):
             return self.albedo(slots, hits) * INV_PI
         f = np.zeros((len(slots), 3))
         put_rows(f, up, self.albedo(slots.take(up), hits, up) * INV_PI)
         return f
-
-    def pdf(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
-        return np.maximum(0.0, dot(components(hits.normal), components(wi))) * INV_PI
 
 
 class GlowingLambertianKernel(LambertianKernel):

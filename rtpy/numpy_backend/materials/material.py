@@ -10,6 +10,7 @@ hits at once:
     emitting(slots, hits)          -> (N, 3)   Material.emitting
     BRDF(slots, hits, wi)          -> (N, 3)   Material.BRDF, wi (N, 3) toward the light
     pdf(slots, hits, wi)           -> (N,)     Material.pdf
+    BRDF_and_pdf(slots, hits, wi)  -> both, sharing the work (for light sampling)
     scattering(slots, hits, rng)   -> ScatterBatch   Material.scattering
     specular_rays(slots, hits)     -> SpecularRays   Material.specular_rays
 
@@ -59,6 +60,13 @@ class Kernel:
 
     def pdf(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
         return np.zeros(len(slots))
+
+    def BRDF_and_pdf(
+        self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(BRDF(), pdf()) at once, what light sampling asks for; kernels whose two
+        share work (a shading frame, a cosine) override it."""
+        return self.BRDF(slots, hits, wi), self.pdf(slots, hits, wi)
 
     def scattering(
         self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator

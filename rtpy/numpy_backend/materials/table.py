@@ -156,6 +156,18 @@ class MaterialTable:
             pdf[rows] = kernel.pdf(slots, part, wi.take(rows, axis=0))
         return pdf
 
+    def BRDF_and_pdf(
+        self, ids: np.ndarray, hits: HitBatch, wi: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(BRDF(), pdf()) at once, as light sampling needs them."""
+        f, pdf = np.zeros((len(hits), 3)), np.zeros(len(hits))
+        for kernel, rows, slots, part in self._groups(ids, hits, "has_brdf"):
+            if isinstance(rows, slice):
+                return kernel.BRDF_and_pdf(slots, part, wi)  # one kernel has all the hits
+            fk, pdf[rows] = kernel.BRDF_and_pdf(slots, part, wi.take(rows, axis=0))
+            put_rows(f, rows, fk)
+        return f, pdf
+
     def scattering(self, ids: np.ndarray, hits: HitBatch, rng: np.random.Generator) -> ScatterBatch:
         """One Material.scattering sample per hit, drawn from `rng`."""
         out = ScatterBatch.absorbed(len(hits))

@@ -187,10 +187,14 @@ def assert_agrees(actual, expected, what: str, rel: float = REL, scale=None) -> 
 
 
 def check_brdf_and_pdf(table: MaterialTable, ids, hits: HitBatch, wi: np.ndarray) -> None:
+    """BRDF() and pdf() equal the scalar methods, and BRDF_and_pdf() equals them both."""
     f, pdf = table.BRDF(ids, hits, wi), table.pdf(ids, hits, wi)
     f_s, pdf_s = scalar_brdf_and_pdf(table.materials, ids, hits, wi)
     assert_agrees(f, f_s, "BRDF")
     assert_agrees(pdf, pdf_s, "pdf")
+    both = table.BRDF_and_pdf(ids, hits, wi)
+    np.testing.assert_array_equal(both[0], f)
+    np.testing.assert_array_equal(both[1], pdf)
 
 
 # --- random materials ------------------------------------------------------------------------

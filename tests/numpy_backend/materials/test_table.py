@@ -184,7 +184,7 @@ def cover_like(n: int) -> list[Material]:
     return out
 
 
-METHODS = ("flat_color", "emitting", "BRDF", "pdf", "scattering", "specular_rays")
+METHODS = ("flat_color", "emitting", "BRDF", "pdf", "BRDF_and_pdf", "scattering", "specular_rays")
 
 
 def run_all(table: MaterialTable, ids, hits, wi) -> None:
@@ -192,6 +192,7 @@ def run_all(table: MaterialTable, ids, hits, wi) -> None:
     table.emitting(ids, hits)
     table.BRDF(ids, hits, wi)
     table.pdf(ids, hits, wi)
+    table.BRDF_and_pdf(ids, hits, wi)
     table.scattering(ids, hits, np.random.default_rng(0))
     table.specular_rays(ids, hits)
 
@@ -215,13 +216,13 @@ def test_kernel_calls_are_bounded_by_the_material_classes():
     run_all(table, ids, hits, random_wi(rng, hits))
     # one call per class present that has something to compute
     expected = {"flat_color": 5, "emitting": 0, "BRDF": 3, "pdf": 3, "scattering": 5}
-    assert calls == {**expected, "specular_rays": 2}
+    assert calls == {**expected, "BRDF_and_pdf": 3, "specular_rays": 2}
 
     calls.update(dict.fromkeys(METHODS, 0))
     lambertian = np.flatnonzero([type(m) is Lambertian for m in table.materials])
     run_all(table, rng.choice(lambertian, 5000), hits, random_wi(rng, hits))
     expected = {"flat_color": 1, "emitting": 0, "BRDF": 1, "pdf": 1, "scattering": 1}
-    assert calls == {**expected, "specular_rays": 0}
+    assert calls == {**expected, "BRDF_and_pdf": 1, "specular_rays": 0}
 
 
 def count_calls(fn) -> int:
