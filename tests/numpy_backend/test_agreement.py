@@ -122,10 +122,6 @@ def test_center_images_agree(name):
     assert close.mean() > 0.99, f"{(~close).sum()} pixels differ"
 
 
-# Every scene and integrator agrees. (Until commit 2f1fa6e the scalar backend let a
-# light block its own shadow ray, so material_gallery's direct light was 9 % too dark
-# near its quad light and these comparisons were marked xfail; neither backend now
-# lets a light block its own shadow ray.)
 CASES = [(name, integrator) for name in SCENES for integrator in SPP]
 
 

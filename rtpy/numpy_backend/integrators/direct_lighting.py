@@ -8,6 +8,8 @@ counted once. Point lights can only be reached by light sampling (weight 1).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..arrays import add_rows, dot, max3, put_rows, rows, scale
@@ -76,34 +78,48 @@ def sample_one_light(
     return out
 
 
+@dataclass
+class Bounce:
+    """Where the rays that reached a batch of hits came from, as the scalar path loop's
+    prev_point, prev_pdf and prev_specular: the vertex each ray left (None for camera
+    rays), the solid-angle pdf its direction was drawn with, and whether that bounce
+    was specular."""
+
+    point: np.ndarray | None
+    pdf: np.ndarray
+    specular: np.ndarray
+
+    @classmethod
+    def camera(cls, n: int) -> Bounce:
+        """n camera rays: no vertex, counted as specular (no light sampling there)."""
+        return cls(None, np.zeros(n), np.ones(n, dtype=bool))
+
+    def take(self, k: np.ndarray) -> Bounce:
+        point = None if self.point is None else rows(self.point, k)
+        return Bounce(point, self.pdf.take(k), self.specular.take(k))
+
+
 def emission_weight(
-    scene: BatchScene,
-    obj: np.ndarray,
-    hits: HitBatch,
-    prev_point: np.ndarray | None,
-    prev_pdf: np.ndarray,
-    prev_specular: np.ndarray,
-    n_mis: int,
-    mis: bool = True,
+    scene: BatchScene, obj: np.ndarray, hits: HitBatch, prev: Bounce, n_mis: int, mis: bool = True
 ) -> np.ndarray:
     """MIS weight (N,) of emission found by BRDF sampling at the hits on objects obj,
-    reached from prev_point with solid-angle pdf prev_pdf: 1 after the camera
-    (prev_point None), after a specular bounce, or when lights are not sampled
-    (n_mis = 0); 0 after other bounces if not mis (light sampling alone counts it)."""
+    reached from `prev`: 1 after the camera, after a specular bounce, or when lights
+    are not sampled (n_mis = 0); 0 after other bounces if not mis (light sampling
+    alone counts it)."""
     w = np.ones(len(obj))
-    if n_mis == 0 or prev_point is None:
+    if n_mis == 0 or prev.point is None:
         return w
     if not mis:
-        return prev_specular.astype(np.float64)
-    m = np.flatnonzero(~prev_specular)
+        return prev.specular.astype(np.float64)
+    m = np.flatnonzero(~prev.specular)
     if m.size == len(obj):
-        light_pdf = scene.lights.direction_pdf(obj, prev_point, hits.point, hits.normal)
-        return power_heuristic(prev_pdf, light_pdf / n_mis)
+        light_pdf = scene.lights.direction_pdf(obj, prev.point, hits.point, hits.normal)
+        return power_heuristic(prev.pdf, light_pdf / n_mis)
     if m.size:
         light_pdf = scene.lights.direction_pdf(
-            obj.take(m), rows(prev_point, m), rows(hits.point, m), rows(hits.normal, m)
+            obj.take(m), rows(prev.point, m), rows(hits.point, m), rows(hits.normal, m)
         )
-        w[m] = power_heuristic(prev_pdf.take(m), light_pdf / n_mis)
+        w[m] = power_heuristic(prev.pdf.take(m), light_pdf / n_mis)
     return w
 
 
@@ -113,38 +129,27 @@ def add_emission(
     paths: np.ndarray,
     beta: np.ndarray,
     obj: np.ndarray,
-    ids: np.ndarray,
     hits: HitBatch,
-    prev_point: np.ndarray | None,
-    prev_pdf: np.ndarray,
-    prev_specular: np.ndarray,
+    prev: Bounce,
     n_mis: int,
     mis: bool,
 ) -> None:
-    """result[paths] += beta * emitted * emission_weight at the hits on emitters (the
-    hits of paths `paths` on objects obj of material ids `ids`)."""
+    """result[paths] += beta * emitted * emission_weight at the hits of paths `paths`
+    on emitting objects (obj: the object each hit is on)."""
     materials = scene.materials
+    ids = scene.material_id.take(obj)
     em = materials.is_emitter.take(ids)
     if not em.any():
         return
     e = np.flatnonzero(em)
     if e.size == len(ids):
         emitted = materials.emitting(ids, hits)
-        w = emission_weight(scene, obj, hits, prev_point, prev_pdf, prev_specular, n_mis, mis)
+        w = emission_weight(scene, obj, hits, prev, n_mis, mis)
         add_rows(result, paths, scale(beta * emitted, w))
         return
     part = hits.take(e)
     emitted = materials.emitting(ids.take(e), part)
-    w = emission_weight(
-        scene,
-        obj.take(e),
-        part,
-        None if prev_point is None else rows(prev_point, e),
-        prev_pdf.take(e),
-        prev_specular.take(e),
-        n_mis,
-        mis,
-    )
+    w = emission_weight(scene, obj.take(e), part, prev.take(e), n_mis, mis)
     add_rows(result, paths.take(e), scale(rows(beta, e) * emitted, w))
 
 
@@ -172,18 +177,6 @@ def direct_lighting(
         nids = scene.material_id[obj[h]]
         if scene.materials.is_emitter[nids].any():
             nh = scene.hit_batch(obj[h], o[h], d[h], t[h])
-            add_emission(
-                scene,
-                result,
-                a[h],
-                att[h],
-                obj[h],
-                nids,
-                nh,
-                hits.point[a[h]],
-                sc.pdf[a[h]],
-                sc.is_specular[a[h]],
-                n_lights,
-                True,
-            )
+            prev = Bounce(hits.point[a[h]], sc.pdf[a[h]], sc.is_specular[a[h]])
+            add_emission(scene, result, a[h], att[h], obj[h], nh, prev, n_lights, True)
     return result

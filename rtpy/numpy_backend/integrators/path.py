@@ -6,7 +6,7 @@ import numpy as np
 
 from ..arrays import add_rows, divide, max3, rows
 from ..ray import spawn_origins
-from .direct_lighting import add_emission, sample_one_light
+from .direct_lighting import Bounce, add_emission, sample_one_light
 from .integrator import BatchIntegrator
 
 
@@ -41,9 +41,7 @@ class PathIntegrator(BatchIntegrator):
         materials = scene.materials
         paths = np.arange(n)  # the camera ray each live path belongs to
         beta = np.ones((n, 3))
-        prev_point = None  # the camera "bounce"
-        prev_pdf = np.zeros(n)
-        prev_specular = np.ones(n, dtype=bool)
+        prev = Bounce.camera(n)
         segment = 1
         while paths.size:
             obj, t = scene.find_intersection(o, d)
@@ -55,30 +53,14 @@ class PathIntegrator(BatchIntegrator):
                 )
                 keep = np.flatnonzero(~miss)
                 paths, obj, t = paths.take(keep), obj.take(keep), t.take(keep)
-                o, d, beta = rows(o, keep), rows(d, keep), rows(beta, keep)
-                prev_pdf, prev_specular = prev_pdf.take(keep), prev_specular.take(keep)
-                if prev_point is not None:
-                    prev_point = rows(prev_point, keep)
+                o, d, beta, prev = rows(o, keep), rows(d, keep), rows(beta, keep), prev.take(keep)
                 if paths.size == 0:
                     break
             hits = scene.hit_batch(obj, o, d, t)
-            ids = scene.material_id.take(obj)
-            add_emission(
-                scene,
-                result,
-                paths,
-                beta,
-                obj,
-                ids,
-                hits,
-                prev_point,
-                prev_pdf,
-                prev_specular,
-                n_mis,
-                mis,
-            )
+            add_emission(scene, result, paths, beta, obj, hits, prev, n_mis, mis)
             if segment >= max_depth:
                 break
+            ids = scene.material_id.take(obj)
             inert = materials.inert.take(ids)
             if inert.any():  # paths end on lights that reflect nothing (no kernel split)
                 k = np.flatnonzero(~inert)
@@ -86,15 +68,7 @@ class PathIntegrator(BatchIntegrator):
                 if paths.size == 0:
                     break
             if n_lights:
-                ns = np.flatnonzero(~materials.is_specular.take(ids))
-                if ns.size == paths.size:
-                    direct = sample_one_light(scene, hits, ids, rng, nee, mis)
-                    direct *= beta
-                    add_rows(result, paths, direct)
-                elif ns.size:
-                    direct = sample_one_light(scene, hits.take(ns), ids.take(ns), rng, nee, mis)
-                    direct *= rows(beta, ns)
-                    add_rows(result, paths.take(ns), direct)
+                add_direct_light(result, paths, beta, scene, hits, ids, rng, nee, mis)
             sc = materials.scattering(ids, hits, rng)
             beta = beta * sc.attenuation
             bmax = max3(beta)
@@ -106,17 +80,30 @@ class PathIntegrator(BatchIntegrator):
             a = np.flatnonzero(alive)
             if a.size == paths.size:  # nothing ended: no compaction
                 point, normal, d = hits.point, hits.normal, sc.direction
-                prev_pdf, prev_specular = sc.pdf, sc.is_specular
+                prev = Bounce(point, sc.pdf, sc.is_specular)
             else:
                 paths, beta = paths.take(a), rows(beta, a)
                 point, normal = rows(hits.point, a), rows(hits.normal, a)
                 d = rows(sc.direction, a)
-                prev_pdf, prev_specular = sc.pdf.take(a), sc.is_specular.take(a)
+                prev = Bounce(point, sc.pdf.take(a), sc.is_specular.take(a))
                 if roulette:
                     survive = survive.take(a)
             if roulette:
                 beta = divide(beta, survive)
             o = spawn_origins(point, normal, d)
-            prev_point = point
             segment += 1
         return result
+
+
+def add_direct_light(result, paths, beta, scene, hits, ids, rng, nee: bool, mis: bool) -> None:
+    """result[paths] += beta * sample_one_light at the hits on non-specular materials
+    (all lights with nee, else the point lights only)."""
+    ns = np.flatnonzero(~scene.materials.is_specular.take(ids))
+    if ns.size == len(paths):
+        direct = sample_one_light(scene, hits, ids, rng, nee, mis)
+        direct *= beta
+        add_rows(result, paths, direct)
+    elif ns.size:
+        direct = sample_one_light(scene, hits.take(ns), ids.take(ns), rng, nee, mis)
+        direct *= rows(beta, ns)
+        add_rows(result, paths.take(ns), direct)

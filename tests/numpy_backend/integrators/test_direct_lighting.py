@@ -6,7 +6,11 @@ from __future__ import annotations
 import numpy as np
 
 from rtpy import Color, DiffuseLight, Lambertian, PointLight, Scene, Sphere, Vec3
-from rtpy.numpy_backend.integrators.direct_lighting import emission_weight, sample_one_light
+from rtpy.numpy_backend.integrators.direct_lighting import (
+    Bounce,
+    emission_weight,
+    sample_one_light,
+)
 from rtpy.numpy_backend.scene import BatchScene
 from rtpy.render_settings import RenderSettings
 from rtpy.testing.analytic_scenes import plane_sphere_light
@@ -65,5 +69,6 @@ def test_without_mis_light_samples_weigh_one_and_brdf_found_emission_zero():
     assert point.any()
     np.testing.assert_allclose(without[point], with_mis[point], rtol=1e-12)
     specular = np.arange(len(obj)) % 2 == 0
-    w = emission_weight(batch, obj, hits, hits.point, np.ones(len(obj)), specular, 2, mis=False)
+    prev = Bounce(hits.point, np.ones(len(obj)), specular)
+    w = emission_weight(batch, obj, hits, prev, 2, mis=False)
     np.testing.assert_array_equal(w, specular.astype(float))
