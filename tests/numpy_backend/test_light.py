@@ -18,28 +18,15 @@ from rtpy.numpy_backend.scene import BatchScene
 from rtpy.sampling import use_generator
 from rtpy.triangle import PARALLEL_TOLERANCE
 
+from .geometry_checks import V, arr
+from .test_camera import Replay
+
 coord = st.floats(-4.0, 4.0, allow_nan=False)
 vec = st.tuples(coord, coord, coord)
 # Away from 0 and 1: a sample exactly on a quad's or triangle's edge may hit or miss
 # it by rounding, differently in the two implementations.
 unit = st.floats(1e-6, 1.0 - 1e-6)
 LIGHT = DiffuseLight(Color(3.0, 2.0, 1.0))
-
-
-class Replay:
-    def __init__(self, values) -> None:
-        self.values = list(map(float, values))
-
-    def random(self) -> float:
-        return self.values.pop(0)
-
-
-def V(a) -> Vec3:
-    return Vec3(*map(float, a))
-
-
-def arr(v: Vec3) -> np.ndarray:
-    return np.array([v.e0, v.e1, v.e2])
 
 
 def shapes(center, size, a, b):

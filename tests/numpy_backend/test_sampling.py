@@ -20,6 +20,8 @@ from rtpy.numpy_backend.sampling import (
     unit_disk,
 )
 
+from .test_camera import Replay
+
 # pi to 36 digits; np.longdouble carries 64 mantissa bits on x86-64 Linux.
 PI_LONG = np.longdouble("3.14159265358979323846264338327950288")
 EXTENDED = np.finfo(np.longdouble).nmant >= 63
@@ -57,16 +59,6 @@ def test_agrees_with_numpy_and_stays_on_the_unit_circle(values):
     np.testing.assert_allclose(cos, np.cos(2 * np.pi * u), rtol=0, atol=1e-15)
     np.testing.assert_allclose(sin, np.sin(2 * np.pi * u), rtol=0, atol=1e-15)
     np.testing.assert_allclose(cos * cos + sin * sin, 1.0, rtol=0, atol=1e-15)
-
-
-class Replay:
-    """A stand-in generator whose random() returns the given numbers in order."""
-
-    def __init__(self, values) -> None:
-        self.values = list(map(float, values))
-
-    def random(self) -> float:
-        return self.values.pop(0)
 
 
 def test_directions_are_the_scalar_ones_from_the_same_numbers():
