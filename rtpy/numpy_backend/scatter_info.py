@@ -39,6 +39,24 @@ class ScatterBatch:
             np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n), np.zeros(n, bool), np.zeros(n, bool)
         )
 
+    @classmethod
+    def alive_at(
+        cls,
+        n: int,
+        rows: np.ndarray | slice,
+        direction: np.ndarray,
+        attenuation: np.ndarray,
+        pdf: np.ndarray,
+    ) -> ScatterBatch:
+        """n samples: non-specular bounces with these values at `rows`, absorbed at
+        the other rows."""
+        out = cls.absorbed(n)
+        out.direction[rows] = direction
+        out.attenuation[rows] = attenuation
+        out.pdf[rows] = pdf
+        out.alive[rows] = True
+        return out
+
     def __len__(self) -> int:
         return len(self.pdf)
 

@@ -134,7 +134,7 @@ class GlossyKernel(AlbedoKernel):
     def scattering(
         self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator
     ) -> ScatterBatch:
-        out = ScatterBatch.absorbed(len(slots))
+        n = len(slots)
         frame = ONB.from_normal_tangent(hits.normal, hits.tangent)
         wo = frame.to_local(hits.wo)
         rows = select(wo[2] > 0.0)  # the viewer below the surface: absorbed
@@ -162,8 +162,5 @@ class GlossyKernel(AlbedoKernel):
 
         weight = self._f(slots, albedo[keep], wo, wi) * (wi[2] / pdf)[:, None]
         rows = compose(rows, keep)
-        out.direction[rows] = stack(*frame.take(rows).to_world(*wi))
-        out.attenuation[rows] = weight
-        out.pdf[rows] = pdf
-        out.alive[rows] = True
-        return out
+        direction = stack(*frame.take(rows).to_world(*wi))
+        return ScatterBatch.alive_at(n, rows, direction, weight, pdf)

@@ -59,7 +59,6 @@ class OrenNayarKernel(AlbedoKernel):
     def scattering(
         self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator
     ) -> ScatterBatch:
-        out = ScatterBatch.absorbed(len(slots))
         frame = ONB.from_normal_tangent(hits.normal, hits.tangent)
         wo = frame.to_local(hits.wo)
         rows = select(wo[2] > 0.0)
@@ -70,8 +69,6 @@ class OrenNayarKernel(AlbedoKernel):
         rows, wi, pdf = compose(rows, live), take(wi, live), pdf[live]
         s = slots[rows]
         k = self.factor(s, take(wo, rows), wi)
-        out.direction[rows] = stack(*frame.take(rows).to_world(*wi))
-        out.attenuation[rows] = self.albedo(s, hits, rows) * k[:, None]
-        out.pdf[rows] = pdf
-        out.alive[rows] = True
-        return out
+        direction = stack(*frame.take(rows).to_world(*wi))
+        attenuation = self.albedo(s, hits, rows) * k[:, None]
+        return ScatterBatch.alive_at(len(slots), rows, direction, attenuation, pdf)
