@@ -29,7 +29,7 @@ from .materials import (
 from .quad import Quad
 from .ray import Ray
 from .render_settings import RenderSettings
-from .renderer import Renderer
+from .renderer import BACKENDS, Renderer
 from .scatter_info import ScatterInfo
 from .scene import Scene
 from .sphere import Sphere
@@ -38,8 +38,6 @@ from .triangle import Triangle
 from .vec3 import Color, Point3, Vec3
 
 __version__ = "0.1.0"
-
-BACKENDS = ("scalar", "numpy")
 
 
 def load_scene(path_or_name: str):
@@ -87,10 +85,10 @@ def render(
             scene.background = background
         if sky is not None:
             scene.sky = sky
-    renderer_class = Renderer
-    if backend == "numpy":
-        from .numpy_backend.render import NumpyRenderer as renderer_class
-    return renderer_class(scene, camera, render_settings, workers=workers, quiet=quiet).render()
+    renderer = Renderer(
+        scene, camera, render_settings, workers=workers, quiet=quiet, backend=backend
+    )
+    return renderer.render()
 
 
 __all__ = [

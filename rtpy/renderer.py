@@ -1,5 +1,10 @@
 """Renderer: runs an integrator over every pixel, in tiles, on one or more processes.
 
+One loop (Renderer) serves both backends: a Backend plans the units of work and
+renders one unit (ScalarBackend here, ray by ray; the numpy backend's in
+rtpy/numpy_backend/renderer.py, a whole unit as arrays), and the loop runs the
+units on worker processes, shows progress, handles Ctrl-C and assembles the image.
+
 The image is cut into square tiles and the samples of each pixel into batches.
 One unit of work is (batch, tile); units run batch by batch, so an interrupted
 render already covers the whole image with fewer samples. Every unit draws from
@@ -15,7 +20,9 @@ import multiprocessing
 import signal
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from tqdm import tqdm
@@ -113,19 +120,96 @@ class PixelSums:
         self.counts[unit.y0 : unit.y1, unit.x0 : unit.x1] += unit.spp
 
 
+# --- backends ---------------------------------------------------------------------
+BACKENDS = ("scalar", "numpy")
+
+
+class Backend:
+    """A way of rendering units of work; Renderer's one loop drives every backend.
+
+    A backend plans the units (how the image and the samples are cut) and renders one
+    unit; the loop does the rest, the same for all: worker processes, the progress
+    bar, Ctrl-C and the assembly of the image. The backend is pickled to every worker
+    process, which calls start() once and then renders units.
+
+    name  the backend's name in rtpy.BACKENDS (the progress bar and image.stats show it)
+    """
+
+    name = ""
+
+    def __init__(self, scene: Scene, camera: Camera, settings: RenderSettings) -> None:
+        self.scene = scene
+        self.camera = camera
+        self.settings = settings
+
+    def make_integrator(self):
+        """The integrator the settings name, in this backend's kind."""
+        raise NotImplementedError
+
+    def uses_center_ray(self) -> bool:
+        """The integrator traces one ray through each pixel's center (spp = 1)."""
+        return self.make_integrator().uses_center_ray
+
+    def plan_units(self, width: int, height: int, spp: int) -> list[Unit]:
+        """All units of work, batch-major, covering every pixel with spp samples."""
+        return plan_units(width, height, spp)
+
+    def start(self) -> Callable[[Unit], np.ndarray]:
+        """Prepare this process to render (called once in each process that renders)
+        and return the function that renders one unit: the sum of unit.spp radiance
+        samples per pixel of its tile, an array (tile height, tile width, 3)."""
+        raise NotImplementedError
+
+
+class ScalarBackend(Backend):
+    """The readable reference: one Ray at a time through the scalar integrators."""
+
+    name = "scalar"
+
+    def make_integrator(self):
+        return make_integrator(self.settings)
+
+    def start(self) -> Callable[[Unit], np.ndarray]:
+        integrator = self.make_integrator()
+        return partial(render_unit, self.scene, self.camera, integrator, self.settings.seed)
+
+
+def make_backend(name: str, scene: Scene, camera: Camera, settings: RenderSettings) -> Backend:
+    """The backend called `name` (one of BACKENDS) for a render."""
+    if name == "scalar":
+        return ScalarBackend(scene, camera, settings)
+    if name == "numpy":
+        # Imported here: student repositories hold a stub of the numpy backend.
+        from .numpy_backend.renderer import NumpyBackend
+
+        return NumpyBackend(scene, camera, settings)
+    raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {name!r}")
+
+
+def peak_rss_mb() -> float:
+    """Peak resident memory in MB of this process and of its finished children (the
+    largest of them; Linux reports kilobytes); nan where the system does not say."""
+    try:
+        import resource
+    except ImportError:  # not a Unix
+        return math.nan
+    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return max(own, children) / 1024.0
+
+
 # --- worker processes -------------------------------------------------------
-_worker_state: tuple | None = None
+_render_one: Callable[[Unit], np.ndarray] | None = None
 
 
-def _init_worker(scene: Scene, camera: Camera, settings: RenderSettings) -> None:
-    global _worker_state
+def _init_worker(backend: Backend) -> None:
+    global _render_one
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
-    _worker_state = (scene, camera, make_integrator(settings), settings.seed)
+    _render_one = backend.start()
 
 
 def _run_unit(unit: Unit) -> tuple[Unit, np.ndarray]:
-    scene, camera, integrator, seed = _worker_state
-    return unit, render_unit(scene, camera, integrator, seed, unit)
+    return unit, _render_one(unit)
 
 
 class Renderer:
@@ -133,6 +217,8 @@ class Renderer:
 
     workers  number of processes (1 = render in this process)
     quiet    no progress bar (it goes to stderr, with an ETA)
+    backend  "scalar" (the readable reference) or "numpy" (vectorized; the same image
+             up to Monte Carlo noise)
     """
 
     def __init__(
@@ -142,6 +228,7 @@ class Renderer:
         settings: RenderSettings,
         workers: int = 1,
         quiet: bool = True,
+        backend: str = "scalar",
     ) -> None:
         if workers < 1:
             raise ValueError(f"workers must be >= 1, got {workers}")
@@ -150,22 +237,13 @@ class Renderer:
         self.settings = settings
         self.workers = workers
         self.quiet = quiet
-
-    # What a backend changes: the progress bar's label, how the image is cut into
-    # units of work, and the integrator that says whether it traces only centre rays.
-    backend_label = ""
-
-    def plan_units(self, width: int, height: int, spp: int) -> list[Unit]:
-        return plan_units(width, height, spp)
-
-    def uses_center_ray(self) -> bool:
-        return make_integrator(self.settings).uses_center_ray
+        self.backend = make_backend(backend, scene, camera, settings)
 
     def render(self) -> RenderedImage:
         """Render; on Ctrl-C return what was finished (image.interrupted is True)."""
-        settings, camera = self.settings, self.camera
-        spp = 1 if self.uses_center_ray() else settings.spp
-        units = self.plan_units(camera.width, camera.height, spp)
+        settings, camera, backend = self.settings, self.camera, self.backend
+        spp = 1 if backend.uses_center_ray() else settings.spp
+        units = backend.plan_units(camera.width, camera.height, spp)
         results = PixelSums(camera.width, camera.height)
         total_paths = camera.width * camera.height * spp
         bar = tqdm(
@@ -174,7 +252,7 @@ class Renderer:
             unit_scale=True,
             file=sys.stderr,
             disable=self.quiet,
-            desc=f"{self.scene.name} ({settings.integrator}{self.backend_label})",
+            desc=f"{self.scene.name} ({settings.integrator}, {backend.name})",
             dynamic_ncols=True,
         )
         start = time.perf_counter()
@@ -194,16 +272,11 @@ class Renderer:
 
     def _run(self, units: list[Unit]):
         if self.workers == 1:
-            integrator = make_integrator(self.settings)
+            render_one = self.backend.start()
             for unit in units:
-                yield (
-                    unit,
-                    render_unit(self.scene, self.camera, integrator, self.settings.seed, unit),
-                )
+                yield unit, render_one(unit)
             return
-        pool = multiprocessing.get_context().Pool(
-            self.workers, _init_worker, (self.scene, self.camera, self.settings)
-        )
+        pool = multiprocessing.get_context().Pool(self.workers, _init_worker, (self.backend,))
         try:
             yield from pool.imap_unordered(_run_unit, units, chunksize=1)
             pool.close()
@@ -224,6 +297,8 @@ class Renderer:
             "paths_per_second": paths / seconds if seconds > 0 else math.inf,
             "workers": self.workers,
             "integrator": self.settings.integrator,
+            "backend": self.backend.name,
+            "peak_rss_mb": peak_rss_mb(),
         }
         return RenderedImage(
             linear,

@@ -1,4 +1,4 @@
-"""Scalar versus numpy backend speed (issue 4's benchmark).
+"""Scalar versus numpy backend speed.
 
     python scripts/bench_backends.py [--quick] [--repeat N]
 
@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import multiprocessing
-import resource
 
 import rtpy
 
@@ -35,9 +34,7 @@ import rtpy
 def _render(queue, name: str, backend: str, workers: int, kw: dict) -> None:
     scene = rtpy.load_scene(name)
     image = rtpy.render(scene, backend=backend, workers=workers, **kw)
-    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    queue.put((image.width, image.height, image.stats, max(own, children) / 1024.0))
+    queue.put((image.width, image.height, image.stats))
 
 
 def run(name: str, backend: str, workers: int = 1, **kw) -> dict:
@@ -46,9 +43,9 @@ def run(name: str, backend: str, workers: int = 1, **kw) -> dict:
     queue = ctx.Queue()
     proc = ctx.Process(target=_render, args=(queue, name, backend, workers, kw))
     proc.start()
-    width, height, stats, rss = queue.get()
+    width, height, stats = queue.get()
     proc.join()
-    return {**stats, "size": f"{width}x{height}", "rss": rss, "spp": kw["spp"]}
+    return {**stats, "size": f"{width}x{height}", "rss": stats["peak_rss_mb"], "spp": kw["spp"]}
 
 
 def best(runs: list[dict]) -> dict:

@@ -10,7 +10,7 @@ import pytest
 
 from rtpy import Color, Scene, Vec3
 from rtpy.environment import Environment, SkyBand
-from rtpy.numpy_backend.integrators import Tracer
+from rtpy.numpy_backend.scene import BatchScene
 
 
 def random_directions(n: int, seed: int = 0) -> np.ndarray:
@@ -64,7 +64,7 @@ def test_both_backends_see_the_scene_environment(env):
     """Scene.environment replaces background and sky, in both backends alike."""
     scene = Scene([], background=Color(9.0, 9.0, 9.0), sky=True, environment=env)
     d = random_directions(300, seed=4)
-    batched = Tracer(scene).background(d)
+    batched = BatchScene(scene).background_radiance(d)
     scalar = np.array([tuple(scene.background_radiance(Vec3(*row))) for row in d])
     np.testing.assert_allclose(batched, scalar, rtol=1e-15)
     assert not np.any(batched == 9.0)

@@ -1,4 +1,5 @@
-"""Renderer: work units, determinism across worker counts, interrupted renders."""
+"""Renderer: work units, determinism across worker counts, interrupted renders, and the
+one loop that drives any backend."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import pytest
 
 import rtpy
 from rtpy import Camera, Color, DiffuseLight, Lambertian, Metal, Scene, Sphere, Vec3
-from rtpy.renderer import PixelSums, plan_units
+from rtpy.renderer import Backend, PixelSums, Renderer, plan_units
 
 
 @pytest.mark.parametrize("width,height,spp", [(1, 1, 1), (16, 16, 16), (37, 21, 5), (40, 3, 64)])
@@ -46,13 +47,47 @@ def test_same_seed_same_image_for_any_worker_count():
     assert not np.array_equal(one.linear, other_seed.linear)
 
 
-def test_render_reports_samples_and_speed():
+def test_render_reports_samples_speed_and_memory():
     scene, camera = small_scene()
     image = rtpy.render(scene, camera=camera, spp=3)
     assert (image.samples_min, image.samples_max, image.spp) == (3, 3, 3)
     assert image.stats["paths"] == camera.width * camera.height * 3
-    assert image.stats["paths_per_second"] > 0
+    assert image.stats["paths_per_second"] > 0 and image.stats["peak_rss_mb"] > 0
+    assert image.stats["backend"] == "scalar"
     assert not image.interrupted
+
+
+def test_an_unknown_backend_is_refused():
+    scene, camera = small_scene()
+    with pytest.raises(ValueError, match="backend must be one of scalar, .*got 'cuda'"):
+        Renderer(scene, camera, rtpy.RenderSettings(), backend="cuda")
+
+
+class Counting(Backend):
+    """A backend whose every sample is the index of its unit's tile: the loop alone
+    decides what the image holds."""
+
+    name = "counting"
+
+    def uses_center_ray(self) -> bool:
+        return False  # no integrator at all
+
+    def plan_units(self, width, height, spp):
+        return plan_units(width, height, spp, tile=8)
+
+    def start(self):
+        return lambda unit: np.full((unit.y1 - unit.y0, unit.x1 - unit.x0, 3), unit.tile * unit.spp)
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_the_loop_drives_any_backend(workers):
+    scene, camera = small_scene()  # 40 x 22: tiles of 8 x 8, five per row
+    renderer = Renderer(scene, camera.with_width(40), rtpy.RenderSettings(spp=5), workers)
+    renderer.backend = Counting(scene, camera, renderer.settings)
+    image = renderer.render()
+    tile = np.arange(image.height)[:, None] // 8 * 5 + np.arange(image.width)[None, :] // 8
+    np.testing.assert_array_equal(image.linear, np.repeat(tile[..., None], 3, axis=2))
+    assert image.stats["backend"] == "counting" and image.samples_min == image.samples_max == 5
 
 
 class InterruptAfter(Sphere):
@@ -89,9 +124,7 @@ def test_pixel_sums_do_not_depend_on_the_order_units_arrive_in():
     float addition is not associative), and a unit is kept only until it is added."""
     units = plan_units(40, 20, 6)
     rng = np.random.default_rng(1)
-    sums = [
-        rng.random((u.y1 - u.y0, u.x1 - u.x0, 3)) * 10.0 ** rng.integers(-8, 8) for u in units
-    ]
+    sums = [rng.random((u.y1 - u.y0, u.x1 - u.x0, 3)) * 10.0 ** rng.integers(-8, 8) for u in units]
     in_order, shuffled = PixelSums(40, 20), PixelSums(40, 20)
     naive = np.zeros((20, 40, 3))
     for unit, s in zip(units, sums, strict=True):

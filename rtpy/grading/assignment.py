@@ -75,7 +75,7 @@ vectorized twins contain the solutions. Render with the scalar backend (the defa
 NUMPY_RENDER_STUB = '''"""Withheld: see rtpy/numpy_backend/__init__.py."""
 
 
-class NumpyRenderer:
+class NumpyBackend:
     def __init__(self, *args, **kwargs) -> None:
         raise NotImplementedError(
             "the numpy backend is withheld from the week {week} assignment repository "
@@ -272,11 +272,13 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
         target.write_text(
             rewrite(path, root, lambda r: r.stub() if withheld(r.week, week) else None)
         )
-    numpy_dir = dest / "rtpy" / "numpy_backend"
-    (numpy_dir / "materials").mkdir(parents=True)
-    (numpy_dir / "__init__.py").write_text(NUMPY_STUB)
-    (numpy_dir / "materials" / "__init__.py").write_text(NUMPY_STUB)
-    (numpy_dir / "render.py").write_text(NUMPY_RENDER_STUB.replace("{week}", week))
+    numpy_dir = root / "rtpy" / "numpy_backend"
+    for package in sorted(numpy_dir.rglob("__init__.py")):  # pyproject lists every package
+        stub = dest / package.relative_to(root)
+        stub.parent.mkdir(parents=True, exist_ok=True)
+        stub.write_text(NUMPY_STUB)
+    stub = dest / "rtpy" / "numpy_backend" / "renderer.py"
+    stub.write_text(NUMPY_RENDER_STUB.replace("{week}", week))
     for name in COPIED:
         path = root / name
         if path.is_dir():

@@ -1,17 +1,28 @@
-"""Vectorized numpy backend: renders the same images as the scalar renderer (up to
-Monte Carlo noise), tracing many rays per numpy call."""
+"""The numpy backend: renders the scalar renderer's images (up to Monte Carlo noise),
+tracing many rays per numpy call. Its modules mirror rtpy's, file for file where a
+twin exists (docs/numpy-backend.md has the table); render with
+rtpy.render(..., backend="numpy")."""
 
-from .hits import HitBatch
-from .materials import MaterialTable, ScatterBatch
-from .textures import TextureTable
+from .camera import CameraRays
+from .hit_info import HitBatch
+from .integrators import INTEGRATORS, BatchIntegrator, make_integrator
+from .light import LightTable
+from .materials import MaterialTable
+from .renderer import NumpyBackend
+from .scatter_info import ScatterBatch
+from .scene import BatchScene
+from .texture import TextureTable
 
-__all__ = ["HitBatch", "MaterialTable", "ScatterBatch", "TextureTable"]
-
-# Geometry, camera, lights, integrators and the renderer.
-from .camera import CameraRays  # noqa: E402
-from .geometry import Geometry  # noqa: E402
-from .integrators import INTEGRATORS, Tracer  # noqa: E402
-from .lights import LightTable  # noqa: E402
-from .render import NumpyRenderer  # noqa: E402
-
-__all__ += ["INTEGRATORS", "CameraRays", "Geometry", "LightTable", "NumpyRenderer", "Tracer"]
+__all__ = [
+    "INTEGRATORS",
+    "BatchIntegrator",
+    "BatchScene",
+    "CameraRays",
+    "HitBatch",
+    "LightTable",
+    "MaterialTable",
+    "NumpyBackend",
+    "ScatterBatch",
+    "TextureTable",
+    "make_integrator",
+]

@@ -1,16 +1,15 @@
-"""Row operations on (N,) and (N, 3) float64 arrays that avoid numpy's slow paths.
+"""Row operations on (N,) and (N, 3) float64 arrays, spelled the way numpy runs fast.
 
-The backend stores vectors as C-contiguous (N, 3) arrays (one row per ray or hit).
-For such arrays some of numpy's natural spellings run their innermost loop over the
-three components, paying a per-row overhead, and are several times slower than an
-equivalent spelling (numpy 2.4, N = 12,000 rows, on the development machine):
+The backend stores vectors as C-contiguous (N, 3) arrays, one row per ray or hit.
+For such arrays several of numpy's natural spellings run their innermost loop over
+the three components and pay a per-row overhead, several times the cost of an
+equivalent spelling:
 
-- gathering rows: a[idx] 136 us, a.take(idx, axis=0) 31 us; a[mask] 167 us,
-  a.compress(mask, axis=0) 41 us;
-- scattering rows: out[idx] = x 146 us, np.put on a view of each row as one
-  24-byte item 36 us;
-- scaling rows: a * s[:, None] 62-92 us, three column products 32 us;
-- a constant row: a + c (c of shape (3,)) 100 us, three column sums 20 us.
+- gathering rows: a.take(idx, axis=0) and a.compress(mask, axis=0), not a[idx] or
+  a[mask];
+- scattering rows: np.put on a view of each row as one 24-byte item, not out[idx] = x;
+- scaling rows, dot products, reductions over the three components: three column
+  operations, not a * s[:, None], a.sum(axis=1) or a.max(axis=1).
 
 The helpers below give the fast spelling with the meaning of the natural one. Each
 takes index arrays (int) or boolean masks where it says so; results are new
@@ -22,6 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 _ROW = np.dtype((np.void, 24))  # one (3,) float64 row as a single item
+
+Rows = np.ndarray | slice  # an index array, or slice(None) for all rows
 
 
 def rows(a: np.ndarray, index: np.ndarray) -> np.ndarray:
@@ -35,6 +36,26 @@ def at(table: np.ndarray, k: np.ndarray | int) -> np.ndarray:
     """table.take(k, axis=0): rows of a table per index; for one int k, that row
     alone (a scalar or a (3,) row, which broadcasts against the (N,) columns)."""
     return table[k] if isinstance(k, int) else table.take(k, axis=0)
+
+
+def true(n: int) -> np.ndarray:
+    """(n,) bool, all True."""
+    return np.ones(n, dtype=bool)
+
+
+def select(mask: np.ndarray) -> Rows:
+    """The rows where mask is True; slice(None) when that is all of them, so that
+    indexing with the result costs nothing in the common case."""
+    return slice(None) if mask.all() else np.flatnonzero(mask)
+
+
+def compose(outer: Rows, inner: Rows) -> Rows:
+    """The rows `inner` of the rows `outer`."""
+    if isinstance(inner, slice):
+        return outer
+    if isinstance(outer, slice):
+        return inner
+    return outer[inner]
 
 
 def _as_items(a: np.ndarray) -> np.ndarray | None:
@@ -59,6 +80,16 @@ def put_rows(out: np.ndarray, index: np.ndarray, values: np.ndarray) -> None:
 def add_rows(out: np.ndarray, index: np.ndarray, values: np.ndarray) -> None:
     """out[index] += values for distinct int indices (no index repeated)."""
     put_rows(out, index, rows(out, index) + values)
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a . b over the last axis of (..., 3) arrays, summed in the scalar order x, y, z."""
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+
+
+def max3(a: np.ndarray) -> np.ndarray:
+    """Largest of the three components of (N, 3) a: a.max(axis=1)."""
+    return np.maximum(np.maximum(a[:, 0], a[:, 1]), a[:, 2])
 
 
 def scale(a: np.ndarray, s: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -94,12 +125,4 @@ def axpy(s: np.ndarray, d: np.ndarray, o: np.ndarray) -> np.ndarray:
         col = out[:, c]
         np.multiply(s, d[..., c], out=col)
         np.add(o[..., c], col, out=col)
-    return out
-
-
-def add_row(a: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """a + c for a (N, 3) and one row c (3,), column by column."""
-    out = np.empty(a.shape)
-    for k in range(3):
-        np.add(a[:, k], c[k], out=out[:, k])
     return out

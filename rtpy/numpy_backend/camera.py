@@ -9,12 +9,11 @@ so the same uniform numbers give the same rays to the last bit.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..camera import Camera
 from .arrays import scale
+from .sampling import unit_disk
 
 
 def _v(v) -> np.ndarray:
@@ -49,9 +48,7 @@ class CameraRays:
         n = len(px)
         target, origin = np.empty((n, 3)), np.empty((n, 3))
         if self.defocus:
-            radius = np.sqrt(lens1)
-            phi = 2.0 * math.pi * lens2
-            x, y = radius * np.cos(phi), radius * np.sin(phi)
+            x, y = unit_disk(lens1, lens2)
         for c in range(3):
             col = target[:, c]
             np.multiply(px, self.du[c], out=col)

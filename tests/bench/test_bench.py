@@ -112,23 +112,23 @@ def drop_one_over_pdf(monkeypatch):
     """A planted mistake: BRDF sampling weights BRDF * cos instead of BRDF * cos / pdf."""
     from rtpy.numpy_backend.materials.table import MaterialTable
 
-    original = MaterialTable.sample
+    original = MaterialTable.scattering
 
-    def sample(self, ids, hits, rng):
+    def scattering(self, ids, hits, rng):
         sc = original(self, ids, hits, rng)
-        keep = sc.specular | ~sc.alive
-        sc.weight = np.where(keep[:, None], sc.weight, sc.weight * sc.pdf[:, None])
+        keep = sc.is_specular | ~sc.alive
+        sc.attenuation = np.where(keep[:, None], sc.attenuation, sc.attenuation * sc.pdf[:, None])
         return sc
 
-    monkeypatch.setattr(MaterialTable, "sample", sample)
+    monkeypatch.setattr(MaterialTable, "scattering", scattering)
 
 
 def count_light_twice(monkeypatch):
     """A planted mistake: emission found by BRDF sampling keeps weight 1 although
     light sampling also counts it."""
-    from rtpy.numpy_backend.integrators import Tracer
+    from rtpy.numpy_backend.integrators import direct_lighting
 
-    monkeypatch.setattr(Tracer, "emission_weight", lambda self, obj, *args, **kw: np.ones(len(obj)))
+    monkeypatch.setattr(direct_lighting, "emission_weight", lambda _, obj, *a: np.ones(len(obj)))
 
 
 @pytest.mark.parametrize(
@@ -155,18 +155,18 @@ def uniform_directions_with_cosine_weights(monkeypatch):
     band, grazing directions are drawn too often."""
     from rtpy.numpy_backend.materials.table import MaterialTable
 
-    original = MaterialTable.sample
+    original = MaterialTable.scattering
 
-    def sample(self, ids, hits, rng):
+    def scattering(self, ids, hits, rng):
         sc = original(self, ids, hits, rng)
         d = rng.normal(size=sc.direction.shape)
         d /= np.linalg.norm(d, axis=1, keepdims=True)
         d *= np.sign(np.einsum("ij,ij->i", d, hits.normal))[:, None]
-        diffuse = sc.alive & ~sc.specular
+        diffuse = sc.alive & ~sc.is_specular
         sc.direction = np.where(diffuse[:, None], d, sc.direction)
         return sc
 
-    monkeypatch.setattr(MaterialTable, "sample", sample)
+    monkeypatch.setattr(MaterialTable, "scattering", scattering)
 
 
 def test_a_wrong_pdf_at_grazing_angles_is_caught_by_the_sky_band_only(monkeypatch):

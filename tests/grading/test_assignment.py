@@ -123,7 +123,7 @@ def check_regions(repo: Path, week: str) -> None:
 def test_student_repository(tmp_path, week):
     repo = make_assignment(week, tmp_path / f"week{week}")
     check_regions(repo, week)
-    assert not (repo / "rtpy" / "numpy_backend" / "geometry.py").exists()
+    assert not (repo / "rtpy" / "numpy_backend" / "scene.py").exists()
     with open(repo / "pyproject.toml", "rb") as f:  # pip install needs every listed package
         setup = tomllib.load(f)["tool"]["setuptools"]
     for package in setup["packages"]:
@@ -180,6 +180,6 @@ def test_map_tests_of_some_files_records_their_weeks_and_keeps_the_rest(tmp_path
     # The numpy backend's tests are never mapped (the backend is withheld), also
     # when named: nothing runs and the table stays as it was.
     before = (tmp_path / TEST_WEEKS_FILE).read_text()
-    weeks = map_tests(tmp_path, files=("tests/numpy_backend/test_trig.py",))
+    weeks = map_tests(tmp_path, files=("tests/numpy_backend/test_sampling.py",))
     assert weeks == {"tests/test_other.py": {"07"}, "tests/test_shade.py": {"05"}}
     assert (tmp_path / TEST_WEEKS_FILE).read_text() == before

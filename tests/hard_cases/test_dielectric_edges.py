@@ -15,7 +15,7 @@ import pytest
 
 from rtpy.hit_info import HitInfo
 from rtpy.materials import Dielectric
-from rtpy.numpy_backend.hits import HitBatch
+from rtpy.numpy_backend.hit_info import HitBatch
 from rtpy.numpy_backend.materials import MaterialTable
 from rtpy.ray import Ray
 from rtpy.vec3 import Color, Vec3

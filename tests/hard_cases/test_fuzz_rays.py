@@ -4,8 +4,8 @@ Hypothesis draws seeds; each makes one sphere, quad or triangle at a random size
 (10^-3 to 10^5) and place (up to 10^5 from the origin), and 40 rays: from random
 points around it, from points on its surface (as spawned rays start), from inside
 a sphere, in the plane of a quad or triangle, and aimed at a point inside it. The
-scalar shape (`intersect`) and the numpy geometry (`Geometry.closest_hit` +
-`hit_batch`) must report only hits with a finite t > 0, a finite point on the
+scalar shape (`intersect`) and the numpy geometry (`BatchScene.find_intersection`
++ `hit_batch`) must report only hits with a finite t > 0, a finite point on the
 surface (to the rounding of the coordinates' size), a unit normal facing the ray,
 and (u, v) in [0, 1]; a ray aimed from outside at a point well inside the shape,
 not grazing it, must hit it no farther than that point.
@@ -15,7 +15,7 @@ big sphere far away to cancellation (the hit is off the surface), Moller-Trumbor
 without a relative parallel test reports hits far from a triangle for rays in
 its plane, and a quad's (a, b) by division returns NaN for a ray in its plane.
 The extensions of tests/test_sphere.py, test_quad.py, test_triangle.py and
-tests/numpy_backend/test_geometry.py, which aim rays at modest shapes or compare
+tests/numpy_backend/test_sphere.py etc., which aim rays at modest shapes or compare
 the backends, to any ray at any scale.
 """
 
@@ -26,9 +26,9 @@ import math
 import numpy as np
 from hypothesis import given, settings
 
-from rtpy import Lambertian, Quad, Sphere, Triangle, Vec3
+from rtpy import Lambertian, Quad, Scene, Sphere, Triangle, Vec3
 from rtpy.interval import Interval
-from rtpy.numpy_backend.geometry import Geometry
+from rtpy.numpy_backend.scene import BatchScene
 from rtpy.ray import Ray
 
 from .scene_strategies import examples, seeds
@@ -161,8 +161,9 @@ def scalar_hits(shape, o, d):
 
 
 def numpy_hits(shape, o, d):
-    geo = Geometry([shape])
-    obj, t = geo.closest_hit(o, d)
+    geo = BatchScene(Scene([shape]))
+    geo.need_uv = True
+    obj, t = geo.find_intersection(o, d)
     hit = np.flatnonzero(obj >= 0)
     batch = geo.hit_batch(obj[hit], o[hit], d[hit], t[hit])
     found = dict(zip(hit.tolist(), range(len(hit)), strict=True))

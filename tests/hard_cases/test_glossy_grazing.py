@@ -7,7 +7,7 @@ products underflow to 0 and the textbook BRDF is 0 / 0 = NaN or x / 0 = inf; at 
 cosine of exactly 0 (a direction in the tangent plane) tan is infinite. rtpy's
 formulas are rearranged so that no cosine is divided by (see rtpy/materials/
 cook_torrance.py and ward.py): its BRDF and pdf must be finite and >= 0 for every pair
-of directions, on the scalar material (BRDF, pdf) and the numpy MaterialTable (eval).
+of directions, on the scalar material (BRDF, pdf) and the numpy MaterialTable (BRDF, pdf).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from rtpy.materials import CookTorrance, Ward
-from rtpy.numpy_backend.hits import HitBatch
+from rtpy.numpy_backend.hit_info import HitBatch
 from rtpy.numpy_backend.materials import MaterialTable
 from rtpy.ray import Ray
 from rtpy.vec3 import Vec3
@@ -65,7 +65,8 @@ def rtpy_eval(backend, material, wo: np.ndarray, wi: np.ndarray):
     )
     if backend == "numpy":
         with np.errstate(all="ignore"):
-            return MaterialTable([material]).eval(np.zeros(n, dtype=np.intp), hits, wi)
+            table, ids = MaterialTable([material]), np.zeros(n, dtype=np.intp)
+            return table.BRDF(ids, hits, wi), table.pdf(ids, hits, wi)
     f, pdf = np.zeros((n, 3)), np.zeros(n)
     for i in range(n):
         hit = hits.hit_info(i, material)

@@ -2,8 +2,8 @@
 shared edges and vertices.
 
 Each test computes the naive formula on the same input, shows that it is wrong, and
-checks rtpy's scalar Quad / Triangle and the numpy QuadSet / TriangleSet (pair_t, and
-closest, which goes through all_t: a different formula).
+checks rtpy's scalar Quad / Triangle and the numpy QuadSet / TriangleSet (hit_t, and
+closest_hit, which goes through all_t: a different formula).
 """
 
 from __future__ import annotations
@@ -14,15 +14,16 @@ import numpy as np
 import pytest
 
 from rtpy import Lambertian, Quad, Triangle, Vec3
-from rtpy.numpy_backend.geometry import QuadSet, TriangleSet
+from rtpy.numpy_backend.quad import QuadSet
+from rtpy.numpy_backend.triangle import TriangleSet
 from rtpy.ray import Ray
 
 MAT = Lambertian()
-BACKENDS = ["scalar", "numpy pair_t", "numpy closest"]
+BACKENDS = ["scalar", "numpy hit_t", "numpy closest_hit"]
 SHAPES = ["quad", "triangle"]
 # A hit reported for a ray lying in the plane must be a point of the shape. Allowed
 # distance: numpy quads accept hits up to 1e-9 edge lengths outside (EDGE_A in
-# rtpy/numpy_backend/geometry.py) and the edges here are shorter than 10; rounding of
+# rtpy/numpy_backend/quad.py) and the edges here are shorter than 10; rounding of
 # o + t d at coordinates below 50 is about 1e-14. The naive far hits are 1e-3 to 6
 # away.
 NEAR = 1e-8
@@ -38,9 +39,9 @@ def shape_t(backend, shape, o: np.ndarray, d: np.ndarray) -> np.ndarray:
     s = QuadSet([shape]) if isinstance(shape, Quad) else TriangleSet([shape])
     t_max = np.full(len(o), math.inf)
     with np.errstate(invalid="ignore", divide="ignore"):
-        if backend == "numpy pair_t":
-            return s.pair_t(o, d, np.zeros(len(o), dtype=np.intp), 0.0, t_max)
-        return s.closest(o, d, 0.0, t_max)[0]
+        if backend == "numpy hit_t":
+            return s.hit_t(o, d, np.zeros(len(o), dtype=np.intp), 0.0, t_max)
+        return s.closest_hit(o, d, 0.0, t_max)[0]
 
 
 def arr(v: Vec3) -> np.ndarray:

@@ -16,13 +16,14 @@ import numpy as np
 import pytest
 
 from rtpy import Lambertian, Sphere, Vec3
-from rtpy.numpy_backend.geometry import SphereSet, spawn_origins
+from rtpy.numpy_backend.ray import spawn_origins
+from rtpy.numpy_backend.sphere import SphereSet
 from rtpy.onb import local_to_world
 from rtpy.ray import Ray, spawn_ray
 
 EPS = 2.0**-53  # unit roundoff of float64
 MAT = Lambertian()
-BACKENDS = ["scalar", "numpy pair_t", "numpy closest"]
+BACKENDS = ["scalar", "numpy hit_t", "numpy closest_hit"]
 
 
 def sphere_t(backend: str, sphere: Sphere, o: np.ndarray, d: np.ndarray, t_min: float = 0.0):
@@ -35,9 +36,9 @@ def sphere_t(backend: str, sphere: Sphere, o: np.ndarray, d: np.ndarray, t_min: 
         return np.array([math.inf if t is None else t for t in ts])
     s = SphereSet([sphere])
     t_max = np.full(len(o), math.inf)
-    if backend == "numpy pair_t":
-        return s.pair_t(o, d, np.zeros(len(o), dtype=np.intp), t_min, t_max)
-    t, _ = s.closest(o, d, t_min, t_max)
+    if backend == "numpy hit_t":
+        return s.hit_t(o, d, np.zeros(len(o), dtype=np.intp), t_min, t_max)
+    t, _ = s.closest_hit(o, d, t_min, t_max)
     return t
 
 
@@ -244,5 +245,5 @@ def hits_from(backend, sphere, o, d):
         return np.array(pts), np.array(nrm)
     s = SphereSet([sphere])
     k = np.zeros(len(o), dtype=np.intp)
-    t = s.pair_t(o, d, k, 0.0, np.full(len(o), math.inf))
+    t = s.hit_t(o, d, k, 0.0, np.full(len(o), math.inf))
     return s.geometric(k, o, d, t)

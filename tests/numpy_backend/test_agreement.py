@@ -33,7 +33,7 @@ import pytest
 
 import rtpy
 from rtpy.io.bundled import bundled_scenes
-from rtpy.numpy_backend.integrators import Tracer
+from rtpy.numpy_backend.integrators import direct_lighting
 
 ALPHA = 1e-3
 BLOCK = 8
@@ -122,10 +122,6 @@ def test_center_images_agree(name):
     assert close.mean() > 0.99, f"{(~close).sum()} pixels differ"
 
 
-# Every scene and integrator agrees. (Until commit 2f1fa6e the scalar backend let a
-# light block its own shadow ray, so material_gallery's direct light was 9 % too dark
-# near its quad light and these comparisons were marked xfail; neither backend now
-# lets a light block its own shadow ray.)
 CASES = [(name, integrator) for name in SCENES for integrator in SPP]
 
 
@@ -139,7 +135,7 @@ def test_a_biased_kernel_is_flagged(monkeypatch):
     lights are also sampled) brightens every lit block: the comparison flags it."""
     name, integrator, spp = "cornell", "path", SPP["path"]
     scalar = renders(name, integrator, "scalar", spp)
-    monkeypatch.setattr(Tracer, "emission_weight", lambda self, obj, *args: np.ones(len(obj)))
+    monkeypatch.setattr(direct_lighting, "emission_weight", lambda _, obj, *a: np.ones(len(obj)))
     biased = [
         rtpy.render(
             rtpy.load_scene(name),

@@ -1,12 +1,11 @@
-"""Batched material kernels: the numpy twins of rtpy.materials.
+"""Batched material kernels: the numpy twins of rtpy.materials, one file per material.
 
-MaterialTable turns a scene's materials into one kernel per material class (see
-table.py); the kernels are in simple.py (Lambertian, Mirror, Metal, Dielectric,
-DiffuseLight), glossy.py (Phong, Blinn-Phong, Cook-Torrance, Ward), oren_nayar.py and
-fallback.py (any other material, through its scalar methods).
+MaterialTable (table.py) turns a scene's materials into one kernel per material
+class; a kernel (material.py) has the scalar Material's methods for many hits at
+once. Materials without a kernel run through their scalar methods (fallback.py).
 """
 
-from .kernel import Kernel, ScatterBatch
+from .material import Kernel
 from .table import KERNELS, MaterialTable, kernel_class
 
-__all__ = ["KERNELS", "Kernel", "MaterialTable", "ScatterBatch", "kernel_class"]
+__all__ = ["KERNELS", "Kernel", "MaterialTable", "kernel_class"]

@@ -17,23 +17,24 @@ import numpy as np
 from ...ray import Ray
 from ...sampling import use_generator
 from ...vec3 import Vec3
-from ..hits import HitBatch
-from .kernel import Kernel, ScatterBatch, SpecularRays
-
-
-def _vec(a: np.ndarray) -> Vec3:
-    return Vec3(float(a[0]), float(a[1]), float(a[2]))
+from ..hit_info import HitBatch
+from ..scatter_info import ScatterBatch, SpecularRays
+from ..vec3 import to_vec3
+from .material import Kernel
 
 
 class ScalarFallback(Kernel):
     """Per-hit calls of the scalar methods of arbitrary materials."""
 
-    evaluates = True
+    has_brdf = True
     scatters = True
     emits = True
     has_specular_rays = True
+    reads_tangent = True
+    reads_uv = True
 
     def _hit(self, slots: np.ndarray, hits: HitBatch, i: int):
+        """(material, HitInfo, the arriving ray) of hit i."""
         material = self.materials[slots[i]]
         hit = hits.hit_info(i, material)
         wo = hits.wo[i]
@@ -42,32 +43,34 @@ class ScalarFallback(Kernel):
         ray_in = Ray(origin, Vec3(-float(wo[0]), -float(wo[1]), -float(wo[2])))
         return material, hit, ray_in
 
+    def _per_hit(self, slots: np.ndarray, hits: HitBatch, value, wi: np.ndarray | None = None):
+        """value(material, hit, ray_in, ray_light) for every hit, as an array (ray_light
+        is the ray toward wi[i], or None without wi)."""
+        out = []
+        for i in range(len(slots)):
+            material, hit, ray_in = self._hit(slots, hits, i)
+            ray_light = None if wi is None else Ray(hit.point, to_vec3(wi[i]))
+            out.append(value(material, hit, ray_in, ray_light))
+        return np.array(out, dtype=np.float64)
+
     def flat_color(self, slots: np.ndarray, hits: HitBatch) -> np.ndarray:
-        out = np.empty((len(slots), 3))
-        for i in range(len(slots)):
-            material, hit, _ = self._hit(slots, hits, i)
-            out[i] = tuple(material.flat_color(hit))
-        return out
+        colors = self._per_hit(slots, hits, lambda m, hit, ray, _: tuple(m.flat_color(hit)))
+        return colors.reshape(-1, 3)
 
-    def emitted(self, slots: np.ndarray, hits: HitBatch) -> np.ndarray:
-        out = np.empty((len(slots), 3))
-        for i in range(len(slots)):
-            material, hit, _ = self._hit(slots, hits, i)
-            out[i] = tuple(material.emitting(hit))
-        return out
+    def emitting(self, slots: np.ndarray, hits: HitBatch) -> np.ndarray:
+        colors = self._per_hit(slots, hits, lambda m, hit, ray, _: tuple(m.emitting(hit)))
+        return colors.reshape(-1, 3)
 
-    def eval(
-        self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        f, pdf = np.empty((len(slots), 3)), np.empty(len(slots))
-        for i in range(len(slots)):
-            material, hit, ray_view = self._hit(slots, hits, i)
-            ray_light = Ray(hit.point, _vec(wi[i]))
-            f[i] = tuple(material.BRDF(ray_view, ray_light, hit))
-            pdf[i] = material.pdf(ray_view, ray_light, hit)
-        return f, pdf
+    def BRDF(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
+        f = self._per_hit(slots, hits, lambda m, hit, ray, to: tuple(m.BRDF(ray, to, hit)), wi)
+        return f.reshape(-1, 3)
 
-    def sample(self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator) -> ScatterBatch:
+    def pdf(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
+        return self._per_hit(slots, hits, lambda m, hit, ray, light: m.pdf(ray, light, hit), wi)
+
+    def scattering(
+        self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator
+    ) -> ScatterBatch:
         out = ScatterBatch.absorbed(len(slots))
         with use_generator(random.Random(int(rng.integers(2**63)))):
             for i in range(len(slots)):
@@ -76,10 +79,10 @@ class ScalarFallback(Kernel):
                 if s is None:
                     continue
                 out.direction[i] = tuple(s.scattered_ray.direction)
-                out.weight[i] = tuple(s.attenuation)
+                out.attenuation[i] = tuple(s.attenuation)
                 out.pdf[i] = s.pdf
                 out.alive[i] = True
-                out.specular[i] = bool(s.is_specular)
+                out.is_specular[i] = bool(s.is_specular)
         return out
 
     def specular_rays(self, slots: np.ndarray, hits: HitBatch) -> SpecularRays:

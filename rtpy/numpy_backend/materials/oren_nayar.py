@@ -1,34 +1,36 @@
-"""Kernel of the Oren-Nayar qualitative model (rough diffuse)."""
+"""Kernel of Oren-Nayar (rtpy/materials/oren_nayar.py): the qualitative rough-diffuse model."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
 from ...materials import OrenNayar
 from ...materials.oren_nayar import MIN_COS
-from ..hits import HitBatch
-from .frame import Frame, Local, components, compose, cosine_direction, dot, select, take
-from .kernel import AlbedoKernel, ScatterBatch, param
-
-INV_PI = 1.0 / math.pi
+from ..arrays import compose, select
+from ..hit_info import HitBatch
+from ..onb import ONB
+from ..sampling import cosine_direction
+from ..scatter_info import ScatterBatch
+from ..vec3 import Columns, components, dot, stack, take
+from .material import INV_PI, AlbedoKernel, param
 
 
 class OrenNayarKernel(AlbedoKernel):
     """albedo / pi (A + B max(0, cos(phi_i - phi_o)) sin(alpha) tan(beta)), sampled
     cosine-weighted (weight albedo * factor)."""
 
-    evaluates = True
+    has_brdf = True
     scatters = True
+    reads_tangent = True
 
     def __init__(self, materials: Sequence[OrenNayar]) -> None:
         super().__init__(materials)
         self.A = param(self.materials, "A")
         self.B = param(self.materials, "B")
 
-    def factor(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
+    def factor(self, slots: np.ndarray, wo: Columns, wi: Columns) -> np.ndarray:
         """A + B max(0, cos(phi_i - phi_o)) sin(alpha) tan(beta) = A + B (projections'
         dot product) / (larger cosine), both directions above the surface."""
         a, b = self.A[slots], self.B[slots]
@@ -37,26 +39,27 @@ class OrenNayarKernel(AlbedoKernel):
         rough = (b != 0.0) & (cos_phi_sin_sin > 0.0)
         return np.where(rough, a + b * cos_phi_sin_sin / cos_beta, a)
 
-    def eval(
-        self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        frame = Frame.from_normal_tangent(hits.normal, hits.tangent)
+    def BRDF(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
+        frame = ONB.from_normal_tangent(hits.normal, hits.tangent)
         wo_l, wi_l = frame.to_local(hits.wo), frame.to_local(wi)
         f = np.zeros((len(slots), 3))
         up = select((wo_l[2] > 0.0) & (wi_l[2] > 0.0))
         s = slots[up]
         k = INV_PI * self.factor(s, take(wo_l, up), take(wi_l, up))
         f[up] = self.albedo(s, hits, up) * k[:, None]
+        return f
+
+    def pdf(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
         # The density of scattering(), from the world normal as OrenNayar.pdf: 0 where
         # the viewer is below the surface (n . d >= 0 for the arriving direction d = -wo).
         n = components(hits.normal)
         viewer_above = ~(dot(n, components(-hits.wo)) >= 0.0)
-        pdf = np.where(viewer_above, np.maximum(0.0, dot(n, components(wi))) * INV_PI, 0.0)
-        return f, pdf
+        return np.where(viewer_above, np.maximum(0.0, dot(n, components(wi))) * INV_PI, 0.0)
 
-    def sample(self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator) -> ScatterBatch:
-        out = ScatterBatch.absorbed(len(slots))
-        frame = Frame.from_normal_tangent(hits.normal, hits.tangent)
+    def scattering(
+        self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator
+    ) -> ScatterBatch:
+        frame = ONB.from_normal_tangent(hits.normal, hits.tangent)
         wo = frame.to_local(hits.wo)
         rows = select(wo[2] > 0.0)
         r = rng.random((2, len(slots[rows])))
@@ -66,8 +69,6 @@ class OrenNayarKernel(AlbedoKernel):
         rows, wi, pdf = compose(rows, live), take(wi, live), pdf[live]
         s = slots[rows]
         k = self.factor(s, take(wo, rows), wi)
-        out.direction[rows] = frame.take(rows).to_world(*wi)
-        out.weight[rows] = self.albedo(s, hits, rows) * k[:, None]
-        out.pdf[rows] = pdf
-        out.alive[rows] = True
-        return out
+        direction = stack(*frame.take(rows).to_world(*wi))
+        attenuation = self.albedo(s, hits, rows) * k[:, None]
+        return ScatterBatch.alive_at(len(slots), rows, direction, attenuation, pdf)

@@ -6,30 +6,53 @@ from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
 
-from ...materials import OrenNayar
+from ... import materials as scalar
 from ...materials.material import Material
 from ...texture import Texture
 from ..arrays import put_rows
-from ..hits import HitBatch
+from ..hit_info import HitBatch
+from ..scatter_info import ScatterBatch, SpecularRays
+from .blinn_phong import BlinnPhongKernel
+from .cook_torrance import cook_torrance_kernel
+from .dielectric import DielectricKernel
+from .diffuse_light import DiffuseLightKernel
 from .fallback import ScalarFallback
-from .glossy import GLOSSY_KERNELS
-from .kernel import AlbedoKernel, Kernel, ScatterBatch, SpecularRays
+from .lambertian import GlowingLambertianKernel, LambertianKernel
+from .material import AlbedoKernel, Kernel
+from .metal import MetalKernel
+from .mirror import MirrorKernel
 from .oren_nayar import OrenNayarKernel
-from .simple import SIMPLE_KERNELS
+from .phong import PhongKernel
+from .ward import WardKernel
+
+KernelChoice = type[Kernel] | Callable[[Material], type[Kernel]]
 
 # Material class -> its kernel class, or a function choosing one from the instance
 # (Cook-Torrance has one kernel per distribution, so no kernel branches per hit).
-KERNELS: dict[type, type[Kernel] | Callable[[Material], type[Kernel]]] = {
-    **SIMPLE_KERNELS,
-    **GLOSSY_KERNELS,
-    OrenNayar: OrenNayarKernel,
+# A class the backend must not import is keyed by its full name, module and
+# qualified name, which identifies it as exactly as the class itself: the closed-form
+# scenes' GlowingLambertian lives in rtpy.testing, which the backend does not import
+# (and rtpy.testing, shipped to students, cannot import the withheld backend).
+KERNELS: dict[type | str, KernelChoice] = {
+    scalar.Lambertian: LambertianKernel,
+    scalar.Mirror: MirrorKernel,
+    scalar.Metal: MetalKernel,
+    scalar.Dielectric: DielectricKernel,
+    scalar.DiffuseLight: DiffuseLightKernel,
+    scalar.Phong: PhongKernel,
+    scalar.BlinnPhong: BlinnPhongKernel,
+    scalar.CookTorrance: cook_torrance_kernel,
+    scalar.Ward: WardKernel,
+    scalar.OrenNayar: OrenNayarKernel,
+    "rtpy.testing.analytic_scenes.GlowingLambertian": GlowingLambertianKernel,
 }
 
 
 def kernel_class(material: Material) -> type[Kernel]:
     """The kernel for `material`: by its exact class (a subclass may override anything,
     so it gets the scalar fallback), and the fallback for anything unusual."""
-    choose = KERNELS.get(type(material))
+    cls = type(material)
+    choose = KERNELS.get(cls) or KERNELS.get(f"{cls.__module__}.{cls.__qualname__}")
     if choose is None:
         return ScalarFallback
     kernel = choose if isinstance(choose, type) else choose(material)
@@ -46,11 +69,13 @@ class MaterialTable:
     The instances are grouped by kernel (material class), each kernel holding its
     instances' parameters as arrays. A batched call splits the hits by kernel and makes
     one call per kernel present in the batch, so the number of numpy calls depends on
-    the number of material classes, not on the number of materials.
+    the number of material classes, not on the number of materials. The methods are
+    the scalar Material's (see material.py), with a material id per hit.
 
-    specular  (M,) bool: Material.is_specular per id (delta scattering only)
-    emitter   (M,) bool: Material.is_emitter per id
-    inert     (M,) bool: no BRDF and no scattering (eval and sample give only zeros)
+    is_specular  (M,) bool: Material.is_specular per id (delta scattering only)
+    is_emitter   (M,) bool: Material.is_emitter per id
+    inert        (M,) bool: no BRDF and no scattering (light arriving there ends)
+    reads_uv, reads_tangent  whether any material reads a hit's (u, v) or tangent
     """
 
     def __init__(self, materials: Sequence[Material]) -> None:
@@ -66,13 +91,14 @@ class MaterialTable:
             self.kernels.append(cls([self.materials[i] for i in ids]))
             self.kind[ids] = k
             self.slot[ids] = np.arange(len(ids))
-        self.specular = np.array([bool(m.is_specular) for m in self.materials], dtype=bool)
-        self.emitter = np.array([bool(m.is_emitter) for m in self.materials], dtype=bool)
-        # Neither a BRDF nor scattering (a DiffuseLight): light arriving there ends.
+        self.is_specular = np.array([bool(m.is_specular) for m in self.materials], dtype=bool)
+        self.is_emitter = np.array([bool(m.is_emitter) for m in self.materials], dtype=bool)
         self.inert = np.array(
-            [not (k.evaluates or k.scatters) for k in (self.kernels[i] for i in self.kind)],
+            [not (k.has_brdf or k.scatters) for k in (self.kernels[i] for i in self.kind)],
             dtype=bool,
         )
+        self.reads_uv = any(k.reads_uv for k in self.kernels)
+        self.reads_tangent = any(k.reads_tangent for k in self.kernels)
 
     def _groups(
         self, ids: np.ndarray, hits: HitBatch, flag: str | None = None
@@ -98,42 +124,57 @@ class MaterialTable:
                 rows = np.flatnonzero(kind == k)
                 yield kernel, rows, slots.take(rows), hits.take(rows)
 
+    def _colors(self, method: str, flag: str | None, fill: float, ids, hits, *args) -> np.ndarray:
+        """(N, 3) of the kernels' `method`, `fill` for the hits of kernels without `flag`."""
+        out = np.full((len(hits), 3), fill)
+        for kernel, rows, slots, part in self._groups(ids, hits, flag):
+            if isinstance(rows, slice):
+                return getattr(kernel, method)(slots, part, *args)  # one kernel has all the hits
+            value = getattr(kernel, method)(slots, part, *(a.take(rows, axis=0) for a in args))
+            put_rows(out, rows, value)
+        return out
+
     def flat_color(self, ids: np.ndarray, hits: HitBatch) -> np.ndarray:
         """(N, 3) as Material.flat_color: the albedo's value, white without one."""
-        out = np.ones((len(hits), 3))
-        for kernel, rows, slots, part in self._groups(ids, hits):
-            out[rows] = kernel.flat_color(slots, part)
-        return out
+        return self._colors("flat_color", None, 1.0, ids, hits)
 
-    def emitted(self, ids: np.ndarray, hits: HitBatch) -> np.ndarray:
+    def emitting(self, ids: np.ndarray, hits: HitBatch) -> np.ndarray:
         """(N, 3) as Material.emitting: radiance emitted back along the arriving rays."""
-        out = np.zeros((len(hits), 3))
-        for kernel, rows, slots, part in self._groups(ids, hits, "emits"):
-            if isinstance(rows, slice):
-                return kernel.emitted(slots, part)  # one kernel has all the hits
-            put_rows(out, rows, kernel.emitted(slots, part))
-        return out
+        return self._colors("emitting", "emits", 0.0, ids, hits)
 
-    def eval(
+    def BRDF(self, ids: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
+        """(N, 3) as Material.BRDF: f_r for light directions wi (N, 3) leaving the
+        surface (0 for specular materials, as their scalar methods)."""
+        return self._colors("BRDF", "has_brdf", 0.0, ids, hits, wi)
+
+    def pdf(self, ids: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
+        """(N,) as Material.pdf: the density with which scattering() picks wi."""
+        pdf = np.zeros(len(hits))
+        for kernel, rows, slots, part in self._groups(ids, hits, "has_brdf"):
+            if isinstance(rows, slice):
+                return kernel.pdf(slots, part, wi)  # one kernel has all the hits
+            pdf[rows] = kernel.pdf(slots, part, wi.take(rows, axis=0))
+        return pdf
+
+    def BRDF_and_pdf(
         self, ids: np.ndarray, hits: HitBatch, wi: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
-        """(f_r (N, 3), pdf (N,)) as BRDF() and pdf() for light directions wi (N, 3)
-        leaving the surface (0 for specular materials, as their scalar methods)."""
+        """(BRDF(), pdf()) at once, as light sampling needs them."""
         f, pdf = np.zeros((len(hits), 3)), np.zeros(len(hits))
-        for kernel, rows, slots, part in self._groups(ids, hits, "evaluates"):
+        for kernel, rows, slots, part in self._groups(ids, hits, "has_brdf"):
             if isinstance(rows, slice):
-                return kernel.eval(slots, part, wi)  # one kernel has all the hits
-            fk, pdf[rows] = kernel.eval(slots, part, wi.take(rows, axis=0))
+                return kernel.BRDF_and_pdf(slots, part, wi)  # one kernel has all the hits
+            fk, pdf[rows] = kernel.BRDF_and_pdf(slots, part, wi.take(rows, axis=0))
             put_rows(f, rows, fk)
         return f, pdf
 
-    def sample(self, ids: np.ndarray, hits: HitBatch, rng: np.random.Generator) -> ScatterBatch:
-        """One scattering() sample per hit, drawn from `rng`."""
+    def scattering(self, ids: np.ndarray, hits: HitBatch, rng: np.random.Generator) -> ScatterBatch:
+        """One Material.scattering sample per hit, drawn from `rng`."""
         out = ScatterBatch.absorbed(len(hits))
         for kernel, rows, slots, part in self._groups(ids, hits, "scatters"):
             if isinstance(rows, slice):
-                return kernel.sample(slots, part, rng)  # one kernel has all the hits
-            out.put(rows, kernel.sample(slots, part, rng))
+                return kernel.scattering(slots, part, rng)  # one kernel has all the hits
+            out.put(rows, kernel.scattering(slots, part, rng))
         return out
 
     def specular_rays(self, ids: np.ndarray, hits: HitBatch) -> SpecularRays:

@@ -1,0 +1,303 @@
+"""Culling for primitive sets: a bounding volume hierarchy, and clusters of planar primitives.
+
+BVH is the batched twin of rtpy/bvh.py: a binary tree of axis-aligned boxes (binned
+surface area heuristic) stored as arrays, which all rays of a batch descend together,
+level by level, so a set of hundreds of spheres costs only the boxes and primitives
+each ray comes near.
+
+Clusters serve a brute-force set of planar primitives (a few dozen quads, as the
+Cornell box): connected groups of primitives (the six quads of a box) are culled by
+their bounding box, so a ray tests their primitives only when it enters the box
+before the closest hit found so far.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .arrays import max3
+
+if TYPE_CHECKING:
+    from .hittable import PrimitiveSet
+
+BVH_LEAF_SIZE = 4
+# Clusters hold at least CLUSTER_SIZE primitives, and their box has at most CLUSTER_AREA
+# of the surface area of the whole set's box.
+CLUSTER_SIZE = 3
+CLUSTER_AREA = 0.5
+
+
+class BVH:
+    """A binary BVH over K axis-aligned boxes (binned SAH), stored as arrays.
+
+    Node i has box lo[i], hi[i]; an inner node has children left[i], right[i]; a
+    leaf (count[i] > 0) holds primitives order[start[i] : start[i] + count[i]].
+    """
+
+    def __init__(self, lo: np.ndarray, hi: np.ndarray, leaf_size: int = BVH_LEAF_SIZE) -> None:
+        k = len(lo)
+        centroid = 0.5 * (lo + hi)
+        nodes_lo, nodes_hi, left, right, start, count = [], [], [], [], [], []
+        order: list[int] = []
+
+        def build(idx: np.ndarray) -> int:
+            node = len(nodes_lo)
+            nodes_lo.append(lo[idx].min(axis=0))
+            nodes_hi.append(hi[idx].max(axis=0))
+            left.append(-1)
+            right.append(-1)
+            start.append(0)
+            count.append(0)
+            split = None if len(idx) <= leaf_size else self._sah_split(idx, lo, hi, centroid)
+            if split is None:
+                start[node] = len(order)
+                count[node] = len(idx)
+                order.extend(idx.tolist())
+                return node
+            a, b = split
+            left[node] = build(a)
+            right[node] = build(b)
+            return node
+
+        build(np.arange(k))
+        self.lo = np.array(nodes_lo)
+        self.hi = np.array(nodes_hi)
+        self.left = np.array(left, dtype=np.int64)
+        self.right = np.array(right, dtype=np.int64)
+        self.start = np.array(start, dtype=np.int64)
+        self.count = np.array(count, dtype=np.int64)
+        self.order = np.array(order, dtype=np.int64)
+
+    @staticmethod
+    def _sah_split(idx, lo, hi, centroid, bins: int = 16):
+        """Split idx in two by the cheapest of `bins` planes per axis (surface area
+        heuristic), or None when keeping a leaf is cheaper."""
+
+        def area(a, b):
+            e = np.maximum(b - a, 0.0)
+            return 2.0 * (e[..., 0] * e[..., 1] + e[..., 1] * e[..., 2] + e[..., 2] * e[..., 0])
+
+        c = centroid[idx]
+        best = (area(lo[idx].min(0), hi[idx].max(0)) * len(idx), None)
+        for axis in range(3):
+            cmin, cmax = c[:, axis].min(), c[:, axis].max()
+            if not cmax > cmin:
+                continue
+            b = np.minimum(((c[:, axis] - cmin) / (cmax - cmin) * bins).astype(int), bins - 1)
+            for plane in range(1, bins):
+                m = b < plane
+                n_left = int(m.sum())
+                if n_left == 0 or n_left == len(idx):
+                    continue
+                il, ir = idx[m], idx[~m]
+                cost = area(lo[il].min(0), hi[il].max(0)) * len(il) + area(
+                    lo[ir].min(0), hi[ir].max(0)
+                ) * len(ir)
+                if cost < best[0]:
+                    best = (cost, (il, ir))
+        if best[1] is None and len(idx) > 4 * BVH_LEAF_SIZE:
+            # All centroids together (or no better split): halve by index.
+            half = len(idx) // 2
+            return idx[:half], idx[half:]
+        return best[1]
+
+    def traverse(
+        self,
+        o: np.ndarray,
+        d: np.ndarray,
+        t_min: float,
+        t_max: np.ndarray,
+        test: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
+        any_hit: bool = False,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Closest (or any) hit of every ray among the primitives.
+
+        test(ray_index, prim_index, t_max_pairs) -> t of each (ray, primitive) pair
+        (inf for a miss). Returns (t, prim) per ray: t_max and -1 where nothing is
+        hit before t_max. All rays descend the tree together, one level per
+        iteration; leaves found at a level are tested at once and shrink the rays'
+        t_max, which prunes the boxes of later levels.
+        """
+        n = len(o)
+        best_t = np.array(t_max, dtype=np.float64, copy=True)
+        best_p = np.full(n, -1, dtype=np.int64)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            safe = np.where(np.abs(d) < 1e-300, np.copysign(1e-300, d), d)
+            inv = 1.0 / safe
+        ray = np.arange(n)
+        node = np.zeros(n, dtype=np.int64)
+        done = np.zeros(n, dtype=bool)
+        while ray.size:
+            ro, ri = o[ray], inv[ray]
+            with np.errstate(invalid="ignore", over="ignore"):
+                t0 = (self.lo[node] - ro) * ri
+                t1 = (self.hi[node] - ro) * ri
+            near = max3(np.minimum(t0, t1))
+            lo = np.maximum(t0, t1)
+            far = np.minimum(np.minimum(lo[:, 0], lo[:, 1]), lo[:, 2])
+            keep = (near <= far) & (far > t_min) & (near < best_t[ray])
+            if any_hit:
+                keep &= ~done[ray]
+            ray, node = ray[keep], node[keep]
+            leaf = self.count[node] > 0
+            if leaf.any():
+                lr, ln = ray[leaf], node[leaf]
+                cnt = self.count[ln]
+                pr = np.repeat(lr, cnt)
+                first = np.repeat(self.start[ln] - (np.cumsum(cnt) - cnt), cnt)
+                pp = self.order[first + np.arange(len(pr))]
+                t = test(pr, pp, best_t[pr])
+                hit = t < best_t[pr]
+                if hit.any():
+                    pr, pp, t = pr[hit], pp[hit], t[hit]
+                    if any_hit:
+                        done[pr] = True
+                        best_t[pr] = t
+                        best_p[pr] = pp
+                    else:
+                        np.minimum.at(best_t, pr, t)
+                        win = t == best_t[pr]
+                        best_p[pr[win]] = pp[win]
+                inner = ~leaf
+                ray, node = ray[inner], node[inner]
+            ray = np.concatenate([ray, ray])
+            node = np.concatenate([self.left[node], self.right[node]])
+        return best_t, best_p
+
+
+class Clusters:
+    """A brute-force set split into parts: the first without a box (the primitives in
+    no cluster, tested by every ray), then one part per cluster, each its own set of
+    the same kind with the box around its primitives.
+
+    parts     [(box lo or None, box hi or None, the part as a set, its members)]
+    part_of   (K,) the part of each primitive of the whole set
+    part_pos  (K,) its index in that part
+    """
+
+    def __init__(self, prims: PrimitiveSet, groups: list[np.ndarray]) -> None:
+        lo, hi = prims.bounding_boxes()
+        self.parts: list[tuple] = []
+        self.part_of = np.empty(len(prims), dtype=np.int64)
+        self.part_pos = np.empty(len(prims), dtype=np.int64)
+        for g, members in enumerate(groups):
+            if g == 0 and members.size == 0:
+                continue
+            sub = type(prims)([prims.objects[i] for i in members], cluster=False)
+            box = (None, None) if g == 0 else _padded_box(lo[members], hi[members])
+            self.part_of[members] = len(self.parts)
+            self.part_pos[members] = np.arange(members.size)
+            self.parts.append((*box, sub, members))
+
+    @classmethod
+    def build(cls, prims: PrimitiveSet) -> Clusters | None:
+        """The clusters of a planar set, or None when they would cull nothing."""
+        if len(prims) < 2 * CLUSTER_SIZE:
+            return None
+        groups = cluster_parts(prims.corners(), *prims.bounding_boxes())
+        return cls(prims, groups) if len(groups) >= 2 else None
+
+    def closest_hit(self, o, d, t_min, t_max, any_hit, ignore):
+        """PrimitiveSet.closest_hit over the parts: each clustered part only for the
+        rays that enter its box before the closest hit found so far (so the part
+        without a box goes first)."""
+        t_best = np.array(t_max, dtype=np.float64, copy=True)
+        idx = np.full(len(o), -1, dtype=np.int64)
+        oc = np.ascontiguousarray(o.T)
+        with np.errstate(divide="ignore"):
+            inv = 1.0 / np.ascontiguousarray(d.T)
+        for p, (lo, hi, part, members) in enumerate(self.parts):
+            if lo is None:
+                rays = None
+                ro, rd, rt = o, d, t_best
+            else:
+                enter = _enters_box(oc, inv, lo, hi, t_min, t_best)
+                if any_hit:
+                    enter &= idx < 0
+                rays = np.flatnonzero(enter)
+                if rays.size == 0:
+                    continue
+                ro, rd, rt = o.take(rays, axis=0), d.take(rays, axis=0), t_best.take(rays)
+            local_ignore = None
+            if ignore is not None:
+                ig = ignore if rays is None else ignore.take(rays)
+                k = np.maximum(ig, 0)
+                mine = (ig >= 0) & (self.part_of.take(k) == p)
+                local_ignore = np.where(mine, self.part_pos.take(k), -1)
+            t, k = part.closest_hit(ro, rd, t_min, rt, any_hit, local_ignore)
+            hit = np.flatnonzero(k >= 0)
+            w = hit if rays is None else rays.take(hit)
+            t_best[w] = t.take(hit)
+            idx[w] = members.take(k.take(hit))
+        return t_best, idx
+
+
+def cluster_parts(corners: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
+    """Groups of primitives worth culling together by one bounding box, as index arrays;
+    the first holds the primitives in no such group (possibly none).
+
+    A group is a connected set of primitives sharing corners (up to 1e-5 of the set's
+    size: the six quads of a box), of at least CLUSTER_SIZE primitives, whose box has
+    at most CLUSTER_AREA of the surface area of the whole set's box. In the Cornell
+    box the two boxes are groups (a ray enters their boxes ~20% and ~15% of the time),
+    the walls (whose box is the whole set's) and the light are not."""
+    k = len(corners)
+    extent = hi.max(axis=0) - lo.min(axis=0)
+    tol = 1e-5 * float(extent.max())
+    root = list(range(k))
+
+    def find(i: int) -> int:
+        while root[i] != i:
+            i = root[i]
+        return i
+
+    for i in range(k):
+        for j in range(i + 1, k):
+            gap = np.abs(corners[i][:, None, :] - corners[j][None, :, :]).max(axis=2)
+            if gap.min() <= tol:
+                root[find(j)] = find(i)
+    comps: dict[int, list[int]] = {}
+    for i in range(k):
+        comps.setdefault(find(i), []).append(i)
+    whole = _box_area(lo.min(axis=0), hi.max(axis=0))
+    free, groups = [], []
+    for members in comps.values():
+        m = np.array(members, dtype=np.int64)
+        small = _box_area(lo[m].min(axis=0), hi[m].max(axis=0)) <= CLUSTER_AREA * whole
+        if len(m) >= CLUSTER_SIZE and small:
+            groups.append(m)
+        else:
+            free.extend(members)
+    return [np.array(sorted(free), dtype=np.int64), *groups] if groups else []
+
+
+def _box_area(lo: np.ndarray, hi: np.ndarray) -> float:
+    e = np.maximum(hi - lo, 0.0)
+    return float(2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]))
+
+
+def _padded_box(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The box around boxes lo, hi (K, 3), padded so rounding in the slab test cannot
+    cull a ray that grazes a primitive on the box's boundary."""
+    lo, hi = lo.min(axis=0), hi.max(axis=0)
+    pad = 1e-7 * (float((hi - lo).max()) + float(np.abs(lo).max()) + float(np.abs(hi).max()))
+    return lo - pad, hi + pad
+
+
+def _enters_box(oc, inv, lo, hi, t_min: float, t_max: np.ndarray) -> np.ndarray:
+    """(N,) bool: rays (origin columns oc (3, N), reciprocal direction columns inv)
+    meet the box lo, hi at some t in (t_min, t_max) (slab test, one axis at a time).
+    A zero direction component gives inv = +-inf; then (lo - o) * inv is nan only for
+    an origin exactly on a slab plane, and nan comparisons count as entering."""
+    near = far = None
+    with np.errstate(invalid="ignore"):
+        for c in range(3):
+            a = (lo[c] - oc[c]) * inv[c]
+            b = (hi[c] - oc[c]) * inv[c]
+            n_c, f_c = np.minimum(a, b), np.maximum(a, b)
+            near = n_c if near is None else np.fmax(near, n_c)
+            far = f_c if far is None else np.fmin(far, f_c)
+        return ~((near > far) | (far <= t_min) | (near >= t_max))

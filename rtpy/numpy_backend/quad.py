@@ -1,0 +1,125 @@
+"""QuadSet: all quads of a scene as arrays, the batched twin of rtpy/quad.py.
+
+The all-pairs test is written as (N, 4) x (4, K) matrix products, an algebraically
+equal form of Quad.hit_t whose t agrees with the scalar one to ~1e-15.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..quad import Quad
+from .arrays import at, axpy, dot
+from .hittable import INF, PlanarSet
+from .vec3 import rows_of
+
+# Quads accept hits this little outside their edges (in units of the edge length):
+# rounding differs from the scalar formula's, and without the margin a ray exactly
+# along the shared edge of two quads (a corner of a closed box) could slip between.
+EDGE_A = 1e-9
+EDGE = 1.0 + 2.0 * EDGE_A  # the same margin for |2a - 1| <= 1
+
+
+class QuadSet(PlanarSet):
+    """Quads q + a u + b v, a, b in [0, 1]; geometric normal normalize(u x v).
+
+    With w = n / (n . n) for n = u x v, the scalar coordinates of a point p are
+    a = w . ((p - q) x v) = (p - q) . (v x w) and b = w . (u x (p - q)) = (p - q) . (w x u),
+    so for p = o + t d: a = o . A + t (d . A) - q . A with A = v x w (B = w x u likewise).
+    """
+
+    def __init__(self, quads: Sequence[Quad], cluster: bool = True) -> None:
+        super().__init__(quads)
+        self.q = rows_of(s.q for s in quads)
+        self.u = rows_of(s.u for s in quads)
+        self.v = rows_of(s.v for s in quads)
+        self.w = rows_of(s.w for s in quads)
+        self.plane_d = np.array([float(s.d) for s in quads], dtype=np.float64)
+        self.A = np.cross(self.v, self.w)
+        self.B = np.cross(self.w, self.u)
+        self.qA = dot(self.q, self.A)
+        self.qB = dot(self.q, self.B)
+        # Products for all_t: (4, K) for homogeneous origins, (3, K) for directions.
+        self.Mo_n = np.vstack([-self.normal.T, self.plane_d])
+        self.Mo_a = np.vstack([2.0 * self.A.T, -2.0 * self.qA - 1.0])
+        self.Mo_b = np.vstack([2.0 * self.B.T, -2.0 * self.qB - 1.0])
+        self.Md_n = self.normal.T.copy()
+        self.Md_a = 2.0 * self.A.T
+        self.Md_b = 2.0 * self.B.T
+        self.build_culling(cluster)
+
+    def corners(self):
+        return np.stack([self.q, self.q + self.u, self.q + self.v, self.q + self.u + self.v], 1)
+
+    def all_t(self, o, d, t_min, t_max=None):
+        """As PrimitiveSet.all_t. With t_max (N,) (occlusion), the edges are tested
+        only for the quads whose plane some ray crosses in (t_min, t_max): a shadow
+        ray inside a room crosses none of the walls' planes."""
+        # Homogeneous o: one product gives d - o.n and 2 (o.A - q.A) - 1 (and for B),
+        # so a' = 2a - 1 and b' = 2b - 1 need one multiply-add each and the test
+        # 0 <= a, b <= 1 becomes max(|a'|, |b'|) <= 1.
+        oh = np.empty((len(o), 4))
+        oh[:, :3] = o
+        oh[:, 3] = 1.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (oh @ self.Mo_n) / (d @ self.Md_n)
+            if t_max is None:
+                return self._inside(oh, d, t, t_min, slice(None))
+            crossed = (t > t_min) & (t < t_max[:, None])
+            cols = np.flatnonzero(crossed.any(axis=0))
+            if cols.size == len(self):
+                return self._inside(oh, d, t, t_min, slice(None))
+            out = np.full(t.shape, INF)
+            if cols.size:
+                out[:, cols] = self._inside(oh, d, t[:, cols], t_min, cols)
+            return out
+
+    def _inside(self, oh, d, t, t_min, cols):
+        """t where the hits at t on the quads cols lie inside them (else inf)."""
+        a = oh @ self.Mo_a[:, cols]
+        a += t * (d @ self.Md_a[:, cols])
+        b = oh @ self.Mo_b[:, cols]
+        b += t * (d @ self.Md_b[:, cols])
+        np.abs(a, out=a)
+        np.abs(b, out=b)
+        np.maximum(a, b, out=a)
+        ok = a <= EDGE
+        ok &= t > t_min
+        return np.where(ok, t, INF)
+
+    def hit_t(self, o, d, k, t_min, t_max):
+        n = self.normal[k]
+        A, B = self.A[k], self.B[k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (self.plane_d[k] - dot(n, o)) / dot(n, d)
+            a = dot(o, A) - self.qA[k] + t * dot(d, A)
+            b = dot(o, B) - self.qB[k] + t * dot(d, B)
+        ok = (t > t_min) & (t < t_max) & (a >= -EDGE_A) & (a <= 1.0 + EDGE_A)
+        ok &= (b >= -EDGE_A) & (b <= 1.0 + EDGE_A)
+        return np.where(ok, t, INF)
+
+    def surface_uv(self, k, point):
+        # Quad._coords, then clamped to [0, 1].
+        q, w, u, v = self.q[k], self.w[k], self.u[k], self.v[k]
+        px, py, pz = point[:, 0] - q[:, 0], point[:, 1] - q[:, 1], point[:, 2] - q[:, 2]
+        a = (
+            w[:, 0] * (py * v[:, 2] - pz * v[:, 1])
+            + w[:, 1] * (pz * v[:, 0] - px * v[:, 2])
+            + w[:, 2] * (px * v[:, 1] - py * v[:, 0])
+        )
+        b = (
+            w[:, 0] * (u[:, 1] * pz - u[:, 2] * py)
+            + w[:, 1] * (u[:, 2] * px - u[:, 0] * pz)
+            + w[:, 2] * (u[:, 0] * py - u[:, 1] * px)
+        )
+        return np.clip(a, 0.0, 1.0), np.clip(b, 0.0, 1.0)
+
+    def sample_point(self, k, r1, r2):
+        # q + r1 u + r2 v, column by column
+        p = axpy(r1, at(self.u, k), at(self.q, k))
+        v = at(self.v, k)
+        for c in range(3):
+            p[:, c] += r2 * v[..., c]
+        return p, at(self.normal, k)

@@ -1,0 +1,27 @@
+"""Rays leaving surfaces, many at once: the batched rtpy.ray.
+
+A batch of rays is two (N, 3) arrays, origins and unit directions; a point on a ray
+is origin + t direction (arrays.axpy). Rays that leave a surface start a little off
+it, exactly as rtpy.ray.spawn_ray places them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..ray import SPAWN_ABSOLUTE_OFFSET, SPAWN_RELATIVE_OFFSET
+from .arrays import axpy, dot, max3
+
+
+def offset_scale(p: np.ndarray) -> np.ndarray:
+    """rtpy.ray.offset_scale for (N, 3) points: how far a ray leaving p starts off it."""
+    return SPAWN_ABSOLUTE_OFFSET + SPAWN_RELATIVE_OFFSET * max3(np.abs(p))
+
+
+def spawn_origins(point: np.ndarray, normal: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Origins of rtpy.ray.spawn_ray(point, normal, direction) for (N, 3) arrays: the
+    point pushed off the surface along the normal to the side the direction goes."""
+    eps = offset_scale(point)
+    below = dot(direction, normal) < 0.0
+    np.negative(eps, out=eps, where=below)
+    return axpy(eps, normal, point)

@@ -1,0 +1,103 @@
+"""NumpyBackend: the numpy backend of rtpy.renderer's one renderer loop.
+
+The loop (rtpy/renderer.py) is the scalar renderer's: units of work (batch, tile),
+run batch by batch on one or more processes, each unit drawing from its own
+generator seeded by (seed, tile, batch), and sums combined in a fixed order, so the
+same seed gives the same image, bit for bit, with any number of worker processes.
+What differs is the unit: all samples of the batch for every pixel of a tile are
+traced together as one wavefront of at most MAX_RAYS paths, so memory is bounded
+by the unit size, not by image size times spp. (The scalar and numpy backends draw
+different random numbers: their images agree up to Monte Carlo noise, not bit for
+bit.)
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import sys
+from collections.abc import Callable
+from functools import partial
+
+import numpy as np
+
+from ..renderer import Backend, Unit
+from ..renderer import plan_units as scalar_plan_units
+from .camera import CameraRays
+from .integrators import BatchIntegrator, make_integrator
+from .sampling import make_generator
+from .scene import BatchScene
+
+TILE_SIZE = 32
+# Camera samples per unit of work. Large, because after the first bounces few paths
+# live and each segment costs hundreds of numpy calls whatever their length; the
+# arrays of a unit's rays (a few MB each) bound the memory of a render.
+MAX_RAYS = 65536
+
+
+def plan_units(width: int, height: int, spp: int) -> list[Unit]:
+    """All units of work, batch-major: each tile's spp split into the fewest batches
+    that keep a unit at or under MAX_RAYS samples."""
+    n_batches = max(1, math.ceil(spp * TILE_SIZE * TILE_SIZE / MAX_RAYS))
+    return scalar_plan_units(width, height, spp, min(n_batches, spp), TILE_SIZE)
+
+
+def render_unit(
+    scene: BatchScene, rays: CameraRays, integrator: BatchIntegrator, seed: int, unit: Unit
+) -> np.ndarray:
+    """Sum of unit.spp radiance samples per pixel of the unit's tile: (h, w, 3)."""
+    rng = make_generator(seed, unit.tile, unit.batch)
+    h, w = unit.y1 - unit.y0, unit.x1 - unit.x0
+    j, i = np.divmod(np.arange(h * w), w)
+    i = np.repeat(i + unit.x0, unit.spp)
+    j = np.repeat(j + unit.y0, unit.spp)
+    if integrator.uses_center_ray:
+        o, d = rays.center_rays(i, j, rng)
+    else:
+        o, d = rays.jittered_rays(i, j, rng)
+    radiance = integrator.compute_scattering(o, d, scene, rng)
+    return radiance.reshape(h, w, unit.spp, 3).sum(axis=2)
+
+
+class NumpyBackend(Backend):
+    """Renders a unit of work as arrays: the scene as a BatchScene, camera rays from
+    CameraRays, the integrator's batched twin."""
+
+    name = "numpy"
+
+    def make_integrator(self) -> BatchIntegrator:
+        return make_integrator(self.settings)
+
+    def plan_units(self, width: int, height: int, spp: int) -> list[Unit]:
+        return plan_units(width, height, spp)
+
+    def start(self) -> Callable[[Unit], np.ndarray]:
+        keep_freed_memory()
+        scene, rays = BatchScene(self.scene), CameraRays(self.camera)
+        integrator = self.make_integrator()
+        return partial(render_unit, scene, rays, integrator, self.settings.seed)
+
+
+def keep_freed_memory() -> None:
+    """Ask glibc's malloc to keep freed blocks of up to 32 MB in the heap (Linux; a
+    no-op elsewhere). The backend allocates and frees the same temporaries of a few
+    hundred KB (arrays over a unit's rays) thousands of times per second; by default
+    glibc maps each one freshly from the kernel and unmaps it when it is freed, so
+    every page of every temporary faults on first touch, a large share of the render
+    time. This is malloc's documented tuning (mallopt, the MALLOC_MMAP_THRESHOLD_ and
+    MALLOC_TRIM_THRESHOLD_ variables), process-wide: the process keeps up to 128 MB of
+    freed memory for reuse instead of returning it."""
+    global _malloc_tuned
+    if _malloc_tuned or not sys.platform.startswith("linux"):
+        return
+    _malloc_tuned = True
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+        libc.mallopt(M_MMAP_THRESHOLD, 32 << 20)
+        libc.mallopt(M_TRIM_THRESHOLD, 128 << 20)
+    except (OSError, AttributeError):  # not glibc: keep the allocator's defaults
+        pass
+
+
+M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3  # glibc's <malloc.h>
+_malloc_tuned = False

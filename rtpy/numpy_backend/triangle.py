@@ -1,0 +1,96 @@
+"""TriangleSet: all triangles of a scene as arrays, the batched twin of rtpy/triangle.py.
+
+The all-pairs test is Moller-Trumbore in Plucker form, written as (N, 3) x (3, K)
+matrix products; its t agrees with Triangle.hit_t's to ~1e-15.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..triangle import Triangle
+from .arrays import dot
+from .hittable import INF, PlanarSet
+from .vec3 import rows_of
+
+
+class TriangleSet(PlanarSet):
+    """Triangles a, b, c; geometric normal normalize((b - a) x (c - a)).
+
+    Moller-Trumbore in Plucker form: with e1 = b - a, e2 = c - a, m = o x d and
+    N = e1 x e2, det = -(d . N), u det = e2 . m - d . (e2 x a),
+    v det = -(e1 . m) - d . (a x e1), t det = o . N - a . N (all K-sided factors
+    are precomputed; the ray-sided ones are (N, 3) x (3, K) products).
+    """
+
+    def __init__(self, triangles: Sequence[Triangle], cluster: bool = True) -> None:
+        super().__init__(triangles)
+        self.a = rows_of(s.a for s in triangles)
+        self.e1 = rows_of(s.e1 for s in triangles)
+        self.e2 = rows_of(s.e2 for s in triangles)
+        # Triangle's relative parallel test: det^2 <= parallel_det2 * |d|^2 is a miss.
+        self.parallel_det2 = np.array([s._parallel_det2 for s in triangles], dtype=np.float64)
+        self.N = np.cross(self.e1, self.e2)
+        self.e2xa = np.cross(self.e2, self.a)
+        self.axe1 = np.cross(self.a, self.e1)
+        self.aN = dot(self.a, self.N)
+        # o-side: [N]; d-side: [N, e2 x a, a x e1]; m-side: [e2, e1]
+        self.Mo = self.N.T.copy()
+        self.Md = np.concatenate([self.N, self.e2xa, self.axe1], axis=0).T.copy()
+        self.Mm = np.concatenate([self.e2, self.e1], axis=0).T.copy()
+        self.build_culling(cluster)
+
+    def corners(self):
+        return np.stack([self.a, self.a + self.e1, self.a + self.e2], 1)
+
+    def _finish(self, det, parallel, u_num, v_num, t_num, t_min, t_max):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = 1.0 / det
+            u = u_num * inv
+            v = v_num * inv
+            t = t_num * inv
+        ok = (det * det > parallel) & (u >= 0.0) & (u <= 1.0) & (v >= 0.0) & (u + v <= 1.0)
+        ok &= (t > t_min) & (t < t_max)
+        return np.where(ok, t, INF)
+
+    def all_t(self, o, d, t_min, t_max=None):
+        k = len(self)
+        m = np.cross(o, d)
+        on = o @ self.Mo
+        dd = d @ self.Md
+        mm = m @ self.Mm
+        det = -dd[:, :k]
+        u_num = mm[:, :k] - dd[:, k : 2 * k]
+        v_num = -mm[:, k:] - dd[:, 2 * k :]
+        t_num = on - self.aN
+        parallel = self.parallel_det2 * dot(d, d)[:, None]
+        return self._finish(det, parallel, u_num, v_num, t_num, t_min, INF)
+
+    def hit_t(self, o, d, k, t_min, t_max):
+        m = np.cross(o, d)
+        nn = self.N[k]
+        det = -dot(d, nn)
+        u_num = dot(self.e2[k], m) - dot(d, self.e2xa[k])
+        v_num = -dot(self.e1[k], m) - dot(d, self.axe1[k])
+        t_num = dot(o, nn) - self.aN[k]
+        parallel = self.parallel_det2[k] * dot(d, d)
+        return self._finish(det, parallel, u_num, v_num, t_num, t_min, t_max)
+
+    def surface_uv(self, k, point):
+        # Triangle.surface_uv: barycentric coordinates from dot products.
+        p = point - self.a[k]
+        e1, e2 = self.e1[k], self.e2[k]
+        d00, d01, d11 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
+        d20, d21 = dot(p, e1), dot(p, e2)
+        denom = d00 * d11 - d01 * d01
+        u = (d11 * d20 - d01 * d21) / denom
+        v = (d00 * d21 - d01 * d20) / denom
+        return np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
+
+    def sample_point(self, k, r1, r2):
+        s = np.sqrt(r1)
+        wb, wc = s * (1.0 - r2), s * r2
+        p = self.a[k] + wb[:, None] * self.e1[k] + wc[:, None] * self.e2[k]
+        return p, self.normal[k]

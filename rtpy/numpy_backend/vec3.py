@@ -1,0 +1,71 @@
+"""n vectors as three (n,) columns: the batched rtpy.vec3 for formulas written per component.
+
+Where a formula reads best component by component (a material's local directions,
+a frame's axes), a batch of n vectors is a tuple (x, y, z) of (n,) arrays, so the
+kernels read like the scalar code, which writes `v.e0 * n.e0 + ...` or `wo[0] * wi[0]
++ ...`. Where vectors are stored and gathered (HitBatch, rays), they are (n, 3) arrays;
+`components` and `stack` convert, and `row`, `rows_of` and `to_vec3` convert from and
+to the scalar Vec3. Every function uses the scalar code's operations in
+the scalar code's order, so the results agree to the last bit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from ..vec3 import Vec3
+from .arrays import Rows
+
+Columns = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def components(a: np.ndarray) -> Columns:
+    """The columns of an (n, 3) array."""
+    return a[:, 0], a[:, 1], a[:, 2]
+
+
+def stack(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """(n, 3) array from three (n,) columns."""
+    return np.stack((x, y, z), axis=1)
+
+
+def take(v: Columns, rows: Rows) -> Columns:
+    """The rows `rows` of every column."""
+    return v[0][rows], v[1][rows], v[2][rows]
+
+
+def dot(a: Columns, b: Columns) -> np.ndarray:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def reflect(v: Columns, n: Columns) -> Columns:
+    """rtpy.vec3.reflect: v mirrored about the plane with unit normal n."""
+    k = 2.0 * dot(v, n)
+    return v[0] - k * n[0], v[1] - k * n[1], v[2] - k * n[2]
+
+
+def refract(uv: Columns, n: Columns, etai_over_etat: np.ndarray) -> Columns:
+    """rtpy.vec3.refract: Snell refraction of the unit vectors uv (pointing toward the
+    surface) through the unit normals n facing them. The caller checks for total
+    internal reflection."""
+    cos_theta = np.minimum(-dot(uv, n), 1.0)
+    perp = tuple((uv[c] + n[c] * cos_theta) * etai_over_etat for c in range(3))
+    s = -np.sqrt(np.abs(1.0 - dot(perp, perp)))
+    return perp[0] + n[0] * s, perp[1] + n[1] * s, perp[2] + n[2] * s
+
+
+def row(v: Vec3) -> np.ndarray:
+    """A Vec3 as a (3,) float64 array."""
+    return np.array([float(v.e0), float(v.e1), float(v.e2)])
+
+
+def rows_of(vectors: Iterable[Vec3]) -> np.ndarray:
+    """(K, 3) float64 array of K Vec3s (K may be 0)."""
+    return np.array([[float(v.e0), float(v.e1), float(v.e2)] for v in vectors]).reshape(-1, 3)
+
+
+def to_vec3(a: np.ndarray) -> Vec3:
+    """A (3,) row as a Vec3 of Python floats (for the scalar code)."""
+    return Vec3(float(a[0]), float(a[1]), float(a[2]))

@@ -1,0 +1,129 @@
+"""The numpy backend of the renderer loop: its work units, determinism across workers,
+Ctrl-C, a material without a kernel, the `backend=` of rtpy.render and `--backend` of
+the command line."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rtpy
+from rtpy.io.cli import main
+from rtpy.materials.material import Material
+from rtpy.numpy_backend.materials.fallback import ScalarFallback
+from rtpy.numpy_backend.renderer import MAX_RAYS, plan_units
+from rtpy.ray import spawn_ray
+from rtpy.scatter_info import ScatterInfo
+from rtpy.vec3 import Color
+
+from ..test_renderer import InterruptAfter, small_scene
+from .test_agreement import SEEDS, compare
+
+
+@pytest.mark.parametrize("width,height,spp", [(1, 1, 1), (40, 33, 7), (100, 3, 64), (64, 64, 100)])
+def test_units_cover_every_pixel_with_spp_samples_and_bounded_size(width, height, spp):
+    counts = np.zeros((height, width), dtype=int)
+    units = plan_units(width, height, spp)
+    for unit in units:
+        counts[unit.y0 : unit.y1, unit.x0 : unit.x1] += unit.spp
+        assert (unit.y1 - unit.y0) * (unit.x1 - unit.x0) * unit.spp <= MAX_RAYS
+    np.testing.assert_array_equal(counts, spp)
+    batches = [u.batch for u in units]
+    assert batches == sorted(batches)
+
+
+def test_same_seed_same_image_for_any_worker_count():
+    scene, camera = small_scene()
+    camera = camera.with_width(70)  # several tiles
+    kw = dict(camera=camera, spp=20, seed=9, backend="numpy")  # and batches
+    one = rtpy.render(scene, workers=1, **kw)
+    two = rtpy.render(scene, workers=2, **kw)
+    np.testing.assert_array_equal(one.linear, two.linear)
+    kw["seed"] = 10
+    assert not np.array_equal(one.linear, rtpy.render(scene, **kw).linear)
+
+
+def test_render_reports_samples_speed_and_memory():
+    scene, camera = small_scene()
+    image = rtpy.render(scene, camera=camera, spp=3, backend="numpy")
+    assert (image.samples_min, image.samples_max, image.spp) == (3, 3, 3)
+    assert image.stats["paths"] == camera.width * camera.height * 3
+    assert image.stats["backend"] == "numpy"
+    assert image.stats["paths_per_second"] > 0 and image.stats["peak_rss_mb"] > 0
+    assert not image.interrupted and np.isfinite(image.linear).all()
+
+
+def test_ctrl_c_keeps_finished_tiles():
+    scene, camera = small_scene()
+    camera = camera.with_width(64)  # 64 x 36: tiles of 32 x 32, 32 x 32, 32 x 4, 32 x 4
+    scene.add_object(InterruptAfter(calls=32 * 32 * 2 + 100))  # during the second tile
+    image = rtpy.render(scene, camera=camera, spp=2, seed=1, integrator="jittered", backend="numpy")
+    assert image.interrupted
+    assert image.samples_min == 0 and image.samples_max == 2
+    assert image.stats["paths"] == 32 * 32 * 2  # the first tile, whole
+    assert (image.linear[:32, :32] > 0).all() and not image.linear[:, 32:].any()
+
+
+class Velvet(Material):
+    """A student's material: no batched twin, so its scalar methods run per hit."""
+
+    def __init__(self) -> None:
+        self.albedo_color = Color(0.3, 0.6, 0.3)
+
+    def scattering(self, ray_in, hit):
+        from rtpy.onb import local_to_world
+        from rtpy.sampling import random_cosine_direction
+
+        x, y, z = random_cosine_direction()
+        direction = local_to_world(hit.normal, x, y, z)
+        ray = spawn_ray(hit.point, hit.normal, direction)
+        return ScatterInfo(ray, self.albedo_color, z / np.pi)
+
+    def BRDF(self, ray_view, ray_light, hit):
+        return self.albedo_color * (1 / np.pi)
+
+    def pdf(self, ray_view, ray_light, hit):
+        n, wi = hit.normal, ray_light.direction
+        return max(0.0, n.e0 * wi.e0 + n.e1 * wi.e1 + n.e2 * wi.e2) / np.pi
+
+
+def test_a_material_without_a_kernel_renders_the_scalar_image(monkeypatch):
+    """Velvet has no kernel, so the numpy backend calls its scalar methods per hit: its
+    images agree with the scalar backend's block by block (test_agreement's z-test),
+    and the test sees a fallback that weights its samples wrongly."""
+    scene, camera = small_scene()
+    scene.objects[0].material = Velvet()
+    camera = camera.with_width(32)
+
+    def renders(backend: str) -> list[np.ndarray]:
+        kw = dict(camera=camera, spp=4, backend=backend)
+        return [rtpy.render(scene, seed=seed, **kw).linear for seed in SEEDS]
+
+    scalar = renders("scalar")
+    z, threshold, _, _ = compare(scalar, 4, renders("numpy"), 4)
+    assert z.max() < threshold
+
+    scattering = ScalarFallback.scattering
+
+    def brighter(self, slots, hits, rng):
+        out = scattering(self, slots, hits, rng)
+        out.attenuation *= 1.25
+        return out
+
+    monkeypatch.setattr(ScalarFallback, "scattering", brighter)
+    z, threshold, _, _ = compare(scalar, 4, renders("numpy"), 4)
+    assert z.max() > threshold
+
+
+def test_cli_backend_numpy(tmp_path, capsys):
+    out = tmp_path / "c.png"
+    linear = tmp_path / "c.npy"
+    argv = ["render", "cornell", "--backend", "numpy", "--width", "24", "--spp", "2"]
+    status = main([*argv, "-o", str(out), "--linear", str(linear), "--quiet"])
+    assert status == 0 and out.exists()
+    image = np.load(linear)
+    assert image.shape == (24, 24, 3) and image.max() > 0
+    assert "paths/s" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as err:
+        main([*argv[:2], "--backend", "gpu"])
+    assert err.value.code == 2
