@@ -18,8 +18,8 @@ week and of every later week replaced by
 
 (a later week's region is withheld too: it would hand out that week's answer, and
 several of them contain this week's, such as Cook-Torrance's Schlick factor or the
-path integrator's light sampling), the bundled scenes, `assignments/weekNN/` (README,
-graders, scenes, reference data) and the tests of rtpy that can pass there.
+path integrator's light sampling), the bundled scenes, docs/, `assignments/weekNN/`
+(README, graders, scenes, reference data) and the tests of rtpy that can pass there.
 
 Which tests ship is decided by `assignments/test_weeks.toml`: for each test file,
 the weeks whose solution regions it executes, as recorded by running the suite on
