@@ -7,7 +7,8 @@
 
 The modules follow the course's structure: vec3 / interval / ray / hit_info /
 scatter_info (utilities), camera, sphere / quad / triangle / scene (hittables),
-materials, light, texture, integrators, renderer.
+materials, light, texture, integrators, renderer. docs/course-map.md says where
+each name of the course's code is; docs/scene-format.md is the scene-file format.
 """
 
 from __future__ import annotations
@@ -18,12 +19,17 @@ from .interval import Interval
 from .io.image import RenderedImage
 from .light import PointLight
 from .materials import (
+    BlinnPhong,
+    CookTorrance,
     Dielectric,
     DiffuseLight,
     Lambertian,
     Material,
     Metal,
     Mirror,
+    OrenNayar,
+    Phong,
+    Ward,
     register_material,
 )
 from .quad import Quad
@@ -41,7 +47,7 @@ __version__ = "0.1.0"
 
 
 def load_scene(path_or_name: str):
-    """Load a scene file (TOML, see the README) or a bundled scene by name."""
+    """Load a scene file (TOML, see docs/scene-format.md) or a bundled scene by name."""
     from .io.bundled import resolve_scene
     from .io.scene_file import load_scene as _load
 
@@ -92,9 +98,11 @@ def render(
 
 
 __all__ = [
+    "BlinnPhong",
     "Camera",
     "CheckerTexture",
     "Color",
+    "CookTorrance",
     "Dielectric",
     "DiffuseLight",
     "HitInfo",
@@ -104,6 +112,8 @@ __all__ = [
     "Material",
     "Metal",
     "Mirror",
+    "OrenNayar",
+    "Phong",
     "Point3",
     "PointLight",
     "Quad",
@@ -118,6 +128,7 @@ __all__ = [
     "Texture",
     "Triangle",
     "Vec3",
+    "Ward",
     "load_scene",
     "register_material",
     "render",

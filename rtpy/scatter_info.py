@@ -10,10 +10,14 @@ class ScatterInfo:
     """The result of Material.scattering().
 
     scattered_ray  the scattered ray, leaving the surface (direction is a unit vector)
-    attenuation    the Monte Carlo weight of this sample: BRDF * cos(theta) / pdf,
-                   or for a specular (delta) bounce the fraction of light carried.
-                   (The course's attenuation_color is the BRDF value alone; here the
-                   cosine and the pdf are already in, as in RTIOW.)
+    attenuation    the Monte Carlo weight of this sample, BRDF * cos(theta) / pdf with
+                   theta the angle between the normal and the scattered direction, or
+                   for a specular (delta) bounce the fraction of light carried. The
+                   integrator multiplies the path's throughput by it, with no further
+                   cosine or pdf. This is not the course's attenuation_color,
+                   which is the BRDF value alone: here the cosine and 1/pdf are
+                   already in (for a cosine-sampled Lambertian surface the weight is
+                   exactly the albedo). See docs/course-map.md.
     pdf            solid-angle density the direction was drawn with (0 for specular)
     is_specular    True for delta bounces (mirror, metal, glass): no light sampling
                    there, and the pdf is not a density

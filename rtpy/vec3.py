@@ -157,3 +157,10 @@ def refract(uv: Vec3, n: Vec3, etai_over_etat: float) -> Vec3:
 
 BLACK = Color(0.0, 0.0, 0.0)
 WHITE = Color(1.0, 1.0, 1.0)
+
+
+# The course's names for three of the functions above, as Vec3's static methods
+# (`Vec3.dot_product(u, v)` is `dot(u, v)`), so the course's spelling works too.
+Vec3.dot_product = staticmethod(dot)
+Vec3.cross_product = staticmethod(cross)
+Vec3.unit_vector = staticmethod(unit_vector)

@@ -18,8 +18,8 @@ week and of every later week replaced by
 
 (a later week's region is withheld too: it would hand out that week's answer, and
 several of them contain this week's, such as Cook-Torrance's Schlick factor or the
-path integrator's light sampling), the bundled scenes, `assignments/weekNN/` (README,
-graders, scenes, reference data) and the tests of rtpy that can pass there.
+path integrator's light sampling), the bundled scenes, docs/, `assignments/weekNN/`
+(README, graders, scenes, reference data) and the tests of rtpy that can pass there.
 
 Which tests ship is decided by `assignments/test_weeks.toml`: for each test file,
 the weeks whose solution regions it executes, as recorded by running the suite on
@@ -54,11 +54,16 @@ BEGIN = re.compile(r"^(?P<indent>[ \t]*)# BEGIN SOLUTION week(?P<week>\d\d)(?::\
 END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
 
 # What the student repository holds besides rtpy/ (top-level names of the source tree).
-COPIED = ("pyproject.toml", ".gitignore", "scenes")
+COPIED = ("pyproject.toml", ".gitignore", "scenes", "docs")
 TEST_WEEKS_FILE = "assignments/test_weeks.toml"
-# Tests of the assignment machinery itself: they grade every week and generate
-# repositories, so they belong to rtpy only (and are not mapped).
-MACHINERY_TESTS = ("tests/grading/test_graders.py", "tests/grading/test_assignment.py")
+# Tests that belong to rtpy's own repository only (and are not mapped): the assignment
+# machinery's, which grade every week and generate repositories, and the checks of
+# rtpy's README (a student repository's README.md is the week's).
+MACHINERY_TESTS = (
+    "tests/grading/test_graders.py",
+    "tests/grading/test_assignment.py",
+    "tests/docs/test_pages.py",
+)
 # A test file that uses the numpy backend (withheld from student repositories).
 NUMPY_USE = re.compile(r"numpy_backend|[\"']numpy[\"']|rtpy\.BACKENDS")
 
@@ -309,7 +314,9 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
         + f"(`assignments/week{week}/`) and prints your score; "
         + f"`python -m pytest assignments/week{week} -x` shows the first failure's traceback, "
         + "and `python -m pytest` runs the graders with rtpy's own tests that apply this "
-        + "week. Left out because they "
+        + "week. `docs/students.md` explains how to work on an assignment and "
+        + "`docs/course-map.md` where each name of the course's code is in rtpy. "
+        + "Left out because they "
         + "test code you write this week or later, or the numpy backend (withheld here: "
         + "its vectorized code contains the solutions; render with the scalar backend):\n\n"
         + "".join(
@@ -395,7 +402,7 @@ def map_tests(
         head = "from __future__ import annotations\n"
         init.write_text(init.read_text().replace(head, head + "from . import _region_log\n", 1))
         (dest / "region_log_plugin.py").write_text(REGION_LOG_PLUGIN)
-        for name in (*COPIED, "tests", "README.md", "docs"):
+        for name in (*COPIED, "tests", "README.md"):
             path = root / name
             if path.is_dir():
                 shutil.copytree(path, dest / name, ignore=shutil.ignore_patterns("__pycache__"))
