@@ -28,7 +28,7 @@ from .materials import (
 )
 from .quad import Quad
 from .ray import Ray
-from .render_settings import RenderSettings
+from .render_settings import SETTINGS, RenderSettings
 from .renderer import Renderer
 from .scatter_info import ScatterInfo
 from .scene import Scene
@@ -68,7 +68,9 @@ def render(
     russian_roulette, seed, gamma, mis), background, sky, the camera width, or a
     whole `camera`. workers = number of processes; quiet = no progress bar.
     backend = "scalar" (the readable reference) or "numpy" (vectorized, many times
-    faster; the same image up to Monte Carlo noise).
+    faster; the same image up to Monte Carlo noise). A setting of the wrong type
+    raises TypeError, one out of its range ValueError, naming the setting
+    (rtpy.render_settings.SETTINGS lists them with their limits).
     """
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {backend!r}")
@@ -78,15 +80,15 @@ def render(
     if camera is None:
         raise ValueError("the scene has no camera: pass camera=rtpy.Camera(...)")
     if width is not None:
-        camera = camera.with_width(width)
+        camera = camera.with_width(SETTINGS["width"].check(width))
     if background is not None or sky is not None:
         import copy
 
         scene = copy.copy(scene)
         if background is not None:
-            scene.background = background
+            scene.background = SETTINGS["background"].check(background)
         if sky is not None:
-            scene.sky = sky
+            scene.sky = SETTINGS["sky"].check(sky)
     renderer_class = Renderer
     if backend == "numpy":
         from .numpy_backend.render import NumpyRenderer as renderer_class

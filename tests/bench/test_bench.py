@@ -27,14 +27,9 @@ import sys
 import numpy as np
 import pytest
 
-from rtpy.bench.run import (
-    ROUNDING,
-    SLOPE_TOLERANCE,
-    VARIANTS,
-    BenchResult,
-    fit_slope,
-    run_bench,
-)
+from rtpy.bench.convergence import ROUNDING, SLOPE_TOLERANCE, BenchResult, fit_slope
+from rtpy.bench.run import run_bench
+from rtpy.bench.scenes import VARIANTS
 from rtpy.io.cli import main
 
 SPP = (1, 4, 16, 64)
@@ -281,7 +276,9 @@ def test_ctrl_c_keeps_the_levels_measured(tmp_path):
     seen = ""
     while time.monotonic() < deadline and "spp 8:" not in seen:
         seen += os.read(proc.stderr.fileno(), 4096).decode()
-    time.sleep(0.5)  # now inside the render of 100000 spp
+    # Level 8 is recorded before its line is printed; from here on, wherever the
+    # signal lands (between levels or inside the render of 100000 spp), the run
+    # stops with the levels 1, 2, 4 and 8.
     proc.send_signal(signal.SIGINT)
     try:
         stdout, rest = proc.communicate(timeout=60)

@@ -31,7 +31,7 @@ from hypothesis import strategies as st
 from PIL import Image
 
 from rtpy.io.cli import main
-from tests.io.test_scene_file import VALUES, to_toml
+from tests.io.scene_text import VALUES, to_toml
 
 from .scene_strategies import examples, random_scene, seeds
 
