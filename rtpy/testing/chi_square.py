@@ -211,6 +211,17 @@ class _BinIntegrals:
                 error += e
         return total, error
 
+    def integrate_all(self, hist: _Histogram, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """(integral of pdf over every bin, its estimated error), refined where the
+        samples or the error estimates ask for it."""
+        integral = np.zeros(hist.observed.shape)
+        errors = np.zeros(hist.observed.shape)
+        for bi, bj in np.ndindex(*hist.observed.shape):
+            integral[bi, bj], errors[bi, bj] = self.integrate(bi, bj)
+        self.refine_where_samples_crowd(hist, integral, errors, n)
+        self.refine_largest_errors(integral, errors, n)
+        return integral, errors
+
     def refine_where_samples_crowd(self, hist: _Histogram, integral, errors, n: int) -> None:
         """A lobe narrower than the node spacing can hide between the nodes. Where a
         bin holds many more samples than its integral predicts, integrate it again
@@ -268,10 +279,20 @@ def _outright_failure(
     return ""
 
 
-def _pearson(obs: np.ndarray, exp: np.ndarray, var: np.ndarray, min_expected: float):
-    """(statistic, number of categories) of Pearson's test, sum (o - e)^2 / var,
-    categories expecting fewer than min_expected pooled into one (joined to the
-    smallest other category when the pool is still too small)."""
+def _pearson(observed, expected, absorbed, expected_absorbed, uncertainty, min_expected):
+    """(statistic, number of categories) of Pearson's test over the bins and the
+    absorbed category, sum (o - e)^2 / var, categories expecting fewer than
+    min_expected pooled into one (joined to the smallest other category when the
+    pool is still too small).
+
+    var is e, except for the absorbed category: its expected count carries the
+    quadrature error of the whole sphere (uncertainty, in samples), usually far
+    below a sample; where it is not, its term is divided by e + uncertainty^2, so
+    that the quadrature cannot fail the material."""
+    obs = np.append(observed.ravel(), absorbed)
+    exp = np.append(expected.ravel(), expected_absorbed)
+    var = exp.copy()
+    var[-1] += uncertainty**2
     small = exp < min_expected
     o, e, v = list(obs[~small]), list(exp[~small]), list(var[~small])
     pooled = (float(obs[small].sum()), float(exp[small].sum()), float(var[small].sum()))
@@ -351,13 +372,7 @@ def chi2_test(
 
     ray_view = incident_ray(incident_deg, phi_deg)
     bins = _BinIntegrals(material, ray_view, (theta_bins, phi_bins), n, node_spacing)
-    integral = np.zeros((theta_bins, phi_bins))
-    errors = np.zeros((theta_bins, phi_bins))
-    for bi in range(theta_bins):
-        for bj in range(phi_bins):
-            integral[bi, bj], errors[bi, bj] = bins.integrate(bi, bj)
-    bins.refine_where_samples_crowd(hist, integral, errors, n)
-    bins.refine_largest_errors(integral, errors, n)
+    integral, errors = bins.integrate_all(hist, n)
 
     expected = n * integral
     pdf_integral = float(integral.sum())
@@ -365,15 +380,10 @@ def chi2_test(
     observed_absorbed = float(n_absorbed + n_specular)
     message = _outright_failure(bins.bad_values, pdf_integral, errors, hist, integral)
 
-    # The absorbed category's expected count carries the quadrature error of the
-    # whole sphere, usually far below a sample; where it is not, its term is divided
-    # by E + error^2 instead of E, so that the quadrature cannot fail the material.
     uncertainty = n * float(errors.sum())
-    obs = np.append(hist.observed.ravel(), observed_absorbed)
-    exp = np.append(expected.ravel(), expected_absorbed)
-    var = exp.copy()
-    var[-1] += uncertainty**2
-    statistic, n_categories = _pearson(obs, exp, var, min_expected)
+    statistic, n_categories = _pearson(
+        hist.observed, expected, observed_absorbed, expected_absorbed, uncertainty, min_expected
+    )
     dof = n_categories - 1
     if message:
         p_value = 0.0
