@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .convergence import ALPHA, BenchResult, Fit, Level
+from .convergence import ALPHA, SLOPE_TOLERANCE, BenchResult, Fit, Level
 from .scenes import VARIANTS
 
 TABLE_COLUMNS = (
@@ -215,19 +215,45 @@ def machine_lines(before: dict, after: dict) -> list[str]:
 
 
 def findings(result: BenchResult) -> list[str]:
-    """What the run shows, computed from it: the convergence verdict, the numpy
-    backend's speed against the scalar one, and each scene's most efficient
-    integrator."""
-    problems = result.problems()
+    """What the run shows, computed from it: significant biases, slopes off -1
+    (judged only where the slope's standard error is at most a quarter of the
+    tolerance, as in the tests), and the numpy backend's speed against the
+    scalar one."""
+    biased = [
+        f"{lv.scene}/{lv.backend}/{lv.integrator} at {lv.spp} spp (z = {lv.bias_z:+.1f})"
+        for lv in result.levels
+        if lv.significant
+    ]
     lines = [
-        "- Convergence: "
+        "- Bias: "
         + (
-            "no series has a significant bias or a slope off -1 (by more than the tolerance)."
-            if not problems
-            else "problems: " + "; ".join(problems) + "."
+            "significant at " + ", ".join(biased) + f" (threshold {result.z_critical:.2f})."
+            if biased
+            else "no level is significantly biased."
         )
     ]
-    speed = {}
+    fitted = [f for f in result.fits if f.slope is not None]
+    judged = [f for f in fitted if f.slope_se <= SLOPE_TOLERANCE / 4]
+    off = [
+        f"{f.scene}/{f.backend}/{f.integrator} ({f.slope:+.2f})" for f in judged if not f.slope_ok
+    ]
+    loose = [f"{f.scene}/{f.backend}/{f.integrator}" for f in fitted if f not in judged]
+    tolerance = f"{SLOPE_TOLERANCE:g}"
+    verdict = (
+        f"off -1 by more than {tolerance}: " + ", ".join(off)
+        if off
+        else f"all of them are -1 within {tolerance}"
+    )
+    text = (
+        f"{len(judged)} of {len(fitted)} series are measured to "
+        f"± {SLOPE_TOLERANCE / 4:g} or better; {verdict}"
+        if judged
+        else f"no slope is measured to ± {SLOPE_TOLERANCE / 4:g} or better"
+    )
+    if loose:
+        text += f". Too few levels or too noisy to judge: {', '.join(loose)}"
+    lines.append(f"- Slopes: {text}.")
+    speed: dict[tuple[str, str, str], list[float]] = {}
     for lv in result.levels:
         speed.setdefault((lv.scene, lv.integrator, lv.backend), []).append(lv.paths_per_second)
     ratios = [
@@ -240,17 +266,28 @@ def findings(result: BenchResult) -> list[str]:
             f"- Speed: the numpy backend traces {min(ratios):.0f}-{max(ratios):.0f} times the "
             "scalar backend's paths/s (mean over the levels of each series)."
         )
-    best: dict[tuple[str, str], Level] = {}
-    for last in _last_levels(result):
-        key = (last.scene, last.backend)
-        if not last.exact and (key not in best or last.efficiency > best[key].efficiency):
-            best[key] = last
-    for (scene, backend), lv in best.items():
-        lines.append(
-            f"- Most efficient on {scene} ({backend}): {lv.integrator} "
-            f"(1/(relMSE*s) = {_fmt('{:.3g}', lv.efficiency)} at {lv.spp} spp)."
-        )
     return lines
+
+
+def format_efficiency(result: BenchResult) -> str:
+    """A markdown table: per scene and backend, the variants from the most to the
+    least efficient (1/(relMSE*s) at the highest spp of each series, relative to
+    the best); scenes without error (exact) are left out."""
+    best: dict[tuple[str, str], list[tuple[float, str]]] = {}
+    for f, last in zip(result.fits, _last_levels(result), strict=True):
+        if f.slope is not None and math.isfinite(last.efficiency):
+            best.setdefault((f.scene, f.backend), []).append((last.efficiency, f.integrator))
+    backends = list(dict.fromkeys(backend for _, backend in best))
+    scenes = list(dict.fromkeys(scene for scene, _ in best))
+    rows = []
+    for scene in scenes:
+        row = [scene]
+        for backend in backends:
+            ranked = sorted(best.get((scene, backend), []), reverse=True)
+            row.append(", ".join(f"{v} {e / ranked[0][0]:.2g}" for e, v in ranked) or "-")
+        rows.append(row)
+    head = ["scene", *(f"efficiency, {b} (relative to the best)" for b in backends)]
+    return _layout(head, rows, markdown=True)
 
 
 def format_doc_section(result: BenchResult, command: str, before: dict, after: dict) -> str:
@@ -276,6 +313,8 @@ def format_doc_section(result: BenchResult, command: str, before: dict, after: d
         "![relative MSE against time and against spp](bench/bench.png)",
         "",
         *findings(result),
+        "",
+        format_efficiency(result),
         "",
         GENERATED_END,
     ]

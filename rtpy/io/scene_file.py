@@ -335,22 +335,14 @@ class _Loader(TableReader):
             radius = self.number(w, "radius", radius, POSITIVE)
             material = self.reference(w, t)
             return self.build(w, "radius", lambda m: Sphere(center, radius, m), material)
-        if kind == "quad":
-            q, u, v = point("q"), point("u"), point("v")
-            return self.build(
-                w,
-                "u",
-                lambda m: Quad(q, u, v, m),
-                self.reference(w, t),
-                f" (u = {describe(list(u))}, v = {describe(list(v))})",
-            )
-        a, b, c = point("a"), point("b"), point("c")
+        # A quad (q, u, v) or a triangle (a, b, c); a degenerate one is blamed on u or a.
+        keys = OBJECT_KEYS[kind][1:4]
+        corners = [point(key) for key in keys]
+        found = ", ".join(f"{k} = {describe(list(p))}" for k, p in zip(keys, corners, strict=True))
+        shape = Quad if kind == "quad" else Triangle
+        blamed = "u" if kind == "quad" else "a"
         return self.build(
-            w,
-            "a",
-            lambda m: Triangle(a, b, c, m),
-            self.reference(w, t),
-            f" (a = {describe(list(a))}, b = {describe(list(b))}, c = {describe(list(c))})",
+            w, blamed, lambda m: shape(*corners, m), self.reference(w, t), f" ({found})"
         )
 
     def build(

@@ -19,6 +19,7 @@ from rtpy.bench.report import (
     GENERATED_END,
     findings,
     format_doc_section,
+    format_efficiency,
     format_series,
     format_table,
     machine_lines,
@@ -58,30 +59,57 @@ def test_tables_have_a_row_per_level_and_per_series(result):
 
 
 def converged(result: BenchResult) -> BenchResult:
-    """result with every fitted slope -1 (a run this small cannot fit slopes)."""
+    """result with every fitted slope -1 +- 0.01 (a run this small cannot fit slopes)."""
     fits = [f if f.slope is None else replace(f, slope=-1.0, slope_se=0.01) for f in result.fits]
     return replace(result, fits=fits)
 
 
-def test_findings_give_the_verdict_the_speed_ratio_and_the_best_integrator(result):
-    lines = findings(converged(result))
-    assert lines[0].startswith("- Convergence: no series has a significant bias")
-    (speed,) = [line for line in lines if line.startswith("- Speed:")]
-    assert re.search(r"traces \d+-\d+ times the scalar backend's paths/s", speed)
-    best = [line for line in lines if line.startswith("- Most efficient on")]
-    # the furnace has no error: no integrator is more efficient than another
-    assert {line.split(" (")[0] for line in best} == {"- Most efficient on plane_point_light"}
-    assert len(best) == 2  # one per backend
+def test_findings_give_the_bias_the_slopes_and_the_speed_ratio(result):
+    bias, slopes, speed = findings(converged(result))
+    assert bias == "- Bias: no level is significantly biased."
+    assert slopes == (
+        "- Slopes: 4 of 4 series are measured to ± 0.0375 or better; "
+        "all of them are -1 within 0.15."
+    )  # the furnace's 4 series have no error, so no slope
+    assert re.fullmatch(r"- Speed: the numpy backend traces \d+-\d+ times the scalar .*", speed)
 
 
-def test_findings_report_a_biased_series_and_a_wrong_slope(result):
+def test_findings_report_a_biased_level_a_wrong_slope_and_an_uncertain_one(result):
     good = converged(result)
-    level = replace(good.levels[-1], significant=True)
+    level = replace(good.levels[-1], significant=True, bias_z=-5.0)
     biased = replace(good, levels=[*good.levels[:-1], level])
-    assert findings(biased)[0] == f"- Convergence: problems: {biased.problems()[0]}."
-    assert biased.problems()[0].startswith(f"{level.scene}/{level.backend}/")
-    flat = replace(good, fits=[replace(good.fits[-1], slope=-0.5), *good.fits[:-1]])
-    assert "slope -0.500" in findings(flat)[0]
+    assert findings(biased)[0].startswith(
+        f"- Bias: significant at {level.scene}/{level.backend}/{level.integrator} "
+        f"at {level.spp} spp (z = -5.0) (threshold"
+    )
+    fits = list(good.fits)
+    fits[-1] = replace(fits[-1], slope=-0.5)  # measured precisely, and wrong
+    fits[-2] = replace(fits[-2], slope=-0.5, slope_se=0.3)  # too uncertain to judge
+    slopes = findings(replace(good, fits=fits))[1]
+    f, g = fits[-1], fits[-2]
+    assert f"off -1 by more than 0.15: {f.scene}/{f.backend}/{f.integrator} (-0.50)" in slopes
+    assert slopes.endswith(
+        f"Too few levels or too noisy to judge: {g.scene}/{g.backend}/{g.integrator}."
+    )
+    assert "3 of 4 series" in slopes
+    vague = replace(good, fits=[replace(f, slope_se=0.3) for f in good.fits])
+    assert findings(vague)[1].startswith("- Slopes: no slope is measured to ± 0.0375 or better. ")
+
+
+def test_efficiency_table_ranks_the_variants_of_each_scene_and_backend(result):
+    lines = format_efficiency(converged(result)).splitlines()
+    assert lines[0] == (
+        "| scene | efficiency, numpy (relative to the best) "
+        "| efficiency, scalar (relative to the best) |"
+    )
+    (row,) = lines[2:]  # the furnace has no error: only the noisy scene
+    cells = row.strip("| ").split(" | ")
+    assert cells[0] == "plane_point_light"
+    for cell in cells[1:]:
+        ranked = [part.rsplit(" ", 1) for part in cell.split(", ")]
+        assert {v for v, _ in ranked} == {"path-brdf", "path-mis"}
+        ratios = [float(r) for _, r in ranked]
+        assert ratios[0] == 1 and ratios == sorted(ratios, reverse=True)
 
 
 def test_the_doc_section_records_machine_and_load_but_no_date(result):

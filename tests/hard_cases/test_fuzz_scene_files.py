@@ -247,8 +247,8 @@ CLEAR_ERRORS = [
         'center = [0, 0, 0]\nradius = nan\nmaterial = "m"\n',
         "[[objects]] #1 radius",
     ),
-    # Found by the fuzzer: a string or key quoted in the message held a character
-    # that splitlines and terminals take for a line break (U+0085, U+2028).
+    # A string or key quoted in the message holds a character that splitlines and
+    # terminals take for a line break (U+0085, U+2028): it is escaped.
     ('[camera]\naspect_ratio = "\u0085"\n', "[camera] aspect_ratio"),
     ('[camera]\n"wid\u2028th" = 3\n', "[camera] wid\\u2028th"),
 ]
