@@ -170,10 +170,11 @@ class UsageError(Exception):
 
 def read_value(text: str):
     """A command-line value read as TOML (2, 2.5, true, [0.1, 0.2, 0.3], "path"), or
-    the text itself when it is not TOML (a bare word such as path)."""
+    the text itself when it is not TOML (a bare word such as path) or more than
+    TOML takes (an integer of thousands of digits, arrays nested thousands deep)."""
     try:
         return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
+    except (tomllib.TOMLDecodeError, ValueError, RecursionError):
         return text.strip()
 
 

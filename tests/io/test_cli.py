@@ -161,6 +161,24 @@ def test_argparse_errors_exit_2(extra):
     assert result.returncode == 2 and "Traceback" not in result.stderr
 
 
+@pytest.mark.parametrize(
+    "argv,option",
+    [
+        (["--spp", "1" + "0" * 5000], "--spp"),
+        (["--set", "seed=" + "9" * 5000], "--set seed"),
+        (["--set", "background=" + "[" * 3000], "--set background"),
+    ],
+)
+def test_values_beyond_what_toml_reads_are_one_clear_error(tmp_path, capsys, argv, option):
+    """An integer of thousands of digits or arrays nested thousands deep: Python's
+    int() and tomllib refuse them with ValueError and RecursionError, which must
+    not end the command with a traceback."""
+    status = main(["render", "cornell", "--quiet", "-o", str(tmp_path / "x.png"), *argv])
+    err = capsys.readouterr().err
+    assert status == 2 and err.startswith(f"rtpy: error: {option}: expected")
+    assert len(err.splitlines()) == 1 and list(tmp_path.iterdir()) == []
+
+
 def test_bad_scene_file_exits_2_with_file_table_and_key(tmp_path):
     scene = write(
         tmp_path,
