@@ -270,12 +270,14 @@ def findings(result: BenchResult) -> list[str]:
 
 
 def format_efficiency(result: BenchResult) -> str:
-    """A markdown table: per scene and backend, the variants from the most to the
-    least efficient (1/(relMSE*s) at the highest spp of each series, relative to
-    the best); scenes without error (exact) are left out."""
+    """A markdown table: per scene and backend, the path-tracing variants from the
+    most to the least efficient (1/(relMSE*s) at the highest spp of each series,
+    relative to the best). "direct" estimates another image (one bounce) and is
+    not ranked; scenes without error (exact) are left out."""
     best: dict[tuple[str, str], list[tuple[float, str]]] = {}
     for f, last in zip(result.fits, _last_levels(result), strict=True):
-        if f.slope is not None and math.isfinite(last.efficiency):
+        same_image = VARIANTS[f.integrator]["integrator"] == "path"
+        if same_image and f.slope is not None and math.isfinite(last.efficiency):
             best.setdefault((f.scene, f.backend), []).append((last.efficiency, f.integrator))
     backends = list(dict.fromkeys(backend for _, backend in best))
     scenes = list(dict.fromkeys(scene for scene, _ in best))
@@ -286,7 +288,7 @@ def format_efficiency(result: BenchResult) -> str:
             ranked = sorted(best.get((scene, backend), []), reverse=True)
             row.append(", ".join(f"{v} {e / ranked[0][0]:.2g}" for e, v in ranked) or "-")
         rows.append(row)
-    head = ["scene", *(f"efficiency, {b} (relative to the best)" for b in backends)]
+    head = ["scene", *(f"path tracing, {b}: efficiency relative to the best" for b in backends)]
     return _layout(head, rows, markdown=True)
 
 

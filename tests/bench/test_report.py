@@ -99,8 +99,8 @@ def test_findings_report_a_biased_level_a_wrong_slope_and_an_uncertain_one(resul
 def test_efficiency_table_ranks_the_variants_of_each_scene_and_backend(result):
     lines = format_efficiency(converged(result)).splitlines()
     assert lines[0] == (
-        "| scene | efficiency, numpy (relative to the best) "
-        "| efficiency, scalar (relative to the best) |"
+        "| scene | path tracing, numpy: efficiency relative to the best "
+        "| path tracing, scalar: efficiency relative to the best |"
     )
     (row,) = lines[2:]  # the furnace has no error: only the noisy scene
     cells = row.strip("| ").split(" | ")
@@ -165,3 +165,15 @@ def test_the_load_is_called_noisy_only_above_the_core_count():
     assert busy[-1].endswith("above 2, so other work shared the cores and times are noisy")
     unknown = machine_lines({**quiet, "load_average": None}, {**quiet, "load_average": None})
     assert "unknown before the run, unknown after" in unknown[-1]
+
+
+def test_direct_estimates_another_image_and_is_not_ranked(result):
+    good = converged(result)
+
+    def as_direct(x):
+        return replace(x, integrator="direct") if x.integrator == "path-mis" else x
+
+    direct = replace(good, fits=[as_direct(f) for f in good.fits])
+    direct = replace(direct, levels=[as_direct(lv) for lv in good.levels])
+    row = format_efficiency(direct).splitlines()[2]
+    assert "path-brdf 1" in row and "direct" not in row
