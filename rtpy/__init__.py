@@ -34,7 +34,7 @@ from .materials import (
 )
 from .quad import Quad
 from .ray import Ray
-from .render_settings import RenderSettings
+from .render_settings import SETTINGS, RenderSettings
 from .renderer import BACKENDS, Renderer
 from .scatter_info import ScatterInfo
 from .scene import Scene
@@ -72,7 +72,9 @@ def render(
     russian_roulette, seed, gamma, mis), background, sky, the camera width, or a
     whole `camera`. workers = number of processes; quiet = no progress bar.
     backend = "scalar" (the readable reference) or "numpy" (vectorized, many times
-    faster; the same image up to Monte Carlo noise).
+    faster; the same image up to Monte Carlo noise). A setting of the wrong type
+    raises TypeError, one out of its range ValueError, naming the setting
+    (rtpy.render_settings.SETTINGS lists them with their limits).
     """
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {backend!r}")
@@ -82,15 +84,15 @@ def render(
     if camera is None:
         raise ValueError("the scene has no camera: pass camera=rtpy.Camera(...)")
     if width is not None:
-        camera = camera.with_width(width)
+        camera = camera.with_width(SETTINGS["width"].check(width))
     if background is not None or sky is not None:
         import copy
 
         scene = copy.copy(scene)
         if background is not None:
-            scene.background = background
+            scene.background = SETTINGS["background"].check(background)
         if sky is not None:
-            scene.sky = sky
+            scene.sky = SETTINGS["sky"].check(sky)
     renderer = Renderer(
         scene, camera, render_settings, workers=workers, quiet=quiet, backend=backend
     )

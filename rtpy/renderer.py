@@ -33,6 +33,7 @@ from .io.image import RenderedImage
 from .render_settings import RenderSettings
 from .sampling import make_generator, use_generator
 from .scene import Scene
+from .testing.statistics import peak_memory_mb
 
 TILE_SIZE = 16
 MAX_BATCHES = 8  # samples per pixel are split into at most this many batches
@@ -186,18 +187,6 @@ def make_backend(name: str, scene: Scene, camera: Camera, settings: RenderSettin
     raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {name!r}")
 
 
-def peak_rss_mb() -> float:
-    """Peak resident memory in MB of this process and of its finished children (the
-    largest of them; Linux reports kilobytes); nan where the system does not say."""
-    try:
-        import resource
-    except ImportError:  # not a Unix
-        return math.nan
-    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    return max(own, children) / 1024.0
-
-
 # --- worker processes -------------------------------------------------------
 _render_one: Callable[[Unit], np.ndarray] | None = None
 
@@ -298,7 +287,7 @@ class Renderer:
             "workers": self.workers,
             "integrator": self.settings.integrator,
             "backend": self.backend.name,
-            "peak_rss_mb": peak_rss_mb(),
+            "peak_rss_mb": peak_memory_mb(children=True),
         }
         return RenderedImage(
             linear,

@@ -32,12 +32,12 @@ import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from statistics import NormalDist
 
 import numpy as np
 
+from ..testing.statistics import BlockTest, block_z_test
+
 ALPHA = 1e-3
-BLOCK = 8
 DEFAULT_POINTS = 1
 
 
@@ -69,59 +69,16 @@ def summarize(stack: np.ndarray, spp: int) -> dict[str, np.ndarray]:
     }
 
 
-def _blocks(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Sums over BLOCK x BLOCK blocks of (H, W, 3) -> (blocks, 3), and pixel counts."""
-    h, w = image.shape[:2]
-    sums, counts = [], []
-    for y in range(0, h, BLOCK):
-        for x in range(0, w, BLOCK):
-            part = image[y : y + BLOCK, x : x + BLOCK]
-            sums.append(part.sum(axis=(0, 1)))
-            counts.append(part.shape[0] * part.shape[1])
-    return np.array(sums), np.array(counts, dtype=np.float64)[:, None]
-
-
-@dataclass
-class Comparison:
-    z: np.ndarray  # (blocks, 3)
-    threshold: float
-    mean: np.ndarray  # block means of the renders being graded
-    reference: np.ndarray  # block means of the reference
-    blocks_x: int
-
-    @property
-    def passed(self) -> bool:
-        return bool(self.z.max() < self.threshold)
-
-    def worst(self) -> str:
-        b, c = np.unravel_index(np.argmax(self.z), self.z.shape)
-        bx, by = b % self.blocks_x, b // self.blocks_x
-        return (
-            f"the {BLOCK}x{BLOCK} block at pixels x={bx * BLOCK}.., y={by * BLOCK}.. "
-            f"({'RGB'[c]}) is {self.mean[b, c]:.4g} where the reference has "
-            f"{self.reference[b, c]:.4g} (z = {self.z[b, c]:.1f}, allowed {self.threshold:.1f}; "
-            f"{int((self.z > self.threshold).any(axis=1).sum())} of {len(self.z)} blocks differ)"
-        )
-
-
-def compare(graded: dict, reference: dict, alpha: float = ALPHA) -> Comparison:
-    """z-test of block means, each side's variance from its own measured noise."""
-    if graded["mean"].shape != reference["mean"].shape:
-        raise ValueError(
-            f"image shapes differ: {graded['mean'].shape} vs {reference['mean'].shape}"
-        )
-    mean_g, n = _blocks(graded["mean"])
-    mean_r, _ = _blocks(reference["mean"])
-    var = _blocks(graded["s2"])[0] / float(graded["samples"]) + _blocks(reference["s2"])[0] / float(
-        reference["samples"]
+def compare(graded: dict, reference: dict, alpha: float = ALPHA) -> BlockTest:
+    """z-test of 8 x 8 block means, each side's variance from its own measured noise
+    (rtpy.testing.statistics.block_z_test)."""
+    return block_z_test(
+        graded["mean"],
+        graded["s2"] / float(graded["samples"]),
+        reference["mean"],
+        reference["s2"] / float(reference["samples"]),
+        alpha,
     )
-    var = var / (n * n)
-    mean_g, mean_r = mean_g / n, mean_r / n
-    floor = (1e-9 * np.maximum(1.0, np.abs(mean_r))) ** 2  # noiseless blocks: rounding only
-    z = np.abs(mean_g - mean_r) / np.sqrt(var + floor)
-    threshold = NormalDist().inv_cdf(1.0 - alpha / (2 * z.size))
-    blocks_x = -(-graded["mean"].shape[1] // BLOCK)
-    return Comparison(z, threshold, mean_g, mean_r, blocks_x)
 
 
 def load_reference(path: str | Path) -> dict[str, np.ndarray]:

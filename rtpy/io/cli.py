@@ -12,57 +12,41 @@ import sys
 import tomllib
 from pathlib import Path
 
-from ..render_settings import INTEGRATOR_NAMES
+from ..render_settings import SETTINGS, SettingError, unknown_setting
 from .image import OutputError, check_image_path, check_linear_path
-from .scene_file import MAX_MAX_DEPTH, MAX_RADIANCE, MAX_SPP, MAX_WIDTH
 
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
-
-# --set KEY=VALUE accepts these [render] keys (VALUE is read as a TOML value).
-SETTABLE_KEYS = (
-    "integrator",
-    "spp",
-    "max_depth",
-    "nee",
-    "russian_roulette",
-    "seed",
-    "gamma",
-    "background",
-    "sky",
-    "width",
-    "mis",
-)
-
-
-def positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a number >= 1, got {value}")
-    return value
-
-
-def non_negative_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {value}")
-    return value
 
 
 MAX_WORKERS = 256  # more processes than that only exhaust the machine
 
 
 def worker_count(text: str) -> int:
-    value = positive_int(text)
-    if value > MAX_WORKERS:
-        raise argparse.ArgumentTypeError(f"expected at most {MAX_WORKERS} processes, got {value}")
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if not 1 <= value <= MAX_WORKERS:
+        raise argparse.ArgumentTypeError(f"expected 1 to {MAX_WORKERS} processes, got {value}")
     return value
+
+
+def add_setting_options(r: argparse.ArgumentParser) -> None:
+    """--NAME for the render settings that have a flag, and --set KEY=VALUE for all
+    of them (rtpy.render_settings.SETTINGS); the values are checked after parsing."""
+    for name, setting in SETTINGS.items():
+        if setting.flag:
+            metavar = {"int": "N", "float": "X", "choice": "NAME"}.get(setting.kind)
+            option = "--" + name.replace("_", "-")
+            r.add_argument(option, dest=name, metavar=metavar, help=setting.help)
+    r.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help=f"override a render setting, VALUE in TOML syntax ({', '.join(SETTINGS)})",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -88,11 +72,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="OUT.npy|OUT.pfm",
         help="also write the linear float image (never gamma-encoded)",
     )
-    r.add_argument("--spp", type=positive_int, help="samples per pixel")
-    r.add_argument("--width", type=positive_int, help="image width in pixels")
-    r.add_argument("--integrator", choices=INTEGRATOR_NAMES)
-    r.add_argument("--max-depth", type=positive_int, help="most ray segments per path")
-    r.add_argument("--seed", type=non_negative_int)
+    add_setting_options(r)
     r.add_argument(
         "--workers",
         type=worker_count,
@@ -105,13 +85,6 @@ def build_parser() -> argparse.ArgumentParser:
         default="scalar",
         help="scalar: the readable reference (default); numpy: vectorized, many times faster",
     )
-    r.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help=f"override a [render] key, VALUE in TOML syntax ({', '.join(SETTABLE_KEYS)})",
-    )
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument(
         "--plugin",
@@ -123,7 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sub.add_parser("scenes", help="list the bundled scenes")
 
-    from ..bench.run import add_parser as add_bench_parser
+    from ..bench.command import add_parser as add_bench_parser
 
     add_bench_parser(sub)
     add_assignment_commands(sub)
@@ -195,82 +168,40 @@ class UsageError(Exception):
     pass
 
 
-def parse_set(items: list[str]) -> dict:
-    """--set KEY=VALUE pairs -> {key: value}, values parsed as TOML."""
-    import difflib
+def read_value(text: str):
+    """A command-line value read as TOML (2, 2.5, true, [0.1, 0.2, 0.3], "path"), or
+    the text itself when it is not TOML (a bare word such as path) or more than
+    TOML takes (an integer of thousands of digits, arrays nested thousands deep)."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except (tomllib.TOMLDecodeError, ValueError, RecursionError):
+        return text.strip()
 
+
+def parse_set(items: list[str]) -> dict:
+    """--set KEY=VALUE pairs -> {key: value}, values read as TOML."""
     result = {}
     for item in items:
         key, sep, text = item.partition("=")
         key = key.strip()
         if not sep:
             raise UsageError(f"--set {item!r}: expected KEY=VALUE")
-        if key not in SETTABLE_KEYS:
-            near = difflib.get_close_matches(key, SETTABLE_KEYS, n=1)
-            hint = f"; did you mean '{near[0]}'?" if near else ""
-            raise UsageError(f"--set {key}: not a settable key ({', '.join(SETTABLE_KEYS)}){hint}")
-        try:
-            value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
-            value = text.strip()  # a bare word such as path or center
-        result[key] = value
+        if key not in SETTINGS:
+            raise UsageError(unknown_setting(key, list(SETTINGS)).for_option(f"--set {key}"))
+        result[key] = read_value(text)
     return result
 
 
 def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
-    """Check command-line overrides as strictly as the scene file's own values;
-    returns them with background turned into a Color."""
-    import math
-
-    from ..vec3 import Color
-
-    def fail(key: str, expected: str, value) -> UsageError:
-        option = f"--{key.replace('_', '-')}" if as_flags else f"--set {key}"
-        return UsageError(f"{option}: expected {expected}, got {value!r}")
-
-    def is_int(v) -> bool:
-        return isinstance(v, int) and not isinstance(v, bool)
-
+    """Check command-line overrides against their settings (as strictly as the scene
+    file's own values); the values as rtpy uses them (background a Color)."""
     checked = {}
     for key, value in overrides.items():
-        if key in ("spp", "width", "max_depth"):
-            limit = {"spp": MAX_SPP, "width": MAX_WIDTH, "max_depth": MAX_MAX_DEPTH}[key]
-            if not is_int(value) or not 1 <= value <= limit:
-                raise fail(key, f"a whole number from 1 to {limit}", value)
-        elif key in ("russian_roulette", "seed"):
-            if not is_int(value) or value < 0:
-                raise fail(key, "a whole number >= 0", value)
-        elif key in ("nee", "sky", "mis"):
-            if not isinstance(value, bool):
-                raise fail(key, "true or false", value)
-        elif key == "gamma":
-            if (
-                isinstance(value, bool)
-                or not isinstance(value, int | float)
-                or not (math.isfinite(value) and value > 0)
-            ):
-                raise fail(key, "a finite number > 0", value)
-        elif key == "integrator":
-            if value not in INTEGRATOR_NAMES:
-                raise fail(key, f"one of {', '.join(INTEGRATOR_NAMES)}", value)
-        elif key == "background":
-            ok = (
-                isinstance(value, list)
-                and len(value) == 3
-                and all(
-                    isinstance(c, int | float)
-                    and not isinstance(c, bool)
-                    and math.isfinite(c)
-                    and 0 <= c <= MAX_RADIANCE
-                    for c in value
-                )
-            )
-            if not ok:
-                raise fail(
-                    key, f"3 numbers in [0, {MAX_RADIANCE:g}], such as [0.1, 0.1, 0.1]", value
-                )
-            value = Color(*map(float, value))
-        checked[key] = value
+        try:
+            checked[key] = SETTINGS[key].check(value)
+        except SettingError as e:
+            option = f"--{key.replace('_', '-')}" if as_flags else f"--set {key}"
+            raise UsageError(e.for_option(option)) from None
     return checked
 
 
@@ -339,14 +270,8 @@ def _render(args: argparse.Namespace) -> int:
         path = resolve_scene(args.scene)
         scene = load_scene(path)
         overrides = validate_overrides(parse_set(args.set))
-        flags = {
-            "spp": args.spp,
-            "width": args.width,
-            "integrator": args.integrator,
-            "seed": args.seed,
-            "max_depth": args.max_depth,
-        }
-        given = {k: v for k, v in flags.items() if v is not None}
+        flags = {name: getattr(args, name) for name, setting in SETTINGS.items() if setting.flag}
+        given = {k: read_value(v) for k, v in flags.items() if v is not None}
         overrides.update(validate_overrides(given, as_flags=True))
         check_width(scene, path, overrides, "--width" if args.width is not None else "--set width")
         output = Path(args.output) if args.output is not None else Path(f"{path.stem}.png")
@@ -357,6 +282,13 @@ def _render(args: argparse.Namespace) -> int:
         return EXIT_BAD_INPUT
 
     image = render(scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides)
+    if image.interrupted:
+        print(
+            "rtpy: interrupted: writing the samples finished so far "
+            "(Ctrl-C again stops at once, writing nothing)",
+            file=sys.stderr,
+            flush=True,
+        )
 
     # A Ctrl-C while the image is written (after a complete render) leaves no file:
     # writes are atomic. After a first Ctrl-C, a second one ends at once.
@@ -385,7 +317,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "scenes":
         return command_scenes()
     if args.command == "bench":
-        from ..bench.run import command_bench
+        from ..bench.command import command_bench
 
         return command_bench(args)
     if args.command in ("assignment", "grade"):

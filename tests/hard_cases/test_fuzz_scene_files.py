@@ -31,7 +31,7 @@ from hypothesis import strategies as st
 from PIL import Image
 
 from rtpy.io.cli import main
-from tests.io.test_scene_file import VALUES, to_toml
+from tests.io.scene_text import VALUES, to_toml
 
 from .scene_strategies import examples, random_scene, seeds
 
@@ -247,8 +247,8 @@ CLEAR_ERRORS = [
         'center = [0, 0, 0]\nradius = nan\nmaterial = "m"\n',
         "[[objects]] #1 radius",
     ),
-    # Found by the fuzzer: a string or key quoted in the message held a character
-    # that splitlines and terminals take for a line break (U+0085, U+2028).
+    # A string or key quoted in the message holds a character that splitlines and
+    # terminals take for a line break (U+0085, U+2028): it is escaped.
     ('[camera]\naspect_ratio = "\u0085"\n', "[camera] aspect_ratio"),
     ('[camera]\n"wid\u2028th" = 3\n', "[camera] wid\\u2028th"),
 ]

@@ -26,7 +26,6 @@ to catch a real mistake (light counted twice by a wrong MIS weight).
 from __future__ import annotations
 
 from functools import cache
-from statistics import NormalDist
 
 import numpy as np
 import pytest
@@ -34,9 +33,9 @@ import pytest
 import rtpy
 from rtpy.io.bundled import bundled_scenes
 from rtpy.numpy_backend.integrators import direct_lighting
+from rtpy.testing.statistics import BlockTest, block_z_test
 
 ALPHA = 1e-3
-BLOCK = 8
 WIDTH = 32
 SCENES = [name for name, _ in bundled_scenes()]
 # Scalar spp per integrator (the numpy backend uses NUMPY_FACTOR times more: it is cheap).
@@ -61,34 +60,13 @@ def render(name: str, integrator: str, backend: str, seed: int, spp: int) -> np.
     return image.linear
 
 
-def blocks(image: np.ndarray) -> np.ndarray:
-    """Sums over 8 x 8 blocks (partial at the edges) of (..., H, W, 3) -> (..., blocks, 3),
-    and the pixel count of each block."""
-    h, w = image.shape[-3:-1]
-    out, counts = [], []
-    for y in range(0, h, BLOCK):
-        for x in range(0, w, BLOCK):
-            part = image[..., y : y + BLOCK, x : x + BLOCK, :]
-            out.append(part.sum(axis=(-3, -2)))
-            counts.append(part.shape[-3] * part.shape[-2])
-    return np.stack(out, axis=-2), np.array(counts)[:, None]
-
-
-def compare(renders_a, spp_a, renders_b, spp_b, alpha: float = ALPHA):
-    """(z per block and channel, the Bonferroni-corrected threshold, block means a, b)
-    for two stacks of R independent renders (R, H, W, 3) at spp_a and spp_b."""
+def compare(renders_a, spp_a, renders_b, spp_b, alpha: float = ALPHA) -> BlockTest:
+    """block_z_test of two stacks of R independent renders (R, H, W, 3) at spp_a and
+    spp_b, each pixel's per-sample variance pooled over both backends."""
     a, b = np.asarray(renders_a), np.asarray(renders_b)
-    # Per-sample variance of each pixel, pooled over both backends.
     s2 = 0.5 * (a.var(axis=0, ddof=1) * spp_a + b.var(axis=0, ddof=1) * spp_b)
-    s2_blocks, n = blocks(s2)
-    mean_a = blocks(a.mean(axis=0))[0] / n
-    mean_b = blocks(b.mean(axis=0))[0] / n
-    var = s2_blocks / (n * n) * (1.0 / (spp_a * len(a)) + 1.0 / (spp_b * len(b)))
-    # A floor for blocks without noise (a constant background): rounding only.
-    floor = (1e-9 * np.maximum(1.0, np.abs(mean_a))) ** 2
-    z = np.abs(mean_a - mean_b) / np.sqrt(var + floor)
-    threshold = NormalDist().inv_cdf(1.0 - alpha / (2 * z.size))
-    return z, threshold, mean_a, mean_b
+    var_a, var_b = s2 / (spp_a * len(a)), s2 / (spp_b * len(b))
+    return block_z_test(a.mean(axis=0), var_a, b.mean(axis=0), var_b, alpha)
 
 
 def renders(name: str, integrator: str, backend: str, spp: int) -> list[np.ndarray]:
@@ -97,17 +75,13 @@ def renders(name: str, integrator: str, backend: str, spp: int) -> list[np.ndarr
 
 def check(name: str, integrator: str, spp: int) -> None:
     numpy_spp = spp * NUMPY_FACTOR
-    z, threshold, ms, mn = compare(
+    test = compare(
         renders(name, integrator, "scalar", spp),
         spp,
         renders(name, integrator, "numpy", numpy_spp),
         numpy_spp,
     )
-    worst = np.unravel_index(np.argmax(z), z.shape)
-    assert z.max() < threshold, (
-        f"block {worst[0]} channel {worst[1]}: z = {z.max():.2f} > {threshold:.2f}; "
-        f"scalar {ms[worst]:.4f}, numpy {mn[worst]:.4f}"
-    )
+    assert test.passed, "scalar backend: " + test.worst("the numpy backend")
 
 
 @pytest.mark.parametrize("name", SCENES)
@@ -147,6 +121,6 @@ def test_a_biased_kernel_is_flagged(monkeypatch):
         ).linear
         for s in SEEDS
     ]
-    z, threshold, _, _ = compare(scalar, spp, biased, spp * NUMPY_FACTOR)
-    assert z.max() > threshold
-    assert (z > threshold).any(axis=1).mean() > 0.25  # many blocks, not one
+    test = compare(scalar, spp, biased, spp * NUMPY_FACTOR)
+    assert not test.passed
+    assert test.failing_share > 0.25  # many blocks, not one

@@ -20,48 +20,27 @@ from rtpy.testing.reference import (
     render_reference,
 )
 
+
+def one_ball(camera: str, render: str, albedo: str, center: str, radius: float) -> str:
+    """A square scene file with [camera] and [render] lines and one Lambertian ball."""
+    return (
+        f"[camera]\n{camera}aspect_ratio = 1.0\n\n[render]\n{render}\n"
+        f'[materials.ball]\ntype = "lambertian"\nalbedo = {albedo}\n\n'
+        f'[[objects]]\ntype = "sphere"\ncenter = {center}\nradius = {radius}\nmaterial = "ball"\n'
+    )
+
+
 # A furnace as a scene file: a Lambertian sphere in a white environment shows
 # exactly its albedo, at every sample, so a rendered reference must too.
-FURNACE_TOML = """\
-[camera]
-look_at = [0, 0, -3]
-vfov = 50
-aspect_ratio = 1.0
-
-[render]
-background = [1, 1, 1]
-max_depth = 4
-
-[materials.ball]
-type = "lambertian"
-albedo = [0.7, 0.35, 0.25]
-
-[[objects]]
-type = "sphere"
-center = [0, 0, -3]
-radius = 1
-material = "ball"
-"""
-
+FURNACE_TOML = one_ball(
+    "look_at = [0, 0, -3]\nvfov = 50\n",
+    "background = [1, 1, 1]\nmax_depth = 4\n",
+    "[0.7, 0.35, 0.25]",
+    "[0, 0, -3]",
+    1,
+)
 # A noisy one: a ball under the sky.
-SKY_TOML = """\
-[camera]
-aspect_ratio = 1.0
-
-[render]
-sky = true
-max_depth = 3
-
-[materials.ball]
-type = "lambertian"
-albedo = [0.6, 0.6, 0.6]
-
-[[objects]]
-type = "sphere"
-center = [0, -0.2, -1]
-radius = 0.6
-material = "ball"
-"""
+SKY_TOML = one_ball("", "sky = true\nmax_depth = 3\n", "[0.6, 0.6, 0.6]", "[0, -0.2, -1]", 0.6)
 
 
 PLANE_TOML = """\

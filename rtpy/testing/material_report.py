@@ -1,0 +1,199 @@
+"""check_material: every check of a material at once, and its report.
+
+How a student uses it::
+
+    from rtpy.testing import check_material
+    print(check_material(MyMaterial(...)))
+
+prints a table with one line per check and incident angle, for example::
+
+    check           angle  result  p-value   details
+    chi2             30.0  pass    0.4121    100000 samples in 1152 bins (...)
+    weights          30.0  FAIL    -         17 of 2000 samples: attenuation != ...
+
+`assert_material(MyMaterial(...))` does the same in a test and raises an
+AssertionError with that table when a check fails. A failing check says what
+disagrees, at which incident angle, with a p-value for the statistical ones.
+Statistical tests fail by chance with probability alpha; check_material divides
+its alpha over the incident angles (Sidak), so a correct material passes all of
+them with probability 1 - alpha.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from ..materials.material import Material
+from ..texture import Texture
+from ..vec3 import Vec3
+from .chi_square import chi2_test
+from .local_setup import color_text, draw_samples
+from .material_checks import (
+    CheckResult,
+    check_energy,
+    check_non_negative_finite,
+    check_reciprocity,
+    check_weights,
+)
+from .statistics import sidak_alpha
+
+__all__ = ["MaterialReport", "assert_material", "check_material", "material_name"]
+
+
+def material_name(material: Material) -> str:
+    """ClassName(parameter=value, ...) from the material's simple attributes."""
+    parts = []
+    for key, value in getattr(material, "__dict__", {}).items():
+        if key.startswith("_"):
+            continue
+        if isinstance(value, bool | int | float | str):
+            parts.append(f"{key}={value:g}" if isinstance(value, float) else f"{key}={value!r}")
+        elif isinstance(value, Vec3):
+            parts.append(f"{key}={color_text(value)}")
+        elif isinstance(value, Texture) and hasattr(value, "color"):
+            parts.append(f"{key}={color_text(value.color)}")
+    return f"{type(material).__name__}({', '.join(parts)})"
+
+
+@dataclass
+class MaterialReport:
+    """All checks of check_material; `passed` is True when every check passed."""
+
+    material: str
+    checks: list[CheckResult]
+    alpha: float
+    seconds: float = 0.0
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks)
+
+    @property
+    def failures(self) -> list[CheckResult]:
+        return [c for c in self.checks if not c.passed]
+
+    def __bool__(self) -> bool:
+        return self.passed
+
+    def __str__(self) -> str:
+        n_fail = len(self.failures)
+        verdict = "PASSED" if self.passed else f"FAILED ({n_fail} of {len(self.checks)} checks)"
+        lines = [
+            f"{self.material}: {verdict}",
+            f"{'check':<12} {'angle':>6}  {'result':<7} {'p-value':<9} details",
+        ]
+        for c in self.checks:
+            angle = "all" if c.incident_deg is None else f"{c.incident_deg:g}"
+            result = "skipped" if c.skipped else ("pass" if c.passed else "FAIL")
+            p = "-" if c.p_value is None else f"{c.p_value:.3g}"
+            lines.append(f"{c.check:<12} {angle:>6}  {result:<7} {p:<9} {c.detail}")
+        if not self.passed:
+            lines.append(_hints(self.failures))
+        lines.append(
+            f"(chi2 tests reject at p < {self.alpha:.3g} each: alpha Sidak-corrected over "
+            f"the incident angles; {self.seconds:.1f} s)"
+        )
+        return "\n".join(lines)
+
+
+_HINTS = {
+    "chi2": "chi2: scattering() does not draw directions with the density pdf() returns "
+    "(compare the sampling formula with pdf(), its normalisation and its frame).",
+    "weights": "weights: the attenuation must be BRDF * cos / pdf for the sampled direction.",
+    "energy": "energy: the mean weight and the integral of BRDF * cos disagree, or exceed 1 "
+    "(check the BRDF's normalisation, and that sampling covers every direction "
+    "where the BRDF is not 0).",
+    "reciprocity": "reciprocity: BRDF(wo, wi) must equal BRDF(wi, wo).",
+    "finite >= 0": "finite >= 0: guard divisions by cosines that reach 0 at grazing angles.",
+}
+
+
+def _hints(failures: list[CheckResult]) -> str:
+    seen = dict.fromkeys(c.check for c in failures)
+    return "\n".join("hint: " + _HINTS[name] for name in seen if name in _HINTS)
+
+
+def _run(check: str, incident_deg: float | None, fn: Callable[[], CheckResult]) -> CheckResult:
+    try:
+        return fn()
+    except Exception as error:  # a crash is a failed check, reported like the others
+        return CheckResult(check, incident_deg, False, f"raised {type(error).__name__}: {error}")
+
+
+def check_material(
+    material: Material,
+    incident_angles: Sequence[float] = (0.0, 30.0, 60.0, 85.0, 89.9),
+    n_samples: int = 100_000,
+    alpha: float = 0.01,
+    reciprocal: bool = True,
+    seed: int = 0,
+    max_albedo: float | None = 1.0,
+    theta_bins: int = 24,
+    phi_bins: int = 48,
+) -> MaterialReport:
+    """Run every check on `material` and return a MaterialReport (print it).
+
+    Per incident angle: chi2_test, check_weights, check_energy (its <= max_albedo
+    part skipped when max_albedo is None); once: check_reciprocity (when
+    `reciprocal`) and check_non_negative_finite. The chi2 and energy tests use
+    the per-test significance sidak_alpha(alpha, number of angles). One set of
+    n_samples draws per angle serves the chi2, weights and energy checks.
+    """
+    start = time.perf_counter()
+    angles = [float(t) for t in incident_angles]
+    a = sidak_alpha(alpha, max(1, len(angles)))
+    checks: list[CheckResult] = []
+    specular = material.is_specular
+    for theta in angles:
+        if specular:
+            checks.append(
+                CheckResult("chi2", theta, True, "specular material: no density", skipped=True)
+            )
+            continue
+        try:
+            samples = draw_samples(material, theta, n_samples, seed)
+        except Exception as error:
+            checks.append(
+                CheckResult("scattering", theta, False, f"raised {type(error).__name__}: {error}")
+            )
+            continue
+
+        def chi2(theta=theta, samples=samples) -> CheckResult:
+            r = chi2_test(
+                material, theta, samples=samples, theta_bins=theta_bins, phi_bins=phi_bins
+            )
+            ok = r.passed(a)
+            return CheckResult("chi2", theta, ok, r.summary(worst=not ok), p_value=r.p_value)
+
+        checks.append(_run("chi2", theta, chi2))
+        checks.append(
+            _run("weights", theta, lambda t=theta, s=samples: check_weights(material, t, samples=s))
+        )
+        checks.append(
+            _run(
+                "energy",
+                theta,
+                lambda t=theta, s=samples: check_energy(
+                    material,
+                    t,
+                    alpha=a,
+                    max_albedo=math.inf if max_albedo is None else max_albedo,
+                    samples=s,
+                ),
+            )
+        )
+    if reciprocal and not specular:
+        checks.append(_run("reciprocity", None, lambda: check_reciprocity(material, seed=seed)))
+    checks.append(_run("finite >= 0", None, lambda: check_non_negative_finite(material, seed=seed)))
+    return MaterialReport(material_name(material), checks, a, time.perf_counter() - start)
+
+
+def assert_material(material: Material, **options) -> MaterialReport:
+    """check_material, raising AssertionError with the report's table when a check fails."""
+    report = check_material(material, **options)
+    if not report.passed:
+        raise AssertionError("\n" + str(report))
+    return report

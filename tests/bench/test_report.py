@@ -1,0 +1,179 @@
+"""rtpy.bench.report: the printed tables, the files, and the generated section of
+docs/bench.md."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import re
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from rtpy.bench.convergence import BenchResult, Level
+from rtpy.bench.machine import machine
+from rtpy.bench.report import (
+    GENERATED_BEGIN,
+    GENERATED_END,
+    findings,
+    format_doc_section,
+    format_efficiency,
+    format_series,
+    format_table,
+    machine_lines,
+    replace_generated,
+    write_outputs,
+)
+from rtpy.bench.run import run_bench
+
+DOC = Path(__file__).resolve().parents[2] / "docs" / "bench.md"
+
+
+@pytest.fixture(scope="module")
+def result():
+    """Two scenes (one exact, one noisy), both backends, two variants, two levels."""
+    return run_bench(
+        ["furnace", "plane_point_light"],
+        ("numpy", "scalar"),
+        ("path-brdf", "path-mis"),
+        (1, 4),
+        repeats=2,
+        width=8,
+        log=lambda _: None,
+    )
+
+
+def test_tables_have_a_row_per_level_and_per_series(result):
+    table = format_table(result).splitlines()
+    assert len(table) == 1 + len(result.levels) == 1 + 2 * 2 * 2 * 2
+    assert table[0].split()[:4] == ["scene", "backend", "integrator", "spp"]
+    series = format_series(result, markdown=True).splitlines()
+    rows = [line for line in series if line.startswith("| ") and "---" not in line]
+    assert len(rows) == 1 + len(result.fits) == 1 + 8
+    assert all(row.count("|") == 12 for row in rows)  # 11 columns
+    furnace = [row for row in rows if row.startswith("| furnace ")]
+    assert furnace and all("| exact |" in row for row in furnace)
+    assert series[-1].startswith("slope: of log MSE against log spp")
+
+
+def converged(result: BenchResult) -> BenchResult:
+    """result with every fitted slope -1 +- 0.01 (a run this small cannot fit slopes)."""
+    fits = [f if f.slope is None else replace(f, slope=-1.0, slope_se=0.01) for f in result.fits]
+    return replace(result, fits=fits)
+
+
+def test_findings_give_the_bias_the_slopes_and_the_speed_ratio(result):
+    bias, slopes, speed = findings(converged(result))
+    assert bias == "- Bias: no level is significantly biased."
+    assert slopes == (
+        "- Slopes: 4 of 4 series are measured to ± 0.0375 or better; "
+        "all of them are -1 within 0.15."
+    )  # the furnace's 4 series have no error, so no slope
+    assert re.fullmatch(r"- Speed: the numpy backend traces \d+-\d+ times the scalar .*", speed)
+
+
+def test_findings_report_a_biased_level_a_wrong_slope_and_an_uncertain_one(result):
+    good = converged(result)
+    level = replace(good.levels[-1], significant=True, bias_z=-5.0)
+    biased = replace(good, levels=[*good.levels[:-1], level])
+    assert findings(biased)[0].startswith(
+        f"- Bias: significant at {level.scene}/{level.backend}/{level.integrator} "
+        f"at {level.spp} spp (z = -5.0) (threshold"
+    )
+    fits = list(good.fits)
+    fits[-1] = replace(fits[-1], slope=-0.5)  # measured precisely, and wrong
+    fits[-2] = replace(fits[-2], slope=-0.5, slope_se=0.3)  # too uncertain to judge
+    slopes = findings(replace(good, fits=fits))[1]
+    f, g = fits[-1], fits[-2]
+    assert f"off -1 by more than 0.15: {f.scene}/{f.backend}/{f.integrator} (-0.50)" in slopes
+    assert slopes.endswith(
+        f"Too few levels or too noisy to judge: {g.scene}/{g.backend}/{g.integrator}."
+    )
+    assert "3 of 4 series" in slopes
+    vague = replace(good, fits=[replace(f, slope_se=0.3) for f in good.fits])
+    assert findings(vague)[1].startswith("- Slopes: no slope is measured to ± 0.0375 or better. ")
+
+
+def test_efficiency_table_ranks_the_variants_of_each_scene_and_backend(result):
+    lines = format_efficiency(converged(result)).splitlines()
+    assert lines[0] == (
+        "| scene | path tracing, numpy: efficiency relative to the best "
+        "| path tracing, scalar: efficiency relative to the best |"
+    )
+    (row,) = lines[2:]  # the furnace has no error: only the noisy scene
+    cells = row.strip("| ").split(" | ")
+    assert cells[0] == "plane_point_light"
+    for cell in cells[1:]:
+        ranked = [part.rsplit(" ", 1) for part in cell.split(", ")]
+        assert {v for v, _ in ranked} == {"path-brdf", "path-mis"}
+        ratios = [float(r) for _, r in ranked]
+        assert ratios[0] == 1 and ratios == sorted(ratios, reverse=True)
+
+
+def test_the_doc_section_records_machine_and_load_but_no_date(result):
+    before, after = machine(), machine()
+    section = format_doc_section(result, "python -m rtpy bench furnace", before, after)
+    assert section.startswith(GENERATED_BEGIN) and section.endswith(GENERATED_END)
+    assert f"- CPU: {before['cpu']}, {before['cores']} cores" in section
+    assert f"numpy {before['numpy']}" in section and "load average" in section
+    assert "python -m rtpy bench furnace" in section and "| plane_point_light |" in section
+    assert not re.search(r"\b(19|20)\d\d-\d\d-\d\d\b", section)
+
+
+def test_replace_generated_keeps_what_is_written_by_hand():
+    text = f"# Title\n\nprose\n\n{GENERATED_BEGIN}\nold table\n{GENERATED_END}\n\nmore prose\n"
+    new = replace_generated(text, f"{GENERATED_BEGIN}\nnew table\n{GENERATED_END}")
+    assert new == text.replace("old table", "new table")
+    with pytest.raises(ValueError, match="no generated section"):
+        replace_generated("# Title\n", "section")
+
+
+def test_docs_bench_md_has_one_generated_section():
+    if not DOC.exists():
+        pytest.skip("docs/ is not part of this checkout")
+    text = DOC.read_text()
+    assert text.count(GENERATED_BEGIN) == 1 and text.count(GENERATED_END) == 1
+    assert text.index(GENERATED_BEGIN) < text.index(GENERATED_END)
+
+
+def test_files_hold_every_level_and_non_finite_numbers_as_json_strings(result, tmp_path):
+    csv_path, json_path = write_outputs(result, tmp_path / "out")
+    with csv_path.open() as f:
+        rows = list(csv.DictReader(f))
+    assert list(rows[0]) == list(Level.__dataclass_fields__)
+    assert len(rows) == len(result.levels)
+    doc = json.loads(json_path.read_text())
+    furnace = [lv for lv in doc["levels"] if lv["scene"] == "furnace"]
+    assert all(lv["efficiency"] == "inf" for lv in furnace)  # exact: no error
+    assert math.isfinite(doc["z_critical"]) and len(doc["fits"]) == len(result.fits)
+
+
+def test_the_load_is_called_noisy_only_above_the_core_count():
+    quiet = {"cpu": "x", "cores": 2, "system": "s", "python": "3", "numpy": "2"}
+    calm = machine_lines(
+        {**quiet, "load_average": (0.5, 0.4, 0.3)}, {**quiet, "load_average": (1.0, 0.5, 0.3)}
+    )
+    assert (
+        calm[-1]
+        == "- load average (1 / 5 / 15 min): 0.5 / 0.4 / 0.3 before the run, 1.0 / 0.5 / 0.3 after"
+    )
+    busy = machine_lines(
+        {**quiet, "load_average": (0.5, 0.4, 0.3)}, {**quiet, "load_average": (3.0, 2.0, 1.0)}
+    )
+    assert busy[-1].endswith("above 2, so other work shared the cores and times are noisy")
+    unknown = machine_lines({**quiet, "load_average": None}, {**quiet, "load_average": None})
+    assert "unknown before the run, unknown after" in unknown[-1]
+
+
+def test_direct_estimates_another_image_and_is_not_ranked(result):
+    good = converged(result)
+
+    def as_direct(x):
+        return replace(x, integrator="direct") if x.integrator == "path-mis" else x
+
+    direct = replace(good, fits=[as_direct(f) for f in good.fits])
+    direct = replace(direct, levels=[as_direct(lv) for lv in good.levels])
+    row = format_efficiency(direct).splitlines()[2]
+    assert "path-brdf 1" in row and "direct" not in row

@@ -1,0 +1,176 @@
+"""Tests for rtpy.io.values: the typed values of scene files. Through the loader,
+each wrong type or range is a SceneError naming the file, table and key; the
+checks themselves say what was expected and found."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rtpy.io import values
+from rtpy.io.values import Invalid, Range
+
+from .scene_text import MINIMAL, assert_names, error_of
+
+
+def test_wrong_type():
+    err = error_of('[camera]\nvfov = "wide"\n')
+    assert_names(err, "[camera]", "vfov")
+    assert "expected a number" in str(err) and '"wide"' in str(err)
+    err = error_of("[camera]\nlook_from = [1, 2]\n")
+    assert_names(err, "[camera]", "look_from")
+    assert "3" in str(err)
+    err = error_of('[render]\nsky = "yes"\n')
+    assert_names(err, "[render]", "sky")
+    assert "true or false" in str(err)
+    err = error_of("[render]\nnee = 1\n")
+    assert_names(err, "[render]", "nee")
+
+
+def test_float_for_integer_key_is_refused_with_a_hint():
+    err = error_of("[render]\nspp = 16.0\n")
+    assert_names(err, "[render]", "spp")
+    assert "integer" in str(err) and "write 16" in str(err)
+    err = error_of("[camera]\nwidth = 300.5\n")
+    assert_names(err, "[camera]", "width")
+
+
+def test_bool_is_not_a_number():
+    err = error_of("[camera]\nvfov = true\n")
+    assert_names(err, "[camera]", "vfov")
+    err = error_of("[render]\nspp = true\n")
+    assert_names(err, "[render]", "spp")
+    err = error_of('[[lights]]\ntype = "point"\nposition = [0, true, 0]\nintensity = [1, 1, 1]\n')
+    assert_names(err, "[[lights]] #1", "position")
+    assert "booleans are not numbers" in str(err)
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "+inf", "-nan"])
+def test_nan_and_infinity_are_refused(value):
+    err = error_of(MINIMAL.replace("radius = 0.5", f"radius = {value}"))
+    assert_names(err, "[[objects]] #1", "radius")
+    assert "finite" in str(err)
+    err = error_of(MINIMAL.replace("center = [0, 0, -1]", f"center = [0, {value}, -1]"))
+    assert_names(err, "[[objects]] #1", "center")
+    err = error_of(f"[render]\ngamma = {value}\n")
+    assert_names(err, "[render]", "gamma")
+
+
+@pytest.mark.parametrize(
+    ("text", "table", "key"),
+    [
+        ("[camera]\nvfov = 180\n", "[camera]", "vfov"),
+        ("[camera]\nvfov = 0\n", "[camera]", "vfov"),
+        ("[camera]\nwidth = 0\n", "[camera]", "width"),
+        ("[camera]\nfocus_distance = 0\n", "[camera]", "focus_distance"),
+        ("[camera]\ndefocus_angle = -1\n", "[camera]", "defocus_angle"),
+        ("[camera]\naspect_ratio = -1.5\n", "[camera]", "aspect_ratio"),
+        ("[render]\nspp = 0\n", "[render]", "spp"),
+        ("[render]\nmax_depth = 0\n", "[render]", "max_depth"),
+        ("[render]\nrussian_roulette = -1\n", "[render]", "russian_roulette"),
+        ("[render]\nseed = -3\n", "[render]", "seed"),
+        ("[render]\ngamma = 0\n", "[render]", "gamma"),
+        ("[render]\nbackground = [0, -0.1, 0]\n", "[render]", "background"),
+        ('[materials.m]\ntype = "lambertian"\nalbedo = [1.2, 0, 0]\n', "[materials.m]", "albedo"),
+        ('[materials.m]\ntype = "lambertian"\nalbedo = [-0.1, 0, 0]\n', "[materials.m]", "albedo"),
+        ('[materials.m]\ntype = "dielectric"\nior = 0\n', "[materials.m]", "ior"),
+        ('[materials.m]\ntype = "metal"\nfuzz = -0.5\n', "[materials.m]", "fuzz"),
+        ('[materials.m]\ntype = "diffuse_light"\nemit = [1, -1, 1]\n', "[materials.m]", "emit"),
+        (
+            '[textures.t]\ntype = "checker"\nscale = -1\neven = [0, 0, 0]\nodd = [1, 1, 1]\n',
+            "[textures.t]",
+            "scale",
+        ),
+        (
+            '[[lights]]\ntype = "point"\nposition = [0, 0, 0]\nintensity = [1, 1, -1]\n',
+            "[[lights]] #1",
+            "intensity",
+        ),
+    ],
+)
+def test_out_of_range(text, table, key):
+    err = error_of(text)
+    assert_names(err, table, key)
+    assert "expected" in str(err)
+
+
+def test_negative_radius_is_refused():
+    err = error_of(MINIMAL.replace("radius = 0.5", "radius = -0.5"))
+    assert_names(err, "[[objects]] #1", "radius")
+    assert "> 0" in str(err)
+
+
+# --- the checks on their own -----------------------------------------------------------------
+
+
+def invalid(check, *args) -> Invalid:
+    with pytest.raises(Invalid) as info:
+        check(*args)
+    return info.value
+
+
+def test_number_takes_integers_refuses_booleans_nan_and_values_out_of_range():
+    assert values.number(3, values.POSITIVE) == 3.0 and isinstance(values.number(3), float)
+    assert values.number(np.float32(0.5)) == 0.5
+    e = invalid(values.number, True)
+    assert e.wrong_type and e.detail == "expected a number, found true"
+    e = invalid(values.number, math.nan, values.POSITIVE)
+    assert not e.wrong_type and e.detail == "expected a finite number > 0, found nan"
+    assert (
+        invalid(values.number, 10**400).detail
+        == "expected a finite number, found a very large integer"
+    )
+    e = invalid(values.number, -1.5, Range(0, 180, True, True))
+    assert e.detail == "expected a number in (0, 180), found -1.5" and not e.wrong_type
+
+
+def test_integer_refuses_floats_with_a_hint_and_takes_numpy_integers():
+    assert values.integer(np.int64(7), values.NON_NEGATIVE) == 7
+    assert type(values.integer(np.int64(7))) is int
+    e = invalid(values.integer, 16.0, Range(1, 100), " (larger counts are refused)")
+    assert e.wrong_type
+    assert e.detail == (
+        "expected an integer in [1, 100] (larger counts are refused), found 16.0 "
+        "(write 16 without the decimal point)"
+    )
+    assert invalid(values.integer, 2.5).detail == "expected an integer, found 2.5"
+    assert invalid(values.integer, np.bool_(True)).wrong_type
+    assert invalid(values.integer, False).detail == "expected an integer, found false"
+    assert invalid(values.integer, 0, Range(1)).detail == "expected an integer >= 1, found 0"
+
+
+def test_string_suggests_the_nearest_choice():
+    assert values.string("path", ("center", "path")) == "path"
+    e = invalid(values.string, "pth", ("center", "path"))
+    assert e.detail == 'expected one of "center", "path", found the string "pth"'
+    assert e.suggestion == "path" and not e.wrong_type
+    assert invalid(values.string, 3).detail == "expected a string, found 3"
+    assert invalid(values.string, "zzz", ("center", "path")).suggestion is None
+
+
+def test_triple_names_the_bad_component():
+    assert values.triple([1, 2.5, 3]) == (1.0, 2.5, 3.0)
+    each = "expected an array of 3 finite numbers, each in [0, 1]"
+    assert invalid(values.triple, [0, 2, 0], values.UNIT).detail == (
+        f"{each}, found [0, 2, 0] (component 2 is 2)"
+    )
+    e = invalid(values.triple, [0, True, 0], values.UNIT)
+    assert e.wrong_type and e.detail.endswith(
+        "found true as component 2 (booleans are not numbers)"
+    )
+    assert invalid(values.triple, [1, 2]).detail.endswith("found [1, 2]")
+    assert invalid(values.triple, "red").detail.endswith('found the string "red"')
+
+
+def test_describe_and_ranges():
+    assert values.describe([1, 2.5, True]) == "[1, 2.5, true]"
+    assert values.describe(list(range(9))) == "an array of 9 items"
+    assert values.describe({"a": 1}) == "a table"
+    assert values.describe("x" * 100) == "the string " + '"' + "x" * 56 + "..."
+    assert values.describe(2.0) == "2.0" and values.describe(2**70) == "a very large integer"
+    assert Range(0, 1).text() == "in [0, 1]" and Range(0, None, True).text() == "> 0"
+    assert Range(None, 5, hi_open=True).text() == "< 5" and values.ANY.text() == ""
+    assert 0 not in Range(0, None, True) and 0 in Range(0) and 1e31 not in values.RADIANCE
+    assert values.suggest("lookat", ["look_at", "look_from"]) == "look_at"

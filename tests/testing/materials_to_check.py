@@ -1,0 +1,132 @@
+"""Materials for the tests of rtpy.testing: a correct narrow lobe, and Lambertians
+with one planted mistake each (every check must catch the one meant for it)."""
+
+from __future__ import annotations
+
+import math
+
+from rtpy.materials import Lambertian
+from rtpy.materials.glossy import GlossyMaterial
+from rtpy.ray import spawn_ray
+from rtpy.sampling import generator
+from rtpy.scatter_info import ScatterInfo
+from rtpy.vec3 import BLACK, Color, Vec3
+
+INV_PI = 1.0 / math.pi
+
+
+class PhongLobe(GlossyMaterial):
+    """A correct narrow lobe: f = kd albedo / pi + ks (n+2)/(2 pi) cos^n(alpha), alpha the
+    angle between wi and the mirror direction of wo, sampled exactly (pdf (n+1)/(2 pi)
+    cos^n(alpha)); samples below the surface are absorbed."""
+
+    def __init__(self, exponent: float, kd: float = 0.0, ks: float = 1.0) -> None:
+        super().__init__(Color(0.9, 0.6, 0.3), kd, ks)
+        self.exponent = float(exponent)
+
+    def _cos(self, wo, wi) -> float:
+        return max(0.0, -wi[0] * wo[0] - wi[1] * wo[1] + wi[2] * wo[2])
+
+    def specular(self, wo, wi) -> Color:
+        v = (self.exponent + 2.0) / (2.0 * math.pi) * self._cos(wo, wi) ** self.exponent
+        return Color(v, v, v)
+
+    def specular_pdf(self, wo, wi) -> float:
+        return (self.exponent + 1.0) / (2.0 * math.pi) * self._cos(wo, wi) ** self.exponent
+
+    def sample_specular(self, wo, r1, r2):
+        m = (-wo[0], -wo[1], wo[2])
+        cos_a = r1 ** (1.0 / (self.exponent + 1.0))
+        sin_a = math.sqrt(max(0.0, 1.0 - cos_a * cos_a))
+        sign = math.copysign(1.0, m[2])
+        a = -1.0 / (sign + m[2])
+        b = m[0] * m[1] * a
+        u = (1.0 + sign * m[0] * m[0] * a, sign * b, -sign * m[0])
+        v = (b, sign + m[1] * m[1] * a, -m[1])
+        x, y = sin_a * math.cos(2.0 * math.pi * r2), sin_a * math.sin(2.0 * math.pi * r2)
+        return tuple(x * u[k] + y * v[k] + cos_a * m[k] for k in range(3))
+
+
+class OverNormalised(Lambertian):
+    """pdf() 10 % too large."""
+
+    def pdf(self, ray_view, ray_light, hit):
+        return 1.1 * super().pdf(ray_view, ray_light, hit)
+
+
+class UniformSampler(Lambertian):
+    """Samples the hemisphere uniformly but pdf() still says cos / pi."""
+
+    def scattering(self, ray_in, hit):
+        r = generator().random
+        z, phi = r(), 2.0 * math.pi * r()
+        s = math.sqrt(1.0 - z * z)
+        d = Vec3(s * math.cos(phi), s * math.sin(phi), z)
+        return ScatterInfo(
+            spawn_ray(hit.point, hit.normal, d), self.albedo.value(hit) * z, z / math.pi
+        )
+
+
+class SecretAbsorber(Lambertian):
+    """Absorbs 2 % of the samples, but pdf() still integrates to 1."""
+
+    def scattering(self, ray_in, hit):
+        if generator().random() < 0.02:
+            return None
+        return super().scattering(ray_in, hit)
+
+
+class HalfSampler(Lambertian):
+    """Only ever scatters to x > 0 (absorbs the rest), and pdf() says so: consistent
+    sampling, but the BRDF is albedo / pi on the whole hemisphere."""
+
+    def scattering(self, ray_in, hit):
+        s = super().scattering(ray_in, hit)
+        return s if s.scattered_ray.direction.e0 > 0.0 else None
+
+    def pdf(self, ray_view, ray_light, hit):
+        return super().pdf(ray_view, ray_light, hit) if ray_light.direction.e0 > 0.0 else 0.0
+
+
+class ForgetsPdf(Lambertian):
+    """attenuation = albedo * cos: the division by the pdf is missing."""
+
+    def scattering(self, ray_in, hit):
+        s = super().scattering(ray_in, hit)
+        s.attenuation = s.attenuation * s.scattered_ray.direction.e2
+        return s
+
+
+class WrongRecordedPdf(Lambertian):
+    """ScatterInfo.pdf is the uniform density, pdf() the cosine density."""
+
+    def scattering(self, ray_in, hit):
+        s = super().scattering(ray_in, hit)
+        s.pdf = 1.0 / (2.0 * math.pi)
+        return s
+
+
+class NonReciprocal(Lambertian):
+    """f grows with the viewer's cosine only."""
+
+    def BRDF(self, ray_view, ray_light, hit):
+        f = super().BRDF(ray_view, ray_light, hit)
+        return f * (0.5 - ray_view.direction.e2)  # -direction.e2 = cos(theta_o)
+
+
+class NegativeAtGrazing(Lambertian):
+    """f < 0 for light within 0.06 degrees of the horizon."""
+
+    def BRDF(self, ray_view, ray_light, hit):
+        z = ray_light.direction.e2
+        if z <= 0.0:
+            return BLACK
+        return self.albedo.value(hit) * (INV_PI * (z - 1e-3) / z)
+
+
+class CrashesAtGrazing(Lambertian):
+    def pdf(self, ray_view, ray_light, hit):
+        z = ray_light.direction.e2
+        if 0.0 < z < 1e-4:
+            raise ZeroDivisionError("grazing")
+        return super().pdf(ray_view, ray_light, hit)

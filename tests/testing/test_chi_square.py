@@ -1,0 +1,154 @@
+"""Tests for rtpy.testing.chi_square: correct materials pass Pearson's test of
+scattering() against pdf(), and sampling that does not match pdf() fails it."""
+
+from __future__ import annotations
+
+import math
+from functools import cache
+
+import numpy as np
+import pytest
+
+from rtpy.materials import Lambertian, Mirror
+from rtpy.testing import chi2_test, draw_samples
+from rtpy.vec3 import Color
+
+from .materials_to_check import (
+    HalfSampler,
+    OverNormalised,
+    PhongLobe,
+    SecretAbsorber,
+    UniformSampler,
+)
+
+ANGLES = (0.0, 30.0, 60.0, 85.0, 89.9)
+
+
+@cache
+def lambertian_chi2(theta: float):
+    return chi2_test(Lambertian(Color(0.8, 0.5, 0.25)), theta)
+
+
+@cache
+def lobe_chi2(exponent: float, theta: float):
+    return chi2_test(PhongLobe(exponent), theta)
+
+
+def exact_mass_above_horizon(exponent: float, theta_axis_deg: float) -> float:
+    """Fraction of a cos^n lobe around an axis at theta_axis that lies above the
+    horizon: integral of (n+1) cos^n(a) sin(a) * (fraction of the circle at angle a
+    around the axis with z > 0), in the variable t = cos(a)^(n+1)."""
+    m = 2_000_000
+    t = (np.arange(m) + 0.5) / m
+    cos_a = t ** (1.0 / (exponent + 1.0))
+    sin_a = np.sqrt(1.0 - cos_a**2)
+    ta = math.radians(theta_axis_deg)
+    # z = cos a cos ta + sin a sin ta cos b > 0  <=>  cos b > k
+    with np.errstate(divide="ignore"):
+        k = -(cos_a * math.cos(ta)) / (sin_a * math.sin(ta))
+    fraction = np.arccos(np.clip(k, -1.0, 1.0)) / math.pi
+    return float(fraction.mean())
+
+
+@pytest.mark.parametrize(
+    ("exponent", "theta"), [(1e4, 0.0), (1e4, 30.0), (1e4, 89.9), (10.0, 85.0)]
+)
+def test_pdf_integral_is_exact_for_narrow_lobes(exponent, theta):
+    r = lobe_chi2(exponent, theta)
+    exact = exact_mass_above_horizon(exponent, theta)
+    assert r.upper_integral == pytest.approx(exact, abs=2e-6)
+    assert r.pdf_integral == pytest.approx(exact, abs=2e-6)  # nothing below the surface
+    assert r.integration_error < 1e-5
+    # ... and it predicts the absorbed fraction.
+    absorbed = r.n_absorbed / r.n_samples
+    se = math.sqrt(max(exact * (1 - exact), 1e-12) / r.n_samples)
+    assert abs((1.0 - absorbed) - r.upper_integral) < 4 * se + 1e-5
+
+
+# --- chi-square test -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("theta", ANGLES)
+def test_chi2_accepts_lambertian(theta):
+    r = lambertian_chi2(theta)
+    assert r.p_value > 0.01, r.summary()
+    assert r.n_absorbed == 0 and r.expected_absorbed < 1.0
+    assert r.pdf_integral == pytest.approx(1.0, abs=1e-6)
+    assert r.upper_integral == pytest.approx(1.0, abs=1e-6)
+    assert r.observed.sum() == r.n_samples
+    assert r.expected.sum() == pytest.approx(r.n_samples, rel=1e-6)
+    assert r.dof > 100  # the bins resolve the distribution
+
+
+@pytest.mark.parametrize("theta", [0.0, 30.0, 89.9])
+def test_chi2_accepts_a_correct_narrow_lobe(theta):
+    r = lobe_chi2(1e4, theta)
+    assert r.p_value > 0.01, r.summary()
+
+
+def test_chi2_accepts_an_extremely_narrow_lobe_at_normal_incidence():
+    # The lobe (about 0.06 degrees wide) hides between the quadrature nodes; the
+    # sample-guided refinement of chi2_test must find it.
+    r = chi2_test(PhongLobe(1e6), 0.0, n_samples=20_000)
+    assert r.p_value > 0.01, r.summary()
+    assert r.pdf_integral == pytest.approx(1.0, abs=1e-5)
+
+
+def test_chi2_counts_absorbed_samples_as_a_category():
+    r = chi2_test(HalfSampler(), 40.0, n_samples=50_000)
+    assert r.p_value > 0.01, r.summary()
+    assert r.pdf_integral == pytest.approx(0.5, abs=1e-6)
+    assert r.n_absorbed / r.n_samples == pytest.approx(0.5, abs=4 * math.sqrt(0.25 / 50_000))
+
+
+def test_chi2_is_deterministic_for_a_seed():
+    a = chi2_test(Lambertian(), 30.0, n_samples=5000, seed=3)
+    b = chi2_test(Lambertian(), 30.0, n_samples=5000, seed=3)
+    c = chi2_test(Lambertian(), 30.0, n_samples=5000, seed=4)
+    assert a.statistic == b.statistic and np.array_equal(a.observed, b.observed)
+    assert a.statistic != c.statistic
+
+
+def test_chi2_rejects_a_misnormalised_pdf():
+    r = chi2_test(OverNormalised(), 30.0)
+    assert r.p_value < 1e-6
+    assert r.pdf_integral == pytest.approx(1.1, abs=1e-5)
+
+
+def test_chi2_rejects_sampling_that_does_not_match_the_pdf():
+    r = chi2_test(UniformSampler(), 30.0)
+    assert r.p_value < 1e-6
+
+
+def test_chi2_rejects_unannounced_absorption():
+    r = chi2_test(SecretAbsorber(), 30.0)
+    assert r.p_value < 1e-6
+    assert "absorbed" in r.worst
+
+
+def test_chi2_fails_samples_where_the_pdf_is_zero():
+    class ClaimsHalf(Lambertian):  # pdf() 0 for x < 0, but samples go there
+        def pdf(self, ray_view, ray_light, hit):
+            d = ray_light.direction
+            return 2.0 * super().pdf(ray_view, ray_light, hit) if d.e0 > 0.0 else 0.0
+
+    r = chi2_test(ClaimsHalf(), 30.0, n_samples=10_000)
+    assert r.p_value == 0.0
+    assert "pdf() is 0" in r.message
+
+
+def test_chi2_fails_a_negative_pdf():
+    class NegativePdf(Lambertian):
+        def pdf(self, ray_view, ray_light, hit):
+            return -super().pdf(ray_view, ray_light, hit)
+
+    r = chi2_test(NegativePdf(), 30.0, n_samples=1000)
+    assert r.p_value == 0.0 and "negative or not finite" in r.message
+
+
+def test_chi2_refuses_specular_materials_and_foreign_samples():
+    with pytest.raises(ValueError):
+        chi2_test(Mirror(), 30.0)
+    samples = draw_samples(Lambertian(), 30.0, 100)
+    with pytest.raises(ValueError):
+        chi2_test(Lambertian(), 60.0, samples=samples)
