@@ -30,6 +30,7 @@ from .io.values import (
 from .vec3 import Color
 
 __all__ = [
+    "BACKENDS",
     "INTEGRATOR_NAMES",
     "MAX_MAX_DEPTH",
     "MAX_SPP",
@@ -43,6 +44,7 @@ __all__ = [
 ]
 
 INTEGRATOR_NAMES = ("center", "jittered", "direct", "whitted", "path")
+BACKENDS = ("scalar", "numpy")  # rtpy.renderer.make_backend builds them
 
 # Sanity limits: larger values would exhaust memory or never finish.
 MAX_WIDTH = 16384

@@ -30,7 +30,7 @@ from tqdm import tqdm
 from .camera import Camera
 from .integrators import make_integrator
 from .io.image import RenderedImage
-from .render_settings import RenderSettings
+from .render_settings import BACKENDS, RenderSettings
 from .sampling import make_generator, use_generator
 from .scene import Scene
 from .testing.statistics import peak_memory_mb
@@ -122,7 +122,6 @@ class PixelSums:
 
 
 # --- backends ---------------------------------------------------------------------
-BACKENDS = ("scalar", "numpy")
 
 
 class Backend:

@@ -12,7 +12,7 @@ import sys
 import tomllib
 from pathlib import Path
 
-from ..render_settings import SETTINGS, SettingError, unknown_setting
+from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
 from .image import OutputError, check_image_path, check_linear_path
 
 EXIT_BAD_INPUT = 2
@@ -81,7 +81,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--backend",
-        choices=("scalar", "numpy"),
+        choices=BACKENDS,
         default="scalar",
         help="scalar: the readable reference (default); numpy: vectorized, many times faster",
     )
