@@ -46,7 +46,7 @@ class BlinnPhong(Material):
     around the normal with density (n + 1) / (2 pi) * (normal . h)^n and reflects
     wo about it: wi = reflect(-wo, h) = 2 (wo . h) h - wo. Changing variables from h
     to wi divides the density by 4 (wo . h), the Jacobian of the reflection. A half
-    vector facing away from the viewer (wo . h <= 0) gives no reflected direction:
+    vector facing away from the viewer (wo . h <= 0) reflects wo below the surface:
     that sample is absorbed.
     """
 
@@ -102,8 +102,7 @@ class BlinnPhong(Material):
             wi = ONB(hit.normal).to_world(random_cosine_direction())
         else:
             h = ONB(hit.normal).to_world(sample_cosine_power(self.exponent, r(), r()))
-            # A half vector facing away from the viewer reflects nothing toward it.
-            wi = reflect(ray_in.direction, h) if dot(ray_in.direction, h) < 0.0 else None
+            wi = reflect(ray_in.direction, h)
         return weighted_sample(self, ray_in, hit, wi)
         # END SOLUTION
 

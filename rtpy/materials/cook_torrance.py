@@ -261,7 +261,7 @@ class CookTorrance(Material):
             wi = ONB(hit.normal).to_world(random_cosine_direction())
         else:
             h = ONB(hit.normal).to_world(self.sample_half_vector(r(), r()))
-            # A facet turned away from the viewer reflects nothing toward it.
-            wi = reflect(ray_in.direction, h) if dot(ray_in.direction, h) < 0.0 else None
+            # A facet turned away from the viewer reflects wo below the surface (absorbed).
+            wi = reflect(ray_in.direction, h)
         return weighted_sample(self, ray_in, hit, wi)
         # END SOLUTION

@@ -67,16 +67,12 @@ def mixture_pdf(p_diffuse: float, cos_i: float, highlight_pdf: float) -> float:
     # END SOLUTION
 
 
-def weighted_sample(
-    material: Material, ray_in: Ray, hit: HitInfo, wi: Vec3 | None
-) -> ScatterInfo | None:
-    """The ScatterInfo of the direction wi that material.scattering() drew (None: the
-    lobe drew none): the ray toward wi and the weight BRDF * cos(theta_i) / pdf, with
-    the material's own BRDF() and pdf(). None (absorbed) when wi lies below the
-    surface or pdf() gives it no density."""
+def weighted_sample(material: Material, ray_in: Ray, hit: HitInfo, wi: Vec3) -> ScatterInfo | None:
+    """The ScatterInfo of the direction wi that material.scattering() drew: the ray
+    toward wi and the weight BRDF * cos(theta_i) / pdf, with the material's own BRDF()
+    and pdf(). None (absorbed) when wi lies below the surface (a reflection about a
+    half vector that faces away from the viewer does) or pdf() gives it no density."""
     # BEGIN SOLUTION week08: the sample's weight BRDF * cos / pdf of the mixture
-    if wi is None:
-        return None
     cos_i = dot(hit.normal, wi)
     if cos_i <= 0.0:
         return None  # drawn below the surface: no reflected light

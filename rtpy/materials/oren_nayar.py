@@ -94,14 +94,17 @@ class OrenNayar(Material):
         return max(0.0, dot(normal, ray_light.direction)) * INV_PI
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
-        """A cosine-weighted direction around the normal; weight BRDF * cos / pdf."""
+        """A cosine-weighted direction around the normal, as Lambertian's; the weight
+        BRDF * cos / pdf = albedo / pi * factor * cos / (cos / pi) is albedo * factor."""
         normal = hit.normal
-        if dot(normal, ray_in.direction) >= 0.0:
-            return None
-        wi = ONB(normal).to_world(random_cosine_direction())
+        cos_o = -dot(normal, ray_in.direction)
+        if cos_o <= 0.0:
+            return None  # viewer below the surface
+        local = random_cosine_direction()  # z = cos(theta_i)
+        wi = ONB(normal).to_world(local)
         cos_i = dot(normal, wi)
-        if not cos_i > 0.0:
+        if not (cos_i > 0.0 and local.z() > 0.0):
             return None
-        ray_light = spawn_ray(hit.point, normal, wi)
-        pdf = cos_i * INV_PI
-        return ScatterInfo(ray_light, self.BRDF(ray_in, ray_light, hit) * (cos_i / pdf), pdf)
+        factor = self.factor(cos_o, cos_i, -dot(ray_in.direction, wi))
+        weight = self.albedo.value(hit) * factor
+        return ScatterInfo(spawn_ray(hit.point, normal, wi), weight, local.z() * INV_PI)

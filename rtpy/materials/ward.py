@@ -188,7 +188,6 @@ class Ward(Material):
             wi = ONB(hit.normal).to_world(random_cosine_direction())
         else:
             h = hit.frame.to_world(self.sample_half_vector(r(), r()))
-            # Reflecting about a half vector turned away from wo would send wo below.
-            wi = reflect(ray_in.direction, h) if dot(ray_in.direction, h) < 0.0 else None
+            wi = reflect(ray_in.direction, h)  # below the surface if h faces away from wo
         return weighted_sample(self, ray_in, hit, wi)
         # END SOLUTION

@@ -17,60 +17,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rtpy.hit_info import HitInfo
 from rtpy.io.scene_file import SceneError, load_scene_text
 from rtpy.materials import MATERIALS, Lambertian, OrenNayar
-from rtpy.ray import Ray
 from rtpy.sampling import make_generator, use_generator
-from rtpy.vec3 import Color, Vec3
+from rtpy.vec3 import Color
 
-ALBEDO = (0.8, 0.5, 0.25)
-POINT = (0.5, -0.25, 2.0)
-
-
-def dot3(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def unit3(a):
-    k = 1.0 / math.sqrt(dot3(a, a))
-    return (a[0] * k, a[1] * k, a[2] * k)
-
-
-def cross3(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def frame(axis):
-    helper = (1.0, 0.0, 0.0) if abs(axis[0]) < 0.9 else (0.0, 1.0, 0.0)
-    k = dot3(helper, axis)
-    t = unit3(tuple(helper[i] - k * axis[i] for i in range(3)))
-    return t, cross3(axis, t)
-
-
-def direction(normal, theta_deg, phi_deg):
-    t, b = frame(normal)
-    th, ph = math.radians(theta_deg), math.radians(phi_deg)
-    s = math.sin(th)
-    return tuple(
-        s * math.cos(ph) * t[i] + s * math.sin(ph) * b[i] + math.cos(th) * normal[i]
-        for i in range(3)
-    )
-
-
-NORMAL = unit3((0.3, -0.5, 0.8))
-
-
-def make_hit(material, normal=NORMAL):
-    return HitInfo(Vec3(*POINT), Vec3(*normal), 1.0, True, material)
-
-
-def view_ray(wo) -> Ray:
-    return Ray(Vec3(*(POINT[i] + wo[i] for i in range(3))), Vec3(*(-x for x in wo)))
-
-
-def light_ray(wi) -> Ray:
-    return Ray(Vec3(*POINT), Vec3(*wi))
+from .directions import ALBEDO, NORMAL, POINT, direction, dot3, light_ray, make_hit, view_ray
 
 
 def coefficients(sigma_deg):

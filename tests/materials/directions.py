@@ -1,0 +1,228 @@
+"""Directions, hits and quadrature for the reflection-model tests.
+
+Plain tuples and math, independent of rtpy.vec3 and rtpy.onb, so that expected
+values do not come from the code under test. Directions point away from the
+surface: wo toward the viewer, wi toward the light.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rtpy.hit_info import HitInfo
+from rtpy.ray import Ray
+from rtpy.sampling import make_generator, use_generator
+from rtpy.vec3 import Vec3
+
+ALBEDO = (0.8, 0.5, 0.25)
+POINT = (0.5, -0.25, 2.0)
+
+
+def dot3(a, b) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross3(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def unit3(a):
+    k = 1.0 / math.sqrt(dot3(a, a))
+    return (a[0] * k, a[1] * k, a[2] * k)
+
+
+def angle(a, b) -> float:
+    return math.acos(max(-1.0, min(1.0, dot3(a, b))))
+
+
+# A tilted surface, so that no coordinate axis helps the code under test; and the
+# axis-aligned one, where local and world coordinates are the same.
+NORMAL = unit3((0.3, -0.5, 0.8))
+TANGENT = unit3(cross3(NORMAL, (0.0, 0.0, 1.0)))
+Z, X = (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)
+
+
+def frame(axis):
+    """Two unit vectors completing `axis` to an orthonormal frame (Gram-Schmidt)."""
+    helper = (1.0, 0.0, 0.0) if abs(axis[0]) < 0.9 else (0.0, 1.0, 0.0)
+    k = dot3(helper, axis)
+    t = unit3(tuple(helper[i] - k * axis[i] for i in range(3)))
+    return t, cross3(axis, t)
+
+
+def around(axis, cos_t, phi, tangent=None):
+    """The unit vector at angle acos(cos_t) from axis, at azimuth phi from the tangent
+    (by default the first vector of frame(axis))."""
+    t, b = frame(axis) if tangent is None else (tangent, cross3(axis, tangent))
+    s = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))
+    c, d = s * math.cos(phi), s * math.sin(phi)
+    return tuple(c * t[i] + d * b[i] + cos_t * axis[i] for i in range(3))
+
+
+def direction(normal, theta_deg, phi_deg):
+    """At theta_deg degrees from the normal, azimuth phi_deg in frame(normal)."""
+    return around(normal, math.cos(math.radians(theta_deg)), math.radians(phi_deg))
+
+
+def polar(theta, phi, normal=NORMAL, tangent=TANGENT):
+    """At polar angle theta (radians) from the normal, azimuth phi from the tangent."""
+    b = cross3(normal, tangent)
+    s = math.sin(theta)
+    return tuple(
+        s * math.cos(phi) * tangent[k] + s * math.sin(phi) * b[k] + math.cos(theta) * normal[k]
+        for k in range(3)
+    )
+
+
+def mirror(d, normal):
+    """d reflected about the normal (d and the result both point away from the surface)."""
+    k = 2.0 * dot3(d, normal)
+    return tuple(k * normal[i] - d[i] for i in range(3))
+
+
+def half(wo, wi):
+    return unit3(tuple(wo[i] + wi[i] for i in range(3)))
+
+
+def make_hit(material, normal=NORMAL, tangent=None) -> HitInfo:
+    hit = HitInfo(Vec3(*POINT), Vec3(*normal), 1.0, True, material)
+    if tangent is not None:
+        hit.tangent = Vec3(*tangent)
+    return hit
+
+
+def view_ray(wo) -> Ray:
+    """The ray arriving at POINT from the viewer, who sits in direction wo."""
+    return Ray(Vec3(*(POINT[i] + wo[i] for i in range(3))), Vec3(*(-x for x in wo)))
+
+
+def light_ray(wi) -> Ray:
+    return Ray(Vec3(*POINT), Vec3(*wi))
+
+
+def brdf(m, wo, wi, normal=NORMAL, tangent=None) -> list[float]:
+    return m.BRDF(view_ray(wo), light_ray(wi), make_hit(m, normal, tangent)).tolist()
+
+
+def pdf(m, wo, wi, normal=NORMAL, tangent=None) -> float:
+    return m.pdf(view_ray(wo), light_ray(wi), make_hit(m, normal, tangent))
+
+
+def alive_fraction(m, wo, n: int, seed: int, normal=NORMAL) -> float:
+    """The fraction of n scattering() calls from viewer direction wo that return a
+    sample (the rest are absorbed)."""
+    hit = make_hit(m, normal)
+    with use_generator(make_generator(seed)):
+        return sum(m.scattering(view_ray(wo), hit) is not None for _ in range(n)) / n
+
+
+# --- quadrature ---------------------------------------------------------------------------
+
+GL_X, GL_W = np.polynomial.legendre.leggauss(24)
+
+# Gauss-Legendre pieces in u = cos(angle to the axis), finer toward u = 1 where
+# cosine-power lobes concentrate; the azimuth uses the periodic trapezoid rule.
+U_BREAKS = (-1.0, 0.0, 1e-4, 1e-3, 0.01, 0.1, 0.5, 0.8, 0.9, 0.95, 0.98, 0.99, 0.995, 0.998)
+U_BREAKS += (0.999, 0.9995, 0.9998, 0.9999, 0.99995, 0.99999, 1.0)
+
+
+def sphere_integral(f, axis, n_phi=48) -> float:
+    """Integral of f(direction) over the unit sphere, in the frame around `axis`."""
+    total = 0.0
+    for lo, hi in zip(U_BREAKS[:-1], U_BREAKS[1:], strict=True):
+        h = 0.5 * (hi - lo)
+        for x, w in zip(GL_X, GL_W, strict=True):
+            u = lo + h * (x + 1.0)
+            ring = sum(f(around(axis, u, 2.0 * math.pi * (k + 0.5) / n_phi)) for k in range(n_phi))
+            total += w * h * ring * (2.0 * math.pi / n_phi)
+    return total
+
+
+GL12_X, GL12_W = np.polynomial.legendre.leggauss(12)
+STEPS = (0.0, 1e-3, 3e-3, 0.01, 0.02, 0.04, 0.08, 0.15, 0.3)
+
+
+def polar_integral(f, axis, peak) -> float:
+    """Integral of f(direction) over the unit sphere, in polar coordinates (psi, phi)
+    around `axis` (psi from the axis): Gauss-Legendre on cells whose edges crowd
+    around the direction `peak`, where the lobe is.
+
+    Around wo's antipode a half-vector lobe's density grows like
+    1 / (4 wo . h) = 1 / (2 sin(psi / 2)) with psi the angle to -wo; the area element
+    sin(psi) makes that smooth, which a grid in cos(psi) would not. So pass axis = -wo
+    for a density."""
+    t, b = frame(axis)
+    psi_peak = math.acos(max(-1.0, min(1.0, dot3(peak, axis))))
+    phi_peak = math.atan2(dot3(peak, b), dot3(peak, t))
+    psi = {k * math.pi / 16 for k in range(17)}
+    psi |= {psi_peak + s for s in STEPS} | {psi_peak - s for s in STEPS}
+    psi = sorted(x for x in psi if 0.0 <= x <= math.pi)
+    phi = {phi_peak + k * math.pi / 8 for k in range(-8, 9)}
+    phi |= {phi_peak + s for s in STEPS} | {phi_peak - s for s in STEPS}
+    phi = sorted(phi)
+    total = 0.0
+    for p0, p1 in zip(psi[:-1], psi[1:], strict=True):
+        hp = 0.5 * (p1 - p0)
+        for x, wx in zip(GL12_X, GL12_W, strict=True):
+            ps = p0 + hp * (x + 1.0)
+            cos_p, sin_p = math.cos(ps), math.sin(ps)
+            ring = 0.0
+            for q0, q1 in zip(phi[:-1], phi[1:], strict=True):
+                hq = 0.5 * (q1 - q0)
+                for y, wy in zip(GL12_X, GL12_W, strict=True):
+                    ring += wy * hq * f(around(axis, cos_p, q0 + hq * (y + 1.0)))
+            total += wx * hp * sin_p * ring
+    return total
+
+
+def theta_nodes(a: float) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights in theta on [0, pi/2], with breakpoints where
+    tan(theta) is a fixed multiple of the width a (so narrow lobes are resolved)."""
+    edges = [0.0]
+    s = 0.125
+    while math.atan(a * s) < math.pi / 2 - 1e-3 and s < 1e7:
+        edges.append(math.atan(a * s))
+        s *= 2.0
+    edges.append(math.pi / 2)
+    xs, ws = [], []
+    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+        xs.append(lo + (hi - lo) * (GL_X + 1.0) / 2.0)
+        ws.append(GL_W * (hi - lo) / 2.0)
+    return np.concatenate(xs), np.concatenate(ws)
+
+
+def hemisphere_integral(f, a: float, n_phi: int = 1, phi_offset: float = 0.0) -> float:
+    """Integral of f(theta, phi) sin(theta) d(theta) d(phi) over the upper hemisphere
+    around z, resolved for a lobe of width a. n_phi = 1 for integrands that do not
+    depend on phi."""
+    thetas, weights = theta_nodes(a)
+    phis = phi_offset + 2.0 * math.pi * (np.arange(n_phi) + 0.5) / n_phi
+    total = 0.0
+    for t, w in zip(thetas, weights, strict=True):
+        row = sum(f(t, p) for p in phis) * (2.0 * math.pi / n_phi)
+        total += w * math.sin(t) * row
+    return total
+
+
+def half_vector_albedo(m, wo, a: float, n_phi: int) -> float:
+    """Directional albedo of a material with kd = 0 seen from wo, on the axis-aligned
+    surface (normal Z, tangent X): the integral of f cos(theta_i) d(w_i), written over
+    the half vector h as f cos(theta_i) 4 (wo . h) d(w_h) (wi = the mirror of wo about
+    h), resolved for a lobe of width a."""
+    hit = make_hit(m, Z, X)
+
+    def integrand(t, p):
+        s = math.sin(t)
+        h = (s * math.cos(p), s * math.sin(p), math.cos(t))
+        wo_h = dot3(wo, h)
+        if wo_h <= 0.0:
+            return 0.0
+        wi = tuple(2.0 * wo_h * h[k] - wo[k] for k in range(3))
+        if wi[2] <= 0.0:
+            return 0.0
+        return m.BRDF(view_ray(wo), light_ray(wi), hit).e0 * wi[2] * 4.0 * wo_h
+
+    # phi_offset keeps the nodes off the plane of incidence's seam.
+    return hemisphere_integral(integrand, a, n_phi, phi_offset=0.01)
