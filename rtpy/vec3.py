@@ -177,9 +177,7 @@ def halfvector(view: Vec3, light: Vec3) -> Vec3:
     surface). Blinn-Phong, Cook-Torrance and Ward evaluate their highlights at h.
     view = -light has no half vector (ZeroDivisionError); above a surface they never
     are, since both lie on the normal's side."""
-    # BEGIN SOLUTION week08: the unit vector halfway between view and light
     return unit_vector(view + light)
-    # END SOLUTION
 
 
 BLACK = Color(0.0, 0.0, 0.0)

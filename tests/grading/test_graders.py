@@ -27,15 +27,16 @@ import rtpy.integrators.center as center
 import rtpy.integrators.direct_lighting as direct_lighting
 import rtpy.integrators.path as path_module
 import rtpy.materials.dielectric as dielectric
+import rtpy.materials.glossy as glossy
 import rtpy.materials.mirror as mirror
+import rtpy.materials.phong as phong
 import rtpy.vec3 as vec3
 from rtpy import Camera, CheckerTexture, ImageTexture, PointLight, Quad, Ray, Scene, Sphere
 from rtpy.grading import compare, summarize
 from rtpy.grading.assignment import WEEKS
 from rtpy.io.cli import main
-from rtpy.materials import BlinnPhong, Lambertian, Metal, Phong
-from rtpy.materials.glossy import GlossyMaterial
-from rtpy.vec3 import Color, Vec3
+from rtpy.materials import BlinnPhong, CookTorrance, Lambertian, Metal, Phong
+from rtpy.vec3 import Vec3
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -61,7 +62,8 @@ def wrap(cls, name, change):
 
 def plant(mp, owner, name, old, new):
     """Replace owner.name by its own source with `old` changed to `new`: a mistake
-    inside a function, such as a forgotten division."""
+    inside a function, such as a forgotten division. A module-level function is
+    replaced in every rtpy module that imported it."""
     function = inspect.unwrap(getattr(owner, name))
     source = textwrap.dedent(inspect.getsource(function))
     assert old in source, f"{name}: {old!r} not in its source"
@@ -69,7 +71,17 @@ def plant(mp, owner, name, old, new):
     module_globals = vars(sys.modules[function.__module__])
     module_globals = {"dot": vec3.dot, **module_globals}
     exec(compile(source.replace(old, new), f"<planted {name}>", "exec"), module_globals, namespace)
-    mp.setattr(owner, name, namespace[name])
+    replace_everywhere(mp, owner, name, function, namespace[name])
+
+
+def replace_everywhere(mp, owner, name, original, replacement):
+    """owner.name = replacement, and the same in every rtpy module that holds original
+    under that name (a module-level function imported by name)."""
+    mp.setattr(owner, name, replacement)
+    if inspect.ismodule(owner):
+        for module_name, module in list(sys.modules.items()):
+            if module_name.startswith("rtpy") and getattr(module, name, None) is original:
+                mp.setattr(module, name, replacement)
 
 
 # --- the mistakes -----------------------------------------------------------------------
@@ -108,7 +120,7 @@ def cosine_with_unnormalised_vector(mp):
         mp,
         direct_lighting,
         "sample_one_light",
-        "cos_i = normal.e0 * wi.e0 + normal.e1 * wi.e1 + normal.e2 * wi.e2",
+        "cos_i = dot(normal, wi)",
         "d = sample.point - hit.point; cos_i = dot(normal, d)",
     )
 
@@ -324,37 +336,52 @@ def fuzz_ignored(mp):
 
 
 def phong_wrong_normalisation(mp):
-    def change(self, f, wo, wi):
-        return f * ((self.exponent + 1.0) / (self.exponent + 2.0))
-
-    mp.setattr(Phong, "specular", wrap(Phong, "specular", change))
+    plant(mp, Phong, "BRDF", "(n + 2.0) * INV_TWO_PI", "(n + 1.0) * INV_TWO_PI")
 
 
-def unnormalised_half_vector(mp):
-    def specular(self, wo, wi):
-        hz = wo[2] + wi[2]  # (wo + wi).z without dividing by |wo + wi|
-        n = self.exponent
-        return Color(1.0, 1.0, 1.0) * ((n + 8.0) / (8.0 * math.pi) * min(hz, 1.5) ** n)
+def phong_albedo_as_brdf(mp):
+    # The course's Phong: fr = kd + ks (R.V)^n, the albedo (no 1 / pi) as the diffuse part.
+    plant(
+        mp,
+        Phong,
+        "BRDF",
+        "self.albedo.value(hit) * (self.kd * INV_PI)",
+        "self.albedo.value(hit) * self.kd",
+    )
 
-    mp.setattr(BlinnPhong, "specular", specular)
+
+def course_halfvector(mp):
+    # The course's halfvector: (view + light) * 0.5, not a unit vector.
+    plant(mp, vec3, "halfvector", "return unit_vector(view + light)", "return (view + light) * 0.5")
 
 
 def half_vector_pdf_without_jacobian(mp):
-    def change(self, pdf, wo, wi):
-        h = [wo[k] + wi[k] for k in range(3)]
-        length = math.sqrt(sum(x * x for x in h))
-        return pdf * 4.0 * sum(wo[k] * h[k] for k in range(3)) / length
+    plant(mp, BlinnPhong, "pdf", " / (4.0 * wo_h)", "")
 
-    mp.setattr(BlinnPhong, "specular_pdf", wrap(BlinnPhong, "specular_pdf", change))
+
+def phong_pdf_around_the_normal(mp):
+    plant(mp, Phong, "pdf", "dot(mirror, wi)", "dot(normal, wi)")
+
+
+def cook_torrance_pdf_without_cosine(mp):
+    plant(mp, CookTorrance, "pdf", "self.D(normal, h) * dot(normal, h)", "self.D(normal, h)")
+
+
+def mixture_pdf_unweighted(mp):
+    plant(mp, glossy, "mixture_pdf", "(1.0 - p_diffuse) * highlight_pdf", "highlight_pdf")
+
+
+def cosine_power_wrong_inverse(mp):
+    plant(mp, phong, "sample_cosine_power", "1.0 / (exponent + 1.0)", "1.0 / (exponent + 2.0)")
+
+
+def ggx_without_pi(mp):
+    plant(mp, CookTorrance, "D", "a2 / (math.pi * k * k)", "a2 / (k * k)")
 
 
 def glossy_no_pdf(mp):
-    def change(self, s, ray_in, hit):
-        if s is not None:
-            s.attenuation = s.attenuation * s.pdf  # BRDF * cos, the 1/pdf forgotten
-        return s
-
-    mp.setattr(GlossyMaterial, "scattering", wrap(GlossyMaterial, "scattering", change))
+    # BRDF * cos, the 1/pdf forgotten
+    plant(mp, glossy, "weighted_sample", "* (cos_i / pdf)", "* cos_i")
 
 
 # (week, mistake, grader tests that must fail)
@@ -387,8 +414,26 @@ PLANTED = [
     ("07", fuzz_not_absorbed, ["test_metal_fuzz"]),
     ("07", fuzz_ignored, ["test_metal_fuzz"]),
     ("08", phong_wrong_normalisation, ["test_phong_brdf"]),
-    ("08", unnormalised_half_vector, ["test_blinn_phong_brdf"]),
-    ("08", half_vector_pdf_without_jacobian, ["test_sampling_follows_pdf[blinn_phong]"]),
+    ("08", phong_albedo_as_brdf, ["test_phong_brdf"]),
+    ("08", course_halfvector, ["test_blinn_phong_brdf"]),
+    (
+        "08",
+        half_vector_pdf_without_jacobian,
+        ["test_pdf[blinn_phong]", "test_sampling_follows_pdf[blinn_phong]"],
+    ),
+    ("08", phong_pdf_around_the_normal, ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"]),
+    (
+        "08",
+        cook_torrance_pdf_without_cosine,
+        ["test_pdf[cook_torrance_ggx]", "test_sampling_follows_pdf[cook_torrance_ggx]"],
+    ),
+    ("08", mixture_pdf_unweighted, ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"]),
+    ("08", cosine_power_wrong_inverse, ["test_cosine_power_sampler"]),
+    (
+        "08",
+        ggx_without_pi,
+        ["test_cook_torrance_factors[ggx]", "test_cook_torrance_brdf[cook_torrance_ggx]"],
+    ),
     ("08", glossy_no_pdf, ["test_weight_is_brdf_cos_over_pdf[cook_torrance_ggx]"]),
     ("08", light_counted_twice, ["test_path_render_matches_reference"]),
     ("08", path_counts_light_twice, ["test_path_render_matches_reference", "test_path_furnace"]),
