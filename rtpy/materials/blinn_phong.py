@@ -22,11 +22,10 @@ from ..onb import ONB
 from ..ray import Ray
 from ..sampling import generator, random_cosine_direction
 from ..scatter_info import ScatterInfo
-from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, dot, halfvector, reflect
-from .glossy import INV_PI, check_strengths, diffuse_probability, mixture_pdf, weighted_sample
-from .material import Material, as_texture
-from .phong import check_exponent, cosine_power_pdf, sample_cosine_power
+from .glossy import INV_PI, diffuse_probability, mixture_pdf, reflected_density, weighted_sample
+from .material import Material
+from .phong import Phong, cosine_power_pdf, sample_cosine_power
 
 INV_EIGHT_PI = 0.125 / math.pi
 
@@ -50,16 +49,7 @@ class BlinnPhong(Material):
     that sample is absorbed.
     """
 
-    def __init__(
-        self,
-        albedo: Color | Texture = Color(0.5, 0.5, 0.5),
-        kd: float = 1.0,
-        ks: float = 0.0,
-        exponent: float = 1.0,
-    ) -> None:
-        self.albedo = as_texture(albedo)
-        self.kd, self.ks = check_strengths(kd, ks)
-        self.exponent = check_exponent(exponent)
+    __init__ = Phong.__init__  # the same parameters as Phong's
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
         """kd * albedo / pi + ks * (n + 8) / (8 pi) * (normal . h)^n with the unit half
@@ -86,10 +76,8 @@ class BlinnPhong(Material):
         if dot(normal, wo) <= 0.0 or cos_i <= 0.0:
             return 0.0
         h = halfvector(wo, wi)
-        wo_h = dot(wo, h)
-        highlight = 0.0
-        if wo_h > 0.0:
-            highlight = cosine_power_pdf(self.exponent, dot(normal, h)) / (4.0 * wo_h)
+        density_h = cosine_power_pdf(self.exponent, dot(normal, h))  # the half vector's
+        highlight = reflected_density(density_h, wo, h)
         return mixture_pdf(diffuse_probability(self, hit), cos_i, highlight)
         # END SOLUTION
 

@@ -56,8 +56,8 @@ from ..sampling import generator, random_cosine_direction
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, Vec3, cross, dot, halfvector, reflect
-from .glossy import INV_PI, check_strengths, diffuse_probability, mixture_pdf, weighted_sample
-from .material import Material, as_texture
+from .glossy import INV_PI, diffuse_probability, mixture_pdf, reflected_density, weighted_sample
+from .material import Material, as_texture, check_strengths
 
 INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
 
@@ -245,10 +245,8 @@ class CookTorrance(Material):
         if dot(normal, wo) <= 0.0 or cos_i <= 0.0:
             return 0.0
         h = halfvector(wo, wi)
-        wo_h = dot(wo, h)
-        highlight = 0.0
-        if wo_h > 0.0:
-            highlight = self.D(normal, h) * dot(normal, h) / (4.0 * wo_h)
+        density_h = self.D(normal, h) * dot(normal, h)  # D(h) cos(theta_h), the half vector's
+        highlight = reflected_density(density_h, wo, h)
         return mixture_pdf(diffuse_probability(self, hit), cos_i, highlight)
         # END SOLUTION
 

@@ -41,14 +41,6 @@ INV_PI = 1.0 / math.pi
 MAX_PDF = 1e150
 
 
-def check_strengths(kd: float, ks: float) -> tuple[float, float]:
-    """(kd, ks) as floats, or ValueError unless both are finite numbers >= 0."""
-    for name, value in (("kd", kd), ("ks", ks)):
-        if not (isinstance(value, int | float) and value >= 0.0 and math.isfinite(value)):
-            raise ValueError(f"{name} must be a finite number >= 0, got {value}")
-    return float(kd), float(ks)
-
-
 def diffuse_probability(material: Material, hit: HitInfo) -> float:
     """p_d = kd * max(albedo) / (kd * max(albedo) + ks) of a material with albedo, kd
     and ks at this hit (1 when both lobes are black)."""
@@ -64,6 +56,18 @@ def mixture_pdf(p_diffuse: float, cos_i: float, highlight_pdf: float) -> float:
     if p_diffuse < 1.0:  # (highlight_pdf may be inf at a grazing half vector)
         pdf += (1.0 - p_diffuse) * highlight_pdf
     return min(pdf, MAX_PDF)
+    # END SOLUTION
+
+
+def reflected_density(half_vector_density: float, wo: Vec3, h: Vec3) -> float:
+    """The density of wi = reflect(-wo, h) when the unit half vector h is drawn with
+    half_vector_density: that times the Jacobian d(w_h) / d(w_i) = 1 / (4 (wo . h)) of
+    the reflection; 0 when h faces away from wo."""
+    # BEGIN SOLUTION week08: the half vector's density over 4 (wo . h)
+    wo_h = dot(wo, h)
+    if wo_h <= 0.0:
+        return 0.0
+    return half_vector_density / (4.0 * wo_h)
     # END SOLUTION
 
 

@@ -21,8 +21,8 @@ from ..sampling import generator, random_cosine_direction
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, Vec3, dot, reflect
-from .glossy import INV_PI, check_strengths, diffuse_probability, mixture_pdf, weighted_sample
-from .material import Material, as_texture
+from .glossy import INV_PI, diffuse_probability, mixture_pdf, weighted_sample
+from .material import Material, as_texture, check_strengths
 
 INV_TWO_PI = 0.5 / math.pi
 

@@ -47,8 +47,8 @@ from ..sampling import generator, random_cosine_direction
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, Vec3, dot, halfvector, reflect
-from .glossy import INV_PI, check_strengths, diffuse_probability, mixture_pdf, weighted_sample
-from .material import Material, as_texture
+from .glossy import INV_PI, diffuse_probability, mixture_pdf, reflected_density, weighted_sample
+from .material import Material, as_texture, check_strengths
 
 MAX_ALPHA = 1.0
 # Widths below this are computed as this (a mirror to every practical purpose):
@@ -153,13 +153,12 @@ class Ward(Material):
         cos_o, cos_i = dot(normal, wo), dot(normal, wi)
         if cos_o <= 0.0 or cos_i <= 0.0:
             return BLACK  # reflection only: both directions above the surface
+        exponent = self.slope_exponent(hit.frame, wo + wi)  # wo + wi: h before normalising
         f = self.albedo.value(hit) * (self.kd * INV_PI)
-        if self.ks > 0.0:
-            exponent = self.slope_exponent(hit.frame, wo + wi)  # h before normalising
-            if exponent <= MAX_EXPONENT:
-                root = math.sqrt(max(cos_i * cos_o, MIN_COS_PRODUCT))
-                lobe = math.exp(-exponent) / (4.0 * math.pi * self.ax * self.ay * root)
-                f = f + WHITE * (self.ks * lobe)
+        if self.ks > 0.0 and exponent <= MAX_EXPONENT:
+            root = math.sqrt(max(cos_i * cos_o, MIN_COS_PRODUCT))
+            lobe = math.exp(-exponent) / (4.0 * math.pi * self.ax * self.ay * root)
+            f = f + WHITE * (self.ks * lobe)
         return f
 
     def pdf(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> float:
@@ -172,10 +171,8 @@ class Ward(Material):
         if dot(normal, wo) <= 0.0 or cos_i <= 0.0:
             return 0.0
         h = halfvector(wo, wi)
-        wo_h = dot(wo, h)
-        highlight = 0.0
-        if wo_h > 0.0:
-            highlight = self.half_vector_pdf(hit.frame, h) / (4.0 * wo_h)
+        density_h = self.half_vector_pdf(hit.frame, h)
+        highlight = reflected_density(density_h, wo, h)
         return mixture_pdf(diffuse_probability(self, hit), cos_i, highlight)
         # END SOLUTION
 

@@ -35,7 +35,7 @@ from rtpy import Camera, CheckerTexture, ImageTexture, PointLight, Quad, Ray, Sc
 from rtpy.grading import compare, summarize
 from rtpy.grading.assignment import WEEKS
 from rtpy.io.cli import main
-from rtpy.materials import BlinnPhong, CookTorrance, Lambertian, Metal, Phong
+from rtpy.materials import CookTorrance, Lambertian, Metal, Phong
 from rtpy.vec3 import Vec3
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -335,53 +335,49 @@ def fuzz_ignored(mp):
     mp.setattr(Metal, "scattering", scattering)
 
 
-def phong_wrong_normalisation(mp):
-    plant(mp, Phong, "BRDF", "(n + 2.0) * INV_TWO_PI", "(n + 1.0) * INV_TWO_PI")
+def in_source(label, owner, name, old, new):
+    """The mistake `label`: `old` changed to `new` in the source of owner.name (plant)."""
+
+    def mistake(mp):
+        plant(mp, owner, name, old, new)
+
+    mistake.__name__ = label
+    return mistake
 
 
-def phong_albedo_as_brdf(mp):
-    # The course's Phong: fr = kd + ks (R.V)^n, the albedo (no 1 / pi) as the diffuse part.
-    plant(
-        mp,
-        Phong,
-        "BRDF",
-        "self.albedo.value(hit) * (self.kd * INV_PI)",
-        "self.albedo.value(hit) * self.kd",
-    )
-
-
-def course_halfvector(mp):
-    # The course's halfvector: (view + light) * 0.5, not a unit vector.
-    plant(mp, vec3, "halfvector", "return unit_vector(view + light)", "return (view + light) * 0.5")
-
-
-def half_vector_pdf_without_jacobian(mp):
-    plant(mp, BlinnPhong, "pdf", " / (4.0 * wo_h)", "")
-
-
-def phong_pdf_around_the_normal(mp):
-    plant(mp, Phong, "pdf", "dot(mirror, wi)", "dot(normal, wi)")
-
-
-def cook_torrance_pdf_without_cosine(mp):
-    plant(mp, CookTorrance, "pdf", "self.D(normal, h) * dot(normal, h)", "self.D(normal, h)")
-
-
-def mixture_pdf_unweighted(mp):
-    plant(mp, glossy, "mixture_pdf", "(1.0 - p_diffuse) * highlight_pdf", "highlight_pdf")
-
-
-def cosine_power_wrong_inverse(mp):
-    plant(mp, phong, "sample_cosine_power", "1.0 / (exponent + 1.0)", "1.0 / (exponent + 2.0)")
-
-
-def ggx_without_pi(mp):
-    plant(mp, CookTorrance, "D", "a2 / (math.pi * k * k)", "a2 / (k * k)")
-
-
-def glossy_no_pdf(mp):
-    # BRDF * cos, the 1/pdf forgotten
-    plant(mp, glossy, "weighted_sample", "* (cos_i / pdf)", "* cos_i")
+# Week 8's mistakes, each one change to the solution's source, the course's own first:
+# Phong's albedo as the BRDF (fr = kd + ks (R.V)^n) and the half vector (v + l) * 0.5.
+WEEK08_MISTAKES = {
+    "phong_albedo_as_brdf": (Phong, "BRDF", "* (self.kd * INV_PI)", "* self.kd"),
+    "course_halfvector": (vec3, "halfvector", "unit_vector(view + light)", "(view + light) * 0.5"),
+    "phong_wrong_normalisation": (Phong, "BRDF", "(n + 2.0) * INV_TWO", "(n + 1.0) * INV_TWO"),
+    "phong_pdf_around_the_normal": (Phong, "pdf", "dot(mirror, wi)", "dot(normal, wi)"),
+    "pdf_without_jacobian": (glossy, "reflected_density", " / (4.0 * wo_h)", ""),
+    "pdf_without_cos_theta_h": (CookTorrance, "pdf", " * dot(normal, h)  #", "  #"),
+    "mixture_pdf_unweighted": (glossy, "mixture_pdf", "(1.0 - p_diffuse) * ", ""),
+    "cosine_power_wrong_inverse": (phong, "sample_cosine_power", "(exponent + 1", "(exponent + 2"),
+    "ggx_without_pi": (CookTorrance, "D", "a2 / (math.pi * k * k)", "a2 / (k * k)"),
+    "weight_without_1_over_pdf": (glossy, "weighted_sample", "* (cos_i / pdf)", "* cos_i"),
+}
+# the grader tests each must fail
+WEEK08_FAILS = {
+    "phong_albedo_as_brdf": ["test_phong_brdf"],
+    "course_halfvector": ["test_blinn_phong_brdf"],
+    "phong_wrong_normalisation": ["test_phong_brdf"],
+    "phong_pdf_around_the_normal": ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
+    "pdf_without_jacobian": ["test_pdf[blinn_phong]", "test_sampling_follows_pdf[blinn_phong]"],
+    "pdf_without_cos_theta_h": [
+        "test_pdf[cook_torrance_ggx]",
+        "test_sampling_follows_pdf[cook_torrance_ggx]",
+    ],
+    "mixture_pdf_unweighted": ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
+    "cosine_power_wrong_inverse": ["test_cosine_power_sampler"],
+    "ggx_without_pi": [
+        "test_cook_torrance_factors[ggx]",
+        "test_cook_torrance_brdf[cook_torrance_ggx]",
+    ],
+    "weight_without_1_over_pdf": ["test_weight_is_brdf_cos_over_pdf[cook_torrance_ggx]"],
+}
 
 
 # (week, mistake, grader tests that must fail)
@@ -413,28 +409,7 @@ PLANTED = [
     ("07", image_v_not_flipped, ["test_image_texture"]),
     ("07", fuzz_not_absorbed, ["test_metal_fuzz"]),
     ("07", fuzz_ignored, ["test_metal_fuzz"]),
-    ("08", phong_wrong_normalisation, ["test_phong_brdf"]),
-    ("08", phong_albedo_as_brdf, ["test_phong_brdf"]),
-    ("08", course_halfvector, ["test_blinn_phong_brdf"]),
-    (
-        "08",
-        half_vector_pdf_without_jacobian,
-        ["test_pdf[blinn_phong]", "test_sampling_follows_pdf[blinn_phong]"],
-    ),
-    ("08", phong_pdf_around_the_normal, ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"]),
-    (
-        "08",
-        cook_torrance_pdf_without_cosine,
-        ["test_pdf[cook_torrance_ggx]", "test_sampling_follows_pdf[cook_torrance_ggx]"],
-    ),
-    ("08", mixture_pdf_unweighted, ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"]),
-    ("08", cosine_power_wrong_inverse, ["test_cosine_power_sampler"]),
-    (
-        "08",
-        ggx_without_pi,
-        ["test_cook_torrance_factors[ggx]", "test_cook_torrance_brdf[cook_torrance_ggx]"],
-    ),
-    ("08", glossy_no_pdf, ["test_weight_is_brdf_cos_over_pdf[cook_torrance_ggx]"]),
+    *[("08", in_source(k, *WEEK08_MISTAKES[k]), WEEK08_FAILS[k]) for k in WEEK08_MISTAKES],
     ("08", light_counted_twice, ["test_path_render_matches_reference"]),
     ("08", path_counts_light_twice, ["test_path_render_matches_reference", "test_path_furnace"]),
     ("08", roulette_not_divided, ["test_path_furnace"]),
