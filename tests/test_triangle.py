@@ -14,30 +14,11 @@ from rtpy.interval import Interval
 from rtpy.materials import Lambertian
 from rtpy.ray import Ray
 from rtpy.triangle import Triangle
-from rtpy.vec3 import Vec3
+
+from .vectors import V, cross3, dot3, norm3, sub3
 
 MAT = Lambertian()
 EVERYWHERE = Interval(0.0, math.inf)
-
-
-def V(x, y, z) -> Vec3:
-    return Vec3(float(x), float(y), float(z))
-
-
-def cross3(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def dot3(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def norm3(a) -> float:
-    return math.sqrt(dot3(a, a))
-
-
-def sub3(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 def barycentric_bc(a, b, c, p):

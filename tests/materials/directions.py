@@ -16,25 +16,10 @@ from rtpy.ray import Ray
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Vec3
 
+from ..vectors import cross3, dot3, unit3
+
 ALBEDO = (0.8, 0.5, 0.25)
 POINT = (0.5, -0.25, 2.0)
-
-
-def dot3(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def cross3(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def unit3(a):
-    k = 1.0 / math.sqrt(dot3(a, a))
-    return (a[0] * k, a[1] * k, a[2] * k)
-
-
-def angle(a, b) -> float:
-    return math.acos(max(-1.0, min(1.0, dot3(a, b))))
 
 
 # A tilted surface, so that no coordinate axis helps the code under test; and the

@@ -23,12 +23,12 @@ from rtpy.materials import MATERIALS, Blinn, BlinnPhong
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
+from ..vectors import dot3
 from .directions import (
     ALBEDO,
     NORMAL,
     alive_fraction,
     direction,
-    dot3,
     half,
     light_ray,
     make_hit,

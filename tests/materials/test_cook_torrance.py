@@ -29,22 +29,19 @@ from rtpy.materials import MATERIALS, CookTorrance
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color, Vec3
 
+from ..vectors import angle, cross3, dot3, unit3
 from .directions import (
     ALBEDO,
     NORMAL,
     TANGENT,
     X,
     Z,
-    angle,
     brdf,
-    cross3,
-    dot3,
     half_vector_albedo,
     hemisphere_integral,
     make_hit,
     pdf,
     theta_nodes,
-    unit3,
     view_ray,
 )
 from .directions import polar as direction

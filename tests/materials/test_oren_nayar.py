@@ -22,7 +22,8 @@ from rtpy.materials import MATERIALS, Lambertian, OrenNayar
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
-from .directions import ALBEDO, NORMAL, POINT, direction, dot3, light_ray, make_hit, view_ray
+from ..vectors import dot3
+from .directions import ALBEDO, NORMAL, POINT, direction, light_ray, make_hit, view_ray
 
 
 def coefficients(sigma_deg):

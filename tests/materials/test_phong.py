@@ -25,13 +25,13 @@ from rtpy.materials.phong import cosine_power_pdf, sample_cosine_power
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
+from ..vectors import dot3
 from .directions import (
     ALBEDO,
     NORMAL,
     POINT,
     alive_fraction,
     direction,
-    dot3,
     frame,
     light_ray,
     make_hit,

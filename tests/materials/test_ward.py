@@ -32,20 +32,9 @@ from rtpy.onb import ONB
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color, Vec3
 
+from ..vectors import angle, cross3, dot3, unit3
 from . import directions
-from .directions import (
-    ALBEDO,
-    X,
-    Z,
-    angle,
-    cross3,
-    dot3,
-    half_vector_albedo,
-    hemisphere_integral,
-    light_ray,
-    unit3,
-    view_ray,
-)
+from .directions import ALBEDO, X, Z, half_vector_albedo, hemisphere_integral, light_ray, view_ray
 
 # A tilted surface with its own tangent: the highlight is anisotropic.
 NORMAL = unit3((-0.2, 0.9, 0.4))
