@@ -1,11 +1,19 @@
 """Plain-tuple vector helpers for the tests, written independently of rtpy.vec3, so that
-expected values do not come from the code under test."""
+expected values do not come from the code under test; and a check of planar hits."""
 
 from __future__ import annotations
 
 import math
 
+import pytest
+from hypothesis import strategies as st
+
+from rtpy.interval import Interval
+from rtpy.ray import Ray
 from rtpy.vec3 import Vec3
+
+# Points in a box around the origin, where the tests' shapes lie.
+ORIGINS = st.tuples(st.floats(-5, 5), st.floats(-5, 5), st.floats(-5, 5))
 
 
 def V(x, y, z) -> Vec3:
@@ -36,3 +44,23 @@ def unit3(a):
 def angle(a, b) -> float:
     """Angle between two vectors, accurate for small angles (atan2 of |a x b| and a.b)."""
     return math.atan2(norm3(cross3(a, b)), dot3(a, b))
+
+
+def check_planar_hit(shape, origin, target, n, uv, inside: bool) -> None:
+    """The ray from origin through target, the point of a planar shape (normal n, any
+    length) at surface coordinates uv, hits it at t = 1 with those (u, v), on the face
+    the ray sees, with the unit normal facing the ray. Rays that cross the plane at a
+    slant (|cos| < 0.05) are not checked; points not strictly inside may be missed
+    (edges may round either way)."""
+    d = sub3(target, origin)
+    if abs(dot3(d, n)) < 0.05 * norm3(d) * norm3(n):
+        return
+    h = shape.intersect(Ray(V(*origin), V(*d)), Interval(0.0, math.inf))
+    if not inside and h is None:
+        return
+    assert h is not None
+    assert h.t == pytest.approx(1.0, rel=1e-9)
+    assert (h.u, h.v) == pytest.approx(uv, abs=1e-9)
+    front = dot3(d, n) < 0.0
+    assert h.front_face is front
+    assert h.normal.tolist() == pytest.approx([x if front else -x for x in unit3(n)], abs=1e-12)
