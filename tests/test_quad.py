@@ -15,7 +15,7 @@ from rtpy.quad import Quad
 from rtpy.ray import Ray
 from rtpy.testing import chi2_sf
 
-from .vectors import ORIGINS, V, check_planar_hit, cross3, dot3, norm3, sub3
+from .vectors import ORIGINS, V, check_planar_hit, cross3, dot3, norm3, planar_samples, sub3
 
 MAT = Lambertian()
 EVERYWHERE = Interval(0.0, math.inf)
@@ -145,19 +145,11 @@ def test_area():
 
 
 def test_sample_point_is_uniform_over_the_quad():
-    rng = random.Random(2024)
     n_samples = 16000
     counts = [[0] * 4 for _ in range(4)]
-    nrm = cross3(U0, V0)
-    nrm = tuple(x / norm3(nrm) for x in nrm)
-    for _ in range(n_samples):
-        p, normal = OBLIQUE.sample_point(rng.random(), rng.random())
-        assert max(abs(x - y) for x, y in zip(normal.tolist(), nrm, strict=True)) < 1e-14
-        pt = p.tolist()
-        # In the plane ...
-        assert abs(dot3(sub3(pt, Q0), nrm)) < 1e-12
+    for pt in planar_samples(OBLIQUE, n_samples, 2024, Q0, cross3(U0, V0)):
         a, b = solve_ab(Q0, U0, V0, pt)
-        # ... and inside the parallelogram.
+        # In the plane (planar_samples checks that) and inside the parallelogram.
         assert -1e-12 <= a <= 1 + 1e-12 and -1e-12 <= b <= 1 + 1e-12
         counts[min(3, int(a * 4))][min(3, int(b * 4))] += 1
     expected = n_samples / 16

@@ -16,7 +16,7 @@ from rtpy.ray import Ray
 from rtpy.testing import chi2_sf
 from rtpy.triangle import Triangle
 
-from .vectors import ORIGINS, V, check_planar_hit, cross3, dot3, norm3, sub3
+from .vectors import ORIGINS, V, check_planar_hit, cross3, dot3, norm3, planar_samples, sub3
 
 MAT = Lambertian()
 EVERYWHERE = Interval(0.0, math.inf)
@@ -137,16 +137,10 @@ def test_area():
 
 def test_sample_point_is_uniform_over_the_triangle():
     """Chi-square over the 16 equal sub-triangles of a 4 x 4 barycentric subdivision."""
-    rng = random.Random(31337)
     n_samples = 16000
     counts: dict[tuple[int, int, bool], int] = {}
     n = cross3(sub3(B0, A0), sub3(C0, A0))
-    nn = tuple(x / norm3(n) for x in n)
-    for _ in range(n_samples):
-        p, normal = GENERAL.sample_point(rng.random(), rng.random())
-        assert max(abs(x - y) for x, y in zip(normal.tolist(), nn, strict=True)) < 1e-14
-        pt = p.tolist()
-        assert abs(dot3(sub3(pt, A0), nn)) < 1e-12
+    for pt in planar_samples(GENERAL, n_samples, 31337, A0, n):
         wb, wc = barycentric_bc(A0, B0, C0, pt)
         assert wb >= -1e-12 and wc >= -1e-12 and wb + wc <= 1 + 1e-12
         fb, fc = wb * 4, wc * 4

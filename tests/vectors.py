@@ -4,6 +4,7 @@ expected values do not come from the code under test; and a check of planar hits
 from __future__ import annotations
 
 import math
+import random
 
 import pytest
 from hypothesis import strategies as st
@@ -64,3 +65,16 @@ def check_planar_hit(shape, origin, target, n, uv, inside: bool) -> None:
     front = dot3(d, n) < 0.0
     assert h.front_face is front
     assert h.normal.tolist() == pytest.approx([x if front else -x for x in unit3(n)], abs=1e-12)
+
+
+def planar_samples(shape, n: int, seed: int, corner, normal):
+    """n points drawn by shape.sample_point, each checked to come with the shape's unit
+    normal and to lie in its plane (through corner, with normal `normal` of any length)."""
+    rng = random.Random(seed)
+    unit_n = unit3(normal)
+    for _ in range(n):
+        p, nrm = shape.sample_point(rng.random(), rng.random())
+        assert max(abs(x - y) for x, y in zip(nrm.tolist(), unit_n, strict=True)) < 1e-14
+        point = p.tolist()
+        assert abs(dot3(sub3(point, corner), unit_n)) < 1e-12
+        yield point
