@@ -10,8 +10,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from rtpy.hit_info import HitInfo
+from rtpy.io.scene_file import load_scene_text
 from rtpy.ray import Ray
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Vec3
@@ -211,3 +213,70 @@ def half_vector_albedo(m, wo, a: float, n_phi: int) -> float:
 
     # phi_offset keeps the nodes off the plane of incidence's seam.
     return hemisphere_integral(integrand, a, n_phi, phi_offset=0.01)
+
+
+# --- checks ---------------------------------------------------------------------------------
+
+
+def check_scattering(m, wo, expected_brdf, expected_pdf, n, seed, normal=NORMAL, tangent=None):
+    """Draws n samples from m.scattering() with the viewer in direction wo. Every sample
+    must be a unit direction above the surface (its ray starting on the surface or above
+    it), not specular, with the pdf expected_pdf(wi) and the weight
+    expected_brdf(wi) * cos(theta_i) / pdf. Returns the cosines of the samples (absorbed
+    ones give none)."""
+    hit = make_hit(m, normal, tangent)
+    cosines = []
+    with use_generator(make_generator(*seed)):
+        for _ in range(n):
+            s = m.scattering(view_ray(wo), hit)
+            if s is None:
+                continue
+            wi = s.scattered_ray.direction.tolist()
+            assert math.isclose(dot3(wi, wi), 1.0, abs_tol=1e-12)
+            cos_i = dot3(wi, normal)
+            assert cos_i > 0.0 and s.is_specular is False
+            origin = s.scattered_ray.origin.tolist()
+            assert dot3([origin[i] - POINT[i] for i in range(3)], normal) >= 0.0
+            pdf = expected_pdf(wi)
+            assert s.pdf == pytest.approx(pdf, rel=1e-7)
+            weight = [x * cos_i / pdf for x in expected_brdf(wi)]
+            assert s.attenuation.tolist() == pytest.approx(weight, rel=1e-7, abs=1e-12)
+            cosines.append(cos_i)
+    return cosines
+
+
+def check_finite(m, pairs, n_samples, normal=NORMAL, tangent=None) -> None:
+    """BRDF() and pdf() finite and >= 0 for every (wo, [wi, ...]) in pairs, and the
+    samples scattering() draws from each wo finite, >= 0, with a pdf > 0."""
+    hit = make_hit(m, normal, tangent)
+    for wo, lights in pairs:
+        for wi in lights:
+            f = m.BRDF(view_ray(wo), light_ray(wi), hit).tolist()
+            p = m.pdf(view_ray(wo), light_ray(wi), hit)
+            assert all(math.isfinite(x) and x >= 0.0 for x in [*f, p]), (wo, wi, f, p)
+        with use_generator(make_generator(3)):
+            for _ in range(n_samples):
+                s = m.scattering(view_ray(wo), hit)
+                if s is not None:
+                    values = [*s.attenuation.tolist(), *s.scattered_ray.direction.tolist()]
+                    assert all(math.isfinite(x) for x in [*values, s.pdf])
+                    assert min(s.attenuation.tolist()) >= 0.0 and s.pdf > 0.0
+
+
+def load_material(keys: str, name: str = "shiny"):
+    """The material of a scene file with one sphere, whose [materials.<name>] table holds
+    these keys (the file is called <name>.toml)."""
+    text = (
+        f'[materials.{name}]\n{keys}\n\n[[objects]]\ntype = "sphere"\ncenter = [0, 0, -1]\n'
+        f'radius = 0.5\nmaterial = "{name}"\n'
+    )
+    return load_scene_text(text, f"{name}.toml").objects[0].material
+
+
+def check_nothing_below(m, wo, below, normal=NORMAL, tangent=None) -> None:
+    """With the light below the surface, or the viewer: BRDF() and pdf() are 0, and
+    scattering() absorbs."""
+    for view, light in ((wo, below), (below, wo)):
+        assert brdf(m, view, light, normal, tangent) == [0.0, 0.0, 0.0]
+        assert pdf(m, view, light, normal, tangent) == 0.0
+    assert m.scattering(view_ray(below), make_hit(m, normal, tangent)) is None

@@ -12,13 +12,14 @@ with p_d = kd * max(albedo) / (kd * max(albedo) + ks).
 from __future__ import annotations
 
 import math
+from functools import partial
 
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rtpy.io.scene_file import SceneError, load_scene_text
+from rtpy.io.scene_file import SceneError
 from rtpy.materials import MATERIALS, Blinn, BlinnPhong
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
@@ -28,14 +29,19 @@ from .directions import (
     ALBEDO,
     NORMAL,
     alive_fraction,
+    check_finite,
+    check_nothing_below,
+    check_scattering,
     direction,
     half,
     light_ray,
+    load_material,
     make_hit,
     mirror,
     polar_integral,
     view_ray,
 )
+from .directions import brdf as model_brdf
 from .directions import pdf as model_pdf
 
 # --- the formulas ---------------------------------------------------------------------
@@ -93,13 +99,7 @@ def test_brdf_and_pdf_match_the_formulas(kd, ks, n, to, po, ti, pi_):
 @given(weights, weights, exponents, thetas, phis, st.floats(90.001, 180.0), phis)
 def test_zero_below_the_surface(kd, ks, n, to, po, ti, pi_):
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
-    hit = make_hit(m)
-    wo, below = direction(NORMAL, to, po), direction(NORMAL, ti, pi_)
-    assert m.BRDF(view_ray(wo), light_ray(below), hit).tolist() == [0.0, 0.0, 0.0]
-    assert m.pdf(view_ray(wo), light_ray(below), hit) == 0.0
-    assert m.BRDF(view_ray(below), light_ray(wo), hit).tolist() == [0.0, 0.0, 0.0]
-    assert m.pdf(view_ray(below), light_ray(wo), hit) == 0.0
-    assert m.scattering(view_ray(below), hit) is None
+    check_nothing_below(m, direction(NORMAL, to, po), direction(NORMAL, ti, pi_))
 
 
 def test_the_highlight_peaks_where_the_half_vector_is_the_normal():
@@ -115,11 +115,8 @@ def test_the_highlight_peaks_where_the_half_vector_is_the_normal():
 @given(weights, weights, exponents, thetas, phis, thetas, phis)
 def test_reciprocity(kd, ks, n, ta, pa, tb, pb):
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
-    hit = make_hit(m)
     a, b = direction(NORMAL, ta, pa), direction(NORMAL, tb, pb)
-    f_ab = m.BRDF(view_ray(a), light_ray(b), hit).tolist()
-    f_ba = m.BRDF(view_ray(b), light_ray(a), hit).tolist()
-    assert f_ab == approx3(f_ba, rel=1e-9)
+    assert model_brdf(m, a, b) == approx3(model_brdf(m, b, a), rel=1e-9)
 
 
 # --- sampling -------------------------------------------------------------------------
@@ -132,24 +129,10 @@ def test_reciprocity(kd, ks, n, ta, pa, tb, pb):
 @pytest.mark.parametrize("theta_o", [0.0, 40.0, 80.0])
 def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, n, theta_o):
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
-    hit = make_hit(m)
     wo = direction(NORMAL, theta_o, 30.0)
-    scattered = 0
-    with use_generator(make_generator(7, int(theta_o))):
-        for _ in range(1500):
-            s = m.scattering(view_ray(wo), hit)
-            if s is None:
-                continue
-            scattered += 1
-            wi = s.scattered_ray.direction.tolist()
-            assert math.isclose(math.sqrt(dot3(wi, wi)), 1.0, abs_tol=1e-12)
-            cos_i = dot3(wi, NORMAL)
-            assert cos_i > 0.0
-            pdf = expected_pdf(kd, ks, n, wo, wi)
-            assert s.pdf == pytest.approx(pdf, rel=1e-7)
-            f = expected_brdf(kd, ks, n, wo, wi)
-            assert s.attenuation.tolist() == approx3([x * cos_i / pdf for x in f], rel=1e-7)
-    assert scattered > 300  # for n = 0 most reflections about h go below the surface
+    brdf, pdf = partial(expected_brdf, kd, ks, n, wo), partial(expected_pdf, kd, ks, n, wo)
+    cosines = check_scattering(m, wo, brdf, pdf, 1500, (7, int(theta_o)))
+    assert len(cosines) > 300  # for n = 0 most reflections about h go below the surface
 
 
 @pytest.mark.parametrize("n", [50.0, 200.0, 1000.0])
@@ -211,21 +194,9 @@ def test_energy_at_normal_incidence_matches_the_closed_form(n):
 def test_grazing_angles_and_huge_exponents_give_finite_values(n):
     m = BlinnPhong(Color(*ALBEDO), kd=0.5, ks=0.5, exponent=n)
     hit = make_hit(m)
-    for to in (0.0, 60.0, 89.99):
-        wo = direction(NORMAL, to, 10.0)
-        lights = [direction(NORMAL, ti, pi_) for ti in (0.0, 45.0, 89.99) for pi_ in (10, 190)]
-        lights.append(mirror(wo, NORMAL))
-        for wi in lights:
-            f = m.BRDF(view_ray(wo), light_ray(wi), hit).tolist()
-            p = m.pdf(view_ray(wo), light_ray(wi), hit)
-            assert all(math.isfinite(x) and x >= 0.0 for x in [*f, p])
-        with use_generator(make_generator(3)):
-            for _ in range(300):
-                s = m.scattering(view_ray(wo), hit)
-                if s is not None:
-                    values = [*s.attenuation.tolist(), s.pdf, *s.scattered_ray.direction.tolist()]
-                    assert all(math.isfinite(x) for x in values)
-                    assert min(s.attenuation.tolist()) >= 0.0 and s.pdf > 0.0
+    views = [direction(NORMAL, to, 10.0) for to in (0.0, 60.0, 89.99)]
+    grazing = [direction(NORMAL, 89.99, pi_) for pi_ in (10, 100, 190)]
+    check_finite(m, [(wo, [*grazing, NORMAL, mirror(wo, NORMAL)]) for wo in views], 300)
     wo = direction(NORMAL, 89.99, 10.0)
     f = m.BRDF(view_ray(wo), light_ray(mirror(wo, NORMAL)), hit).e0
     assert f == pytest.approx(0.5 * ALBEDO[0] / math.pi + 0.5 * (n + 8) / (8 * math.pi), rel=1e-6)
@@ -259,26 +230,11 @@ def test_constructor_refuses_bad_parameters(kwargs, message):
         BlinnPhong(Color(*ALBEDO), **kwargs)
 
 
-SCENE = """\
-[materials.shiny]
-type = "blinn_phong"
-albedo = [0.1, 0.2, 0.6]
-kd = 0.7
-ks = 0.3
-exponent = 120
-
-[[objects]]
-type = "sphere"
-center = [0, 0, -1]
-radius = 0.5
-material = "shiny"
-"""
-
-
 def test_the_loader_accepts_a_blinn_phong_material():
-    m = load_scene_text(SCENE, "blinn.toml").objects[0].material
+    keys = 'type = "blinn_phong"\nalbedo = [0.1, 0.2, 0.6]\nkd = 0.7\nks = 0.3\nexponent = 120'
+    m = load_material(keys)
     assert isinstance(m, BlinnPhong)
     assert m.albedo.color == Color(0.1, 0.2, 0.6)
     assert (m.kd, m.ks, m.exponent) == (0.7, 0.3, 120.0)
     with pytest.raises(SceneError, match=r"\[materials.shiny\] ks: expected a number in \[0, 1\]"):
-        load_scene_text(SCENE.replace("ks = 0.3", "ks = -0.3"), "blinn.toml")
+        load_material(keys.replace("ks = 0.3", "ks = -0.3"))

@@ -37,6 +37,7 @@ from .directions import (
     X,
     Z,
     brdf,
+    check_nothing_below,
     half_vector_albedo,
     hemisphere_integral,
     make_hit,
@@ -172,15 +173,7 @@ def test_a_sharp_highlight_at_the_mirror_direction():
 def test_zero_below_the_surface(dist, a, to, po, ti, pi_):
     m = CookTorrance(Color(*ALBEDO), 0.5, 1.0, a, dist)
     wo, wi = direction(to, po), direction(ti, pi_)
-    below_i = tuple(-x for x in wi)  # the light behind the surface
-    below_o = tuple(-x for x in wo)
-    assert brdf(m, wo, below_i) == [0.0, 0.0, 0.0]
-    assert pdf(m, wo, below_i) == 0.0
-    # A viewer behind the surface (a normal that does not face the ray): nothing either.
-    assert brdf(m, below_o, wi) == [0.0, 0.0, 0.0]
-    assert pdf(m, below_o, wi) == 0.0
-    hit = make_hit(m)
-    assert m.scattering(view_ray(below_o), hit) is None
+    check_nothing_below(m, wo, tuple(-x for x in wi))
 
 
 @given(

@@ -179,12 +179,8 @@ def test_the_highlight_is_stretched_along_the_rougher_axis():
 def test_zero_below_the_surface(ax, ay, to, po, ti, pi_):
     m = Ward(Color(*ALBEDO), 0.5, 1.0, ax, ay)
     wo, wi = direction(to, po), direction(ti, pi_)
-    below_i, below_o = tuple(-x for x in wi), tuple(-x for x in wo)
-    assert brdf(m, wo, below_i) == [0.0, 0.0, 0.0]
-    assert pdf(m, wo, below_i) == 0.0
-    assert brdf(m, below_o, wi) == [0.0, 0.0, 0.0]
-    assert pdf(m, below_o, wi) == 0.0
-    assert m.scattering(view_ray(below_o), make_hit(m)) is None
+    below_i = tuple(-x for x in wi)
+    directions.check_nothing_below(m, wo, below_i, NORMAL, TANGENT)
     assert m.half_vector_pdf(make_hit(m).frame, Vec3(*below_i)) == 0.0
 
 
