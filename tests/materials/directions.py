@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import strategies as st
 
 from rtpy.hit_info import HitInfo
 from rtpy.io.scene_file import load_scene_text
@@ -29,6 +30,24 @@ POINT = (0.5, -0.25, 2.0)
 NORMAL = unit3((0.3, -0.5, 0.8))
 TANGENT = unit3(cross3(NORMAL, (0.0, 0.0, 1.0)))
 Z, X = (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)
+
+
+# Directions above the surface (degrees from the normal, azimuths), and weights kd, ks.
+thetas = st.floats(0.0, 89.9)
+phis = st.floats(0.0, 360.0)
+weights = st.floats(0.0, 1.0)
+
+
+def approx3(values, rel=1e-9, abs_=1e-12):
+    return pytest.approx(values, rel=rel, abs=abs_)
+
+
+def mixture_pdf(kd: float, ks: float, cos_i: float, highlight_pdf: float) -> float:
+    """p_d cos(theta_i) / pi + (1 - p_d) highlight_pdf, p_d = kd max(ALBEDO) / (kd max(ALBEDO)
+    + ks): the density of the glossy models' mixture."""
+    diffuse = kd * max(ALBEDO)
+    p_d = diffuse / (diffuse + ks) if diffuse + ks > 0.0 else 1.0
+    return p_d * cos_i / math.pi + (1.0 - p_d) * highlight_pdf
 
 
 def frame(axis):
@@ -280,3 +299,9 @@ def check_nothing_below(m, wo, below, normal=NORMAL, tangent=None) -> None:
         assert brdf(m, view, light, normal, tangent) == [0.0, 0.0, 0.0]
         assert pdf(m, view, light, normal, tangent) == 0.0
     assert m.scattering(view_ray(below), make_hit(m, normal, tangent)) is None
+
+
+def check_brdf_and_pdf(m, wo, wi, expected_brdf, expected_pdf, normal=NORMAL) -> None:
+    """BRDF() and pdf() are the expected values, to 1e-9 relative."""
+    assert brdf(m, wo, wi, normal) == pytest.approx(expected_brdf, rel=1e-9, abs=1e-12)
+    assert pdf(m, wo, wi, normal) == pytest.approx(expected_pdf, rel=1e-9, abs=1e-12)

@@ -29,6 +29,8 @@ from .directions import (
     ALBEDO,
     NORMAL,
     alive_fraction,
+    approx3,
+    check_brdf_and_pdf,
     check_finite,
     check_nothing_below,
     check_scattering,
@@ -38,8 +40,12 @@ from .directions import (
     load_material,
     make_hit,
     mirror,
+    mixture_pdf,
+    phis,
     polar_integral,
+    thetas,
     view_ray,
+    weights,
 )
 from .directions import brdf as model_brdf
 from .directions import pdf as model_pdf
@@ -58,11 +64,9 @@ def expected_pdf(kd, ks, n, wo, wi, normal=NORMAL):
     cos_i = dot3(wi, normal)
     if dot3(wo, normal) <= 0.0 or cos_i <= 0.0:
         return 0.0
-    diffuse = kd * max(ALBEDO)
-    p_d = diffuse / (diffuse + ks) if diffuse + ks > 0.0 else 1.0
     h = half(wo, wi)
     pdf_h = (n + 1.0) / (2.0 * math.pi) * dot3(normal, h) ** n
-    return p_d * cos_i / math.pi + (1.0 - p_d) * pdf_h / (4.0 * dot3(wo, h))
+    return mixture_pdf(kd, ks, cos_i, pdf_h / (4.0 * dot3(wo, h)))
 
 
 def lobe_albedo_at_normal_incidence(n):
@@ -72,14 +76,7 @@ def lobe_albedo_at_normal_incidence(n):
     return (n + 8.0) * (2.0 * (1 - a ** (n + 4)) / (n + 4) - (1 - a ** (n + 2)) / (n + 2))
 
 
-thetas = st.floats(0.0, 89.9)
-phis = st.floats(0.0, 360.0)
-weights = st.floats(0.0, 1.0)
 exponents = st.one_of(st.sampled_from([0.0, 1.0, 4.0, 40.0, 400.0]), st.floats(0.0, 1000.0))
-
-
-def approx3(values, rel=1e-9, abs_=1e-12):
-    return pytest.approx(values, rel=rel, abs=abs_)
 
 
 # --- BRDF and pdf ---------------------------------------------------------------------
@@ -89,11 +86,7 @@ def approx3(values, rel=1e-9, abs_=1e-12):
 def test_brdf_and_pdf_match_the_formulas(kd, ks, n, to, po, ti, pi_):
     wo, wi = direction(NORMAL, to, po), direction(NORMAL, ti, pi_)
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
-    hit = make_hit(m)
-    f = m.BRDF(view_ray(wo), light_ray(wi), hit)
-    assert f.tolist() == approx3(expected_brdf(kd, ks, n, wo, wi))
-    p = m.pdf(view_ray(wo), light_ray(wi), hit)
-    assert p == pytest.approx(expected_pdf(kd, ks, n, wo, wi), rel=1e-9, abs=1e-12)
+    check_brdf_and_pdf(m, wo, wi, expected_brdf(kd, ks, n, wo, wi), expected_pdf(kd, ks, n, wo, wi))
 
 
 @given(weights, weights, exponents, thetas, phis, st.floats(90.001, 180.0), phis)

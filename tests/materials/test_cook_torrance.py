@@ -41,6 +41,7 @@ from .directions import (
     half_vector_albedo,
     hemisphere_integral,
     make_hit,
+    mixture_pdf,
     pdf,
     theta_nodes,
     view_ray,
@@ -114,11 +115,10 @@ def ref_pdf(kd, ks, dist, a, wo, wi) -> float:
     ci = dot3(NORMAL, wi)
     if ci <= 0.0 or dot3(NORMAL, wo) <= 0.0:
         return 0.0
-    p_d = kd * max(ALBEDO) / (kd * max(ALBEDO) + ks)
     h = unit3(tuple(wi[k] + wo[k] for k in range(3)))
     theta_h = angle(NORMAL, h)
     spec = ref_D(dist, a, theta_h) * math.cos(theta_h) / (4.0 * dot3(wo, h))
-    return p_d * ci / math.pi + (1.0 - p_d) * spec
+    return mixture_pdf(kd, ks, ci, spec)
 
 
 def albedo_by_quadrature(m: CookTorrance, theta_o: float, n_phi: int = 96) -> float:

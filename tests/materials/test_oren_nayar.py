@@ -35,6 +35,8 @@ from .directions import (
     light_ray,
     load_material,
     make_hit,
+    phis,
+    thetas,
     view_ray,
 )
 
@@ -66,8 +68,6 @@ def expected_brdf(sigma, wo, wi, normal=NORMAL):
     return [a * k for a in ALBEDO]
 
 
-thetas = st.floats(0.0, 89.9)
-phis = st.floats(0.0, 360.0)
 sigmas = st.one_of(st.sampled_from([0.0, 10.0, 20.0, 45.0]), st.floats(0.0, 89.9))
 
 

@@ -31,6 +31,8 @@ from .directions import (
     ALBEDO,
     NORMAL,
     alive_fraction,
+    approx3,
+    check_brdf_and_pdf,
     check_finite,
     check_nothing_below,
     check_scattering,
@@ -40,8 +42,12 @@ from .directions import (
     load_material,
     make_hit,
     mirror,
+    mixture_pdf,
+    phis,
     sphere_integral,
+    thetas,
     view_ray,
+    weights,
 )
 from .directions import brdf as model_brdf
 from .directions import pdf as model_pdf
@@ -69,23 +75,13 @@ def expected_pdf(kd, ks, n, wo, wi, normal=NORMAL):
     cos_i = dot3(wi, normal)
     if dot3(wo, normal) <= 0.0 or cos_i <= 0.0:
         return 0.0
-    diffuse = kd * max(ALBEDO)
-    p_d = diffuse / (diffuse + ks) if diffuse + ks > 0.0 else 1.0
     c = dot3(mirror(wo, normal), wi)  # m . wi, another route to r . wo
-    spec = (n + 1.0) / (2.0 * math.pi) * c**n if c > 0.0 else 0.0
-    return p_d * cos_i / math.pi + (1.0 - p_d) * spec
+    return mixture_pdf(kd, ks, cos_i, (n + 1.0) / (2.0 * math.pi) * c**n if c > 0.0 else 0.0)
 
 
 # --- strategies -----------------------------------------------------------------------
 
-thetas = st.floats(0.0, 89.9)
-phis = st.floats(0.0, 360.0)
-weights = st.floats(0.0, 1.0)
 exponents = st.one_of(st.sampled_from([0.0, 1.0, 2.0, 10.0, 100.0]), st.floats(0.0, 500.0))
-
-
-def approx3(values, rel=1e-9, abs_=1e-12):
-    return pytest.approx(values, rel=rel, abs=abs_)
 
 
 # --- BRDF and pdf ---------------------------------------------------------------------
@@ -96,11 +92,7 @@ def test_brdf_and_pdf_match_the_formulas(kd, ks, n, to, po, ti, pi_):
     wo, wi = direction(NORMAL, to, po), direction(NORMAL, ti, pi_)
     assume(abs(lobe_cos(wo, wi, NORMAL)) > 1e-6)  # away from the lobe's edge (0^n)
     m = Phong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
-    hit = make_hit(m)
-    f = m.BRDF(view_ray(wo), light_ray(wi), hit)
-    assert f.tolist() == approx3(expected_brdf(kd, ks, n, wo, wi))
-    p = m.pdf(view_ray(wo), light_ray(wi), hit)
-    assert p == pytest.approx(expected_pdf(kd, ks, n, wo, wi), rel=1e-9, abs=1e-12)
+    check_brdf_and_pdf(m, wo, wi, expected_brdf(kd, ks, n, wo, wi), expected_pdf(kd, ks, n, wo, wi))
 
 
 @given(weights, weights, exponents, thetas, phis, st.floats(90.001, 180.0), phis)

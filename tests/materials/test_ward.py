@@ -34,7 +34,16 @@ from rtpy.vec3 import Color, Vec3
 
 from ..vectors import angle, cross3, dot3, unit3
 from . import directions
-from .directions import ALBEDO, X, Z, half_vector_albedo, hemisphere_integral, light_ray, view_ray
+from .directions import (
+    ALBEDO,
+    X,
+    Z,
+    half_vector_albedo,
+    hemisphere_integral,
+    light_ray,
+    mixture_pdf,
+    view_ray,
+)
 
 # A tilted surface with its own tangent: the highlight is anisotropic.
 NORMAL = unit3((-0.2, 0.9, 0.4))
@@ -98,9 +107,8 @@ def ref_pdf(kd, ks, ax, ay, wo, wi) -> float:
     ci = dot3(NORMAL, wi)
     if ci <= 0.0 or dot3(NORMAL, wo) <= 0.0:
         return 0.0
-    p_d = kd * max(ALBEDO) / (kd * max(ALBEDO) + ks)
     h = unit3(tuple(wi[k] + wo[k] for k in range(3)))
-    return p_d * ci / math.pi + (1.0 - p_d) * ref_p_h(ax, ay, h) / (4.0 * dot3(wo, h))
+    return mixture_pdf(kd, ks, ci, ref_p_h(ax, ay, h) / (4.0 * dot3(wo, h)))
 
 
 def albedo_by_quadrature(m: Ward, theta_o: float, phi_o: float = 0.0, n_phi: int = 128):
