@@ -14,7 +14,7 @@ import pytest
 from hypothesis import strategies as st
 
 from rtpy.hit_info import HitInfo
-from rtpy.io.scene_file import load_scene_text
+from rtpy.io.scene_file import SceneError, load_scene_text
 from rtpy.ray import Ray
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Vec3
@@ -36,6 +36,15 @@ Z, X = (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)
 thetas = st.floats(0.0, 89.9)
 phis = st.floats(0.0, 360.0)
 weights = st.floats(0.0, 1.0)
+
+
+# Strengths every glossy model refuses, with the start of its message.
+BAD_STRENGTHS = [
+    ({"kd": -0.1}, "kd must be a finite number >= 0"),
+    ({"ks": -1.0}, "ks must be a finite number >= 0"),
+    ({"ks": math.inf}, "ks must be a finite number >= 0"),
+    ({"ks": math.nan}, "ks must be a finite number >= 0"),
+]
 
 
 def approx3(values, rel=1e-9, abs_=1e-12):
@@ -305,3 +314,43 @@ def check_brdf_and_pdf(m, wo, wi, expected_brdf, expected_pdf, normal=NORMAL) ->
     """BRDF() and pdf() are the expected values, to 1e-9 relative."""
     assert brdf(m, wo, wi, normal) == pytest.approx(expected_brdf, rel=1e-9, abs=1e-12)
     assert pdf(m, wo, wi, normal) == pytest.approx(expected_pdf, rel=1e-9, abs=1e-12)
+
+
+def check_mean_weight(m, wo, expected, n, seed, normal=NORMAL, tangent=None) -> None:
+    """The mean of scattering()'s weights (red channel; absorbed samples count 0) over n
+    samples estimates the directional albedo exactly when the sampler draws with the
+    density pdf() claims: it must agree with `expected` (a quadrature) within 4.5
+    standard errors, plus 2e-3 for the quadrature."""
+    hit = make_hit(m, normal, tangent)
+    weights = []
+    with use_generator(make_generator(*seed)):
+        for _ in range(n):
+            s = m.scattering(view_ray(wo), hit)
+            weights.append(0.0 if s is None else s.attenuation.e0)
+    mean, stderr = float(np.mean(weights)), float(np.std(weights)) / math.sqrt(n)
+    assert abs(mean - expected) < 4.5 * stderr + 2e-3
+
+
+# Polar angles from the normal to the horizon, for the checks at the extremes.
+EXTREME_ANGLES = [0.0, 0.5, math.radians(89.0), math.radians(89.99), math.pi / 2 - 1e-12]
+
+
+def extreme_pairs(dphis, normal=NORMAL, tangent=TANGENT):
+    """(wo, [wi, ...]) for check_finite: wo at every EXTREME_ANGLES, and wi at every one of
+    them and each azimuth offset from wo's in dphis."""
+    return [
+        (
+            polar(t_o, 0.2, normal, tangent),
+            [polar(t_i, 0.2 + d, normal, tangent) for t_i in EXTREME_ANGLES for d in dphis],
+        )
+        for t_o in EXTREME_ANGLES
+    ]
+
+
+def check_refused(material_type: str, keys: str, words, name: str = "shiny") -> None:
+    """A [materials.<name>] table of this type with these keys is refused with a
+    SceneError naming the table and containing every one of `words`."""
+    with pytest.raises(SceneError) as e:
+        load_material(f'type = "{material_type}"\n{keys}', name)
+    for word in [*words, f"[materials.{name}]"]:
+        assert word in str(e.value)

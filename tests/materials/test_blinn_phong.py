@@ -27,6 +27,7 @@ from rtpy.vec3 import Color
 from ..vectors import dot3
 from .directions import (
     ALBEDO,
+    BAD_STRENGTHS,
     NORMAL,
     alive_fraction,
     approx3,
@@ -211,8 +212,7 @@ def test_defaults_and_registration():
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        ({"kd": -0.1}, "kd must be a finite number >= 0"),
-        ({"ks": -1.0}, "ks must be a finite number >= 0"),
+        *BAD_STRENGTHS,
         ({"exponent": -0.5}, "exponent must be a finite number >= 0, got -0.5"),
         ({"exponent": math.nan}, "exponent must be a finite number >= 0"),
         ({"exponent": math.inf}, "exponent must be a finite number >= 0"),

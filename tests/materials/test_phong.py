@@ -29,6 +29,7 @@ from rtpy.vec3 import Color
 from ..vectors import dot3
 from .directions import (
     ALBEDO,
+    BAD_STRENGTHS,
     NORMAL,
     alive_fraction,
     approx3,
@@ -263,9 +264,7 @@ def test_defaults_and_registration():
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        ({"kd": -0.1}, "kd must be a finite number >= 0"),
-        ({"ks": -1.0}, "ks must be a finite number >= 0"),
-        ({"ks": math.inf}, "ks must be a finite number >= 0"),
+        *BAD_STRENGTHS,
         ({"exponent": -1.0}, "exponent must be a finite number >= 0, got -1.0"),
         ({"exponent": math.nan}, "exponent must be a finite number >= 0"),
         ({"exponent": math.inf}, "exponent must be a finite number >= 0"),

@@ -20,22 +20,22 @@ quadrature in theta and the trapezoidal rule in phi.
 from __future__ import annotations
 
 import math
+from functools import partial
 
 import numpy as np
 import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from rtpy.io.scene_file import SceneError, load_scene_text
 from rtpy.materials import MATERIALS, Ward
 from rtpy.onb import ONB
-from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color, Vec3
 
 from ..vectors import angle, cross3, dot3, unit3
 from . import directions
 from .directions import (
     ALBEDO,
+    BAD_STRENGTHS,
     X,
     Z,
     half_vector_albedo,
@@ -257,23 +257,10 @@ def test_the_sampler_inverts_walters_cdf(ax, ay):
 )
 def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, ax, ay, theta_o):
     m = Ward(Color(*ALBEDO), kd, ks, ax, ay)
-    hit = make_hit(m)
     wo = direction(theta_o, 0.8)
-    with use_generator(make_generator(5, int(ax * 100), int(theta_o * 100))):
-        for _ in range(400):
-            s = m.scattering(view_ray(wo), hit)
-            if s is None:
-                continue
-            wi = s.scattered_ray.direction.tolist()
-            cos_i = dot3(NORMAL, wi)
-            assert cos_i > 0.0
-            expected_pdf = ref_pdf(kd, ks, ax, ay, wo, wi)
-            assert s.pdf == pytest.approx(expected_pdf, rel=1e-9)
-            f = ref_brdf(kd, ks, ax, ay, wo, wi)
-            assert s.attenuation.tolist() == pytest.approx(
-                [v * cos_i / expected_pdf for v in f], rel=1e-8
-            )
-            assert not s.is_specular
+    brdf_of, pdf_of = partial(ref_brdf, kd, ks, ax, ay, wo), partial(ref_pdf, kd, ks, ax, ay, wo)
+    seed = (5, int(ax * 100), int(theta_o * 100))
+    directions.check_scattering(m, wo, brdf_of, pdf_of, 400, seed, NORMAL, TANGENT)
 
 
 @pytest.mark.parametrize(
@@ -294,43 +281,21 @@ def test_mean_sample_weight_is_the_albedo_by_quadrature(ax, ay, theta_o_deg, phi
     m = Ward(kd=0.0, ks=1.0, alpha_x=ax, alpha_y=ay)
     t_o = math.radians(theta_o_deg)
     expected = albedo_by_quadrature(m, t_o, phi_o, n_phi=256)
-    hit = make_hit(m)
+    seed = (13, int(ax * 100), int(theta_o_deg), int(phi_o * 10))
     wo = direction(t_o, phi_o)
-    n = 6000
-    weights = []
-    with use_generator(make_generator(13, int(ax * 100), int(theta_o_deg), int(phi_o * 10))):
-        for _ in range(n):
-            s = m.scattering(view_ray(wo), hit)
-            weights.append(0.0 if s is None else s.attenuation.e0)
-    mean = float(np.mean(weights))
-    stderr = float(np.std(weights)) / math.sqrt(n)
-    assert abs(mean - expected) < 4.5 * stderr + 2e-3
+    directions.check_mean_weight(m, wo, expected, 6000, seed, NORMAL, TANGENT)
 
 
 # --- numerics at the extremes --------------------------------------------------------------
-
-EXTREME_ANGLES = [0.0, 0.5, math.radians(89.0), math.radians(89.99), math.pi / 2 - 1e-12]
 
 
 @pytest.mark.parametrize("ax, ay", [(1e-9, 1e-9), (0.001, 0.001), (0.001, 1.0), (1.0, 1.0)])
 def test_tiny_widths_and_grazing_angles_give_finite_values(ax, ay):
     m = Ward(Color(*ALBEDO), 0.2, 1.0, ax, ay)
-    hit = make_hit(m)
-    for t_o in EXTREME_ANGLES:
-        wo = direction(t_o, 0.2)
-        for t_i in EXTREME_ANGLES:
-            for dphi in (0.0, 0.3, math.pi / 2, math.pi - 1e-7, math.pi):
-                wi = direction(t_i, 0.2 + dphi)
-                f = brdf(m, wo, wi)
-                p = pdf(m, wo, wi)
-                assert all(math.isfinite(x) and x >= 0.0 for x in f), (t_o, t_i, dphi, f)
-                assert math.isfinite(p) and p >= 0.0
-        with use_generator(make_generator(3)):
-            for _ in range(50):
-                s = m.scattering(view_ray(wo), hit)
-                if s is not None:
-                    assert all(math.isfinite(x) and x >= 0.0 for x in s.attenuation.tolist())
-                    assert math.isfinite(s.pdf) and s.pdf > 0.0
+    pairs = directions.extreme_pairs(
+        (0.0, 0.3, math.pi / 2, math.pi - 1e-7, math.pi), NORMAL, TANGENT
+    )
+    directions.check_finite(m, pairs, 50, NORMAL, TANGENT)
     for r1 in (0.0, 1e-300, 0.5, 1.0 - 2.0**-53):
         for r2 in (0.0, 0.25, 0.5, 0.75, 1.0 - 2.0**-53):
             h = m.sample_half_vector(r1, r2).tolist()
@@ -395,9 +360,7 @@ def test_defaults_and_registration():
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        ({"kd": -0.1}, "kd"),
-        ({"ks": -1.0}, "ks"),
-        ({"ks": math.nan}, "ks"),
+        *BAD_STRENGTHS,
         ({"alpha_x": 0.0}, "alpha_x"),
         ({"alpha_x": -0.1}, "alpha_x"),
         ({"alpha_x": 1.5}, "alpha_x"),
@@ -412,31 +375,17 @@ def test_constructor_refuses_bad_parameters(kwargs, message):
         Ward(**kwargs)
 
 
-SCENE = """
-[materials.brushed]
-type = "ward"
-{keys}
-
-[[objects]]
-type = "quad"
-q = [-1, 0, -2]
-u = [2, 0, 0]
-v = [0, 0, 2]
-material = "brushed"
-"""
-
-
-def load_material(keys: str):
-    return load_scene_text(SCENE.format(keys=keys), "test.toml").objects[0].material
+def load_ward(keys: str) -> Ward:
+    return directions.load_material(f'type = "ward"\n{keys}', "brushed")
 
 
 def test_the_loader_reads_ward_with_and_without_alpha_y():
-    m = load_material("")
+    m = load_ward("")
     assert isinstance(m, Ward)
     assert (m.kd, m.ks, m.alpha_x, m.alpha_y) == (1.0, 0.0, 0.2, 0.2)
-    m = load_material("albedo = [0.2, 0.2, 0.25]\nkd = 0.1\nks = 1\nalpha_x = 0.05")
+    m = load_ward("albedo = [0.2, 0.2, 0.25]\nkd = 0.1\nks = 1\nalpha_x = 0.05")
     assert (m.kd, m.ks, m.alpha_x, m.alpha_y) == (0.1, 1.0, 0.05, 0.05)
-    m = load_material("ks = 1\nalpha_x = 0.4\nalpha_y = 0.05")
+    m = load_ward("ks = 1\nalpha_x = 0.4\nalpha_y = 0.05")
     assert (m.alpha_x, m.alpha_y) == (0.4, 0.05)
 
 
@@ -452,8 +401,4 @@ def test_the_loader_reads_ward_with_and_without_alpha_y():
     ],
 )
 def test_the_loader_refuses_bad_values(keys, words):
-    with pytest.raises(SceneError) as e:
-        load_material(keys)
-    for word in words:
-        assert word in str(e.value)
-    assert "[materials.brushed]" in str(e.value)
+    directions.check_refused("ward", keys, words, "brushed")
