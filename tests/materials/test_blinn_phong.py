@@ -25,31 +25,12 @@ from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
 from ..vectors import dot3
-from .directions import (
-    ALBEDO,
-    BAD_STRENGTHS,
-    NORMAL,
-    alive_fraction,
-    approx3,
-    check_brdf_and_pdf,
-    check_finite,
-    check_nothing_below,
-    check_scattering,
-    direction,
-    half,
-    light_ray,
-    load_material,
-    make_hit,
-    mirror,
-    mixture_pdf,
-    phis,
-    polar_integral,
-    thetas,
-    view_ray,
-    weights,
-)
+from . import directions
+from .directions import ALBEDO, NORMAL, direction, half, light_ray, make_hit, mirror, view_ray
 from .directions import brdf as model_brdf
 from .directions import pdf as model_pdf
+
+thetas, phis, weights = directions.thetas, directions.phis, directions.weights
 
 # --- the formulas ---------------------------------------------------------------------
 
@@ -67,7 +48,7 @@ def expected_pdf(kd, ks, n, wo, wi, normal=NORMAL):
         return 0.0
     h = half(wo, wi)
     pdf_h = (n + 1.0) / (2.0 * math.pi) * dot3(normal, h) ** n
-    return mixture_pdf(kd, ks, cos_i, pdf_h / (4.0 * dot3(wo, h)))
+    return directions.mixture_pdf(kd, ks, cos_i, pdf_h / (4.0 * dot3(wo, h)))
 
 
 def lobe_albedo_at_normal_incidence(n):
@@ -87,13 +68,15 @@ exponents = st.one_of(st.sampled_from([0.0, 1.0, 4.0, 40.0, 400.0]), st.floats(0
 def test_brdf_and_pdf_match_the_formulas(kd, ks, n, to, po, ti, pi_):
     wo, wi = direction(NORMAL, to, po), direction(NORMAL, ti, pi_)
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
-    check_brdf_and_pdf(m, wo, wi, expected_brdf(kd, ks, n, wo, wi), expected_pdf(kd, ks, n, wo, wi))
+    directions.check_brdf_and_pdf(
+        m, wo, wi, expected_brdf(kd, ks, n, wo, wi), expected_pdf(kd, ks, n, wo, wi)
+    )
 
 
 @given(weights, weights, exponents, thetas, phis, st.floats(90.001, 180.0), phis)
 def test_zero_below_the_surface(kd, ks, n, to, po, ti, pi_):
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
-    check_nothing_below(m, direction(NORMAL, to, po), direction(NORMAL, ti, pi_))
+    directions.check_nothing_below(m, direction(NORMAL, to, po), direction(NORMAL, ti, pi_))
 
 
 def test_the_highlight_peaks_where_the_half_vector_is_the_normal():
@@ -110,7 +93,7 @@ def test_the_highlight_peaks_where_the_half_vector_is_the_normal():
 def test_reciprocity(kd, ks, n, ta, pa, tb, pb):
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
     a, b = direction(NORMAL, ta, pa), direction(NORMAL, tb, pb)
-    assert model_brdf(m, a, b) == approx3(model_brdf(m, b, a), rel=1e-9)
+    assert model_brdf(m, a, b) == directions.approx3(model_brdf(m, b, a), rel=1e-9)
 
 
 # --- sampling -------------------------------------------------------------------------
@@ -125,7 +108,7 @@ def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, n, theta_o):
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
     wo = direction(NORMAL, theta_o, 30.0)
     brdf, pdf = partial(expected_brdf, kd, ks, n, wo), partial(expected_pdf, kd, ks, n, wo)
-    cosines = check_scattering(m, wo, brdf, pdf, 1500, (7, int(theta_o)))
+    cosines = directions.check_scattering(m, wo, brdf, pdf, 1500, (7, int(theta_o)))
     assert len(cosines) > 300  # for n = 0 most reflections about h go below the surface
 
 
@@ -157,9 +140,11 @@ def test_pdf_integrates_to_the_fraction_of_samples_not_absorbed(kd, n, theta_o):
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=1.0 - kd, exponent=n)
     wo = direction(NORMAL, theta_o, 0.0)
     below = tuple(-x for x in wo)
-    total = polar_integral(lambda wi: model_pdf(m, wo, wi), below, peak=mirror(wo, NORMAL))
+    total = directions.polar_integral(
+        lambda wi: model_pdf(m, wo, wi), below, peak=mirror(wo, NORMAL)
+    )
     k = 20000
-    alive = alive_fraction(m, wo, k, seed=int(n + theta_o))
+    alive = directions.alive_fraction(m, wo, k, seed=int(n + theta_o))
     assert 0.0 < total < 1.0
     assert abs(alive - total) < 5.0 * math.sqrt(total * (1.0 - total) / k)
 
@@ -176,7 +161,7 @@ def test_energy_at_normal_incidence_matches_the_closed_form(n):
         cos_i = dot3(wi, NORMAL)
         return m.BRDF(view_ray(wo), light_ray(wi), hit).e0 * cos_i if cos_i > 0 else 0.0
 
-    albedo = polar_integral(f_cos, NORMAL, peak=NORMAL)
+    albedo = directions.polar_integral(f_cos, NORMAL, peak=NORMAL)
     assert albedo == pytest.approx(lobe_albedo_at_normal_incidence(n), abs=1e-6)
     assert albedo < 1.08
 
@@ -190,7 +175,7 @@ def test_grazing_angles_and_huge_exponents_give_finite_values(n):
     hit = make_hit(m)
     views = [direction(NORMAL, to, 10.0) for to in (0.0, 60.0, 89.99)]
     grazing = [direction(NORMAL, 89.99, pi_) for pi_ in (10, 100, 190)]
-    check_finite(m, [(wo, [*grazing, NORMAL, mirror(wo, NORMAL)]) for wo in views], 300)
+    directions.check_finite(m, [(wo, [*grazing, NORMAL, mirror(wo, NORMAL)]) for wo in views], 300)
     wo = direction(NORMAL, 89.99, 10.0)
     f = m.BRDF(view_ray(wo), light_ray(mirror(wo, NORMAL)), hit).e0
     assert f == pytest.approx(0.5 * ALBEDO[0] / math.pi + 0.5 * (n + 8) / (8 * math.pi), rel=1e-6)
@@ -212,7 +197,7 @@ def test_defaults_and_registration():
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        *BAD_STRENGTHS,
+        *directions.BAD_STRENGTHS,
         ({"exponent": -0.5}, "exponent must be a finite number >= 0, got -0.5"),
         ({"exponent": math.nan}, "exponent must be a finite number >= 0"),
         ({"exponent": math.inf}, "exponent must be a finite number >= 0"),
@@ -225,9 +210,9 @@ def test_constructor_refuses_bad_parameters(kwargs, message):
 
 def test_the_loader_accepts_a_blinn_phong_material():
     keys = 'type = "blinn_phong"\nalbedo = [0.1, 0.2, 0.6]\nkd = 0.7\nks = 0.3\nexponent = 120'
-    m = load_material(keys)
+    m = directions.load_material(keys)
     assert isinstance(m, BlinnPhong)
     assert m.albedo.color == Color(0.1, 0.2, 0.6)
     assert (m.kd, m.ks, m.exponent) == (0.7, 0.3, 120.0)
     with pytest.raises(SceneError, match=r"\[materials.shiny\] ks: expected a number in \[0, 1\]"):
-        load_material(keys.replace("ks = 0.3", "ks = -0.3"))
+        directions.load_material(keys.replace("ks = 0.3", "ks = -0.3"))
