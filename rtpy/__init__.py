@@ -18,12 +18,18 @@ from .interval import Interval
 from .io.image import RenderedImage
 from .light import PointLight
 from .materials import (
+    Blinn,
+    BlinnPhong,
+    CookTorrance,
     Dielectric,
     DiffuseLight,
     Lambertian,
     Material,
     Metal,
     Mirror,
+    OrenNayar,
+    Phong,
+    Ward,
     register_material,
 )
 from .quad import Quad
@@ -94,9 +100,12 @@ def render(
 
 
 __all__ = [
+    "Blinn",
+    "BlinnPhong",
     "Camera",
     "CheckerTexture",
     "Color",
+    "CookTorrance",
     "Dielectric",
     "DiffuseLight",
     "HitInfo",
@@ -106,6 +115,8 @@ __all__ = [
     "Material",
     "Metal",
     "Mirror",
+    "OrenNayar",
+    "Phong",
     "Point3",
     "PointLight",
     "Quad",
@@ -120,6 +131,7 @@ __all__ = [
     "Texture",
     "Triangle",
     "Vec3",
+    "Ward",
     "load_scene",
     "register_material",
     "render",

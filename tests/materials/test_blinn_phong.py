@@ -19,6 +19,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+import rtpy
 from rtpy.io.scene_file import SceneError
 from rtpy.materials import MATERIALS, Blinn, BlinnPhong
 from rtpy.sampling import make_generator, use_generator
@@ -191,7 +192,7 @@ def test_defaults_and_registration():
     assert (m.kd, m.ks, m.exponent) == (1.0, 0.0, 1.0)
     assert m.albedo.color == Color(0.5, 0.5, 0.5)
     assert MATERIALS["blinn_phong"] is BlinnPhong
-    assert Blinn is BlinnPhong  # the course's name
+    assert Blinn is BlinnPhong is rtpy.Blinn  # the course's name, importable from rtpy too
 
 
 @pytest.mark.parametrize(
