@@ -19,17 +19,12 @@ from .io.image import RenderedImage
 from .light import PointLight
 from .materials import (
     Blinn,
-    BlinnPhong,
-    CookTorrance,
     Dielectric,
     DiffuseLight,
     Lambertian,
     Material,
     Metal,
     Mirror,
-    OrenNayar,
-    Phong,
-    Ward,
     register_material,
 )
 from .quad import Quad
@@ -101,11 +96,9 @@ def render(
 
 __all__ = [
     "Blinn",
-    "BlinnPhong",
     "Camera",
     "CheckerTexture",
     "Color",
-    "CookTorrance",
     "Dielectric",
     "DiffuseLight",
     "HitInfo",
@@ -115,8 +108,6 @@ __all__ = [
     "Material",
     "Metal",
     "Mirror",
-    "OrenNayar",
-    "Phong",
     "Point3",
     "PointLight",
     "Quad",
@@ -131,7 +122,6 @@ __all__ = [
     "Texture",
     "Triangle",
     "Vec3",
-    "Ward",
     "load_scene",
     "register_material",
     "render",
