@@ -19,6 +19,7 @@ from .interval import Interval
 from .io.image import RenderedImage
 from .light import PointLight
 from .materials import (
+    Blinn,
     BlinnPhong,
     CookTorrance,
     Dielectric,
@@ -100,6 +101,7 @@ def render(
 
 
 __all__ = [
+    "Blinn",
     "BlinnPhong",
     "Camera",
     "CheckerTexture",

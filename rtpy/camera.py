@@ -122,17 +122,12 @@ class Camera:
     def _ray_through(self, px: float, py: float) -> Ray:
         """Ray through the viewport at fractional pixel position (px, py)."""
         # BEGIN SOLUTION week03: unit ray from the eye (or lens) through pixel position (px, py)
-        p00, du, dv = self.pixel00, self.pixel_delta_u, self.pixel_delta_v
-        tx = p00.e0 + px * du.e0 + py * dv.e0
-        ty = p00.e1 + px * du.e1 + py * dv.e1
-        tz = p00.e2 + px * du.e2 + py * dv.e2
+        target = self.pixel00 + self.pixel_delta_u * px + self.pixel_delta_v * py
         origin = self.look_from
         if self.defocus_angle > 0.0:
             d = random_in_unit_disk()
-            origin = origin + self.defocus_disk_u * d.e0 + self.defocus_disk_v * d.e1
-        dx, dy, dz = tx - origin.e0, ty - origin.e1, tz - origin.e2
-        k = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
-        return Ray(origin, Vec3(dx * k, dy * k, dz * k))
+            origin = origin + self.defocus_disk_u * d.x() + self.defocus_disk_v * d.y()
+        return Ray(origin, unit_vector(target - origin))
         # END SOLUTION
 
     def get_center_ray(self, i: int, j: int) -> Ray:

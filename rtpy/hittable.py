@@ -93,6 +93,21 @@ class Hittable:
             return None
         return direction, dist2 / (cos_light * self.area())
 
+    def sample_hit(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float, HitInfo] | None:
+        """Light sampling from p: (the unit direction sample_direction draws, its
+        solid-angle pdf, the HitInfo where the ray from p along it meets this object,
+        whose t is the distance), or None when the sample is useless. This traces the
+        ray; a shape that knows the distance from the sample can skip that."""
+        sample = self.sample_direction(p, r1, r2)
+        if sample is None:
+            return None
+        direction, pdf = sample
+        ray = Ray(p, direction)
+        t = self.hit_t(ray, 0.0, math.inf)
+        if t is None or not pdf > 0.0:
+            return None  # a grazing sample that rounding moved off the shape
+        return direction, pdf, self.hit_info(ray, t)
+
     def direction_pdf(self, p: Vec3, hit: HitInfo) -> float:
         """Solid-angle density with which sample_direction(p) picks the direction
         from p to `hit`, a point on this object."""

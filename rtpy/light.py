@@ -14,8 +14,7 @@ import math
 
 from .hit_info import HitInfo
 from .hittable import Hittable
-from .ray import Ray
-from .sampling import random_double
+from .sampling import generator
 from .vec3 import Color, Vec3
 
 
@@ -59,14 +58,12 @@ class PointLight(Light):
 
     def sample(self, p: Vec3) -> LightSample | None:
         # BEGIN SOLUTION week05: direction, distance and radiance I / d^2 seen from p
-        q = self.position
-        dx, dy, dz = q.e0 - p.e0, q.e1 - p.e1, q.e2 - p.e2
-        dist2 = dx * dx + dy * dy + dz * dz
+        to_light = self.position - p
+        dist2 = to_light.length_squared()
         if dist2 == 0.0:
             return None
         dist = math.sqrt(dist2)
-        direction = Vec3(dx / dist, dy / dist, dz / dist)
-        return LightSample(direction, dist, self.intensity / dist2, 1.0, True, q)
+        return LightSample(to_light / dist, dist, self.intensity / dist2, 1.0, True, self.position)
         # END SOLUTION
 
 
@@ -78,16 +75,13 @@ class AreaLight(Light):
         self.shape = shape
 
     def sample(self, p: Vec3) -> LightSample | None:
-        s = self.shape.sample_direction(p, random_double(), random_double())
+        r = generator().random
+        s = self.shape.sample_hit(p, r(), r())
         if s is None:
             return None
-        direction, pdf = s
-        ray = Ray(p, direction)
-        t = self.shape.hit_t(ray, 0.0, math.inf)
-        if t is None or not pdf > 0.0:
-            return None  # a grazing sample that rounding moved off the shape
-        hit = self.shape.hit_info(ray, t)
-        return LightSample(direction, t, self.shape.material.emitting(hit), pdf, False, hit.point)
+        direction, pdf, hit = s
+        emitted = self.shape.material.emitting(hit)
+        return LightSample(direction, hit.t, emitted, pdf, False, hit.point)
 
     def pdf(self, p: Vec3, hit: HitInfo) -> float:
         """Solid-angle density of sample(p) choosing the direction toward `hit`."""

@@ -1,14 +1,20 @@
-"""Orthonormal basis around a unit normal (local frame with z = normal)."""
+"""Orthonormal basis: a frame (u, v, w) around a unit vector w.
+
+Sampling draws a direction in a frame with its z axis along some axis (the normal
+for a diffuse bounce, the mirror direction for a Phong highlight): a Vec3 of local
+coordinates (x, y, z). ONB(axis).to_world(local) turns it into the world direction
+x u + y v + z w.
+"""
 
 from __future__ import annotations
 
 import math
 
-from .vec3 import Vec3
+from .vec3 import Vec3, cross, dot
 
 
 class ONB:
-    """Frame (u, v, w) with w the given unit vector; right-handed.
+    """Frame (u, v, w) with w the given unit vector; right-handed (u x v = w).
 
     Built with the branchless method of Duff et al. 2017 ("Building an
     Orthonormal Basis, Revisited"), which is stable for every w.
@@ -28,34 +34,26 @@ class ONB:
     def from_normal_tangent(cls, normal: Vec3, tangent: Vec3) -> ONB:
         """Frame with w = normal and u = the tangent made perpendicular to it
         (Gram-Schmidt); v = w x u."""
-        frame = cls.__new__(cls)
-        k = tangent.e0 * normal.e0 + tangent.e1 * normal.e1 + tangent.e2 * normal.e2
-        ux = tangent.e0 - k * normal.e0
-        uy = tangent.e1 - k * normal.e1
-        uz = tangent.e2 - k * normal.e2
-        length = math.sqrt(ux * ux + uy * uy + uz * uz)
+        u = tangent - normal * dot(tangent, normal)
+        length = u.length()
         if length < 1e-9:  # tangent along the normal: any frame will do
             return cls(normal)
-        u = Vec3(ux / length, uy / length, uz / length)
-        w = normal
-        frame.u = u
-        frame.v = Vec3(
-            w.e1 * u.e2 - w.e2 * u.e1, w.e2 * u.e0 - w.e0 * u.e2, w.e0 * u.e1 - w.e1 * u.e0
-        )
-        frame.w = w
+        frame = cls.__new__(cls)
+        frame.u = u / length
+        frame.v = cross(normal, frame.u)
+        frame.w = normal
         return frame
 
-    def to_local(self, d: Vec3) -> tuple[float, float, float]:
+    def to_local(self, d: Vec3) -> Vec3:
         """Coordinates (x, y, z) of the world vector d in this frame (z along w)."""
-        u, v, w = self.u, self.v, self.w
-        return (
-            d.e0 * u.e0 + d.e1 * u.e1 + d.e2 * u.e2,
-            d.e0 * v.e0 + d.e1 * v.e1 + d.e2 * v.e2,
-            d.e0 * w.e0 + d.e1 * w.e1 + d.e2 * w.e2,
-        )
+        return Vec3(dot(d, self.u), dot(d, self.v), dot(d, self.w))
 
-    def to_world(self, x: float, y: float, z: float) -> Vec3:
+    def to_world(self, a: Vec3) -> Vec3:
+        """The world vector x u + y v + z w of the local coordinates a = (x, y, z)."""
+        # Written per component: every bounce of a path calls this, and one Vec3
+        # costs less than the five that u * x + v * y + w * z would make.
         u, v, w = self.u, self.v, self.w
+        x, y, z = a.e0, a.e1, a.e2
         return Vec3(
             x * u.e0 + y * v.e0 + z * w.e0,
             x * u.e1 + y * v.e1 + z * w.e1,
@@ -65,7 +63,7 @@ class ONB:
 
 def local_to_world(w: Vec3, x: float, y: float, z: float) -> Vec3:
     """x * u + y * v + z * w for the frame ONB(w) builds, without building it
-    (the same numbers; this is the hot path of every diffuse bounce)."""
+    (the same numbers)."""
     w0, w1, w2 = w.e0, w.e1, w.e2
     sign = math.copysign(1.0, w2)
     a = -1.0 / (sign + w2)

@@ -31,34 +31,22 @@ class Quad(Hittable):
 
     def _coords(self, p: Vec3) -> tuple[float, float]:
         # BEGIN SOLUTION week04: the planar coordinates (alpha, beta) of p: p = q + alpha u + beta v
-        q, w = self.q, self.w
-        px, py, pz = p.e0 - q.e0, p.e1 - q.e1, p.e2 - q.e2
-        u, v = self.u, self.v
-        # alpha = w . (p x v), beta = w . (u x p)
-        a = (
-            w.e0 * (py * v.e2 - pz * v.e1)
-            + w.e1 * (pz * v.e0 - px * v.e2)
-            + w.e2 * (px * v.e1 - py * v.e0)
-        )
-        b = (
-            w.e0 * (u.e1 * pz - u.e2 * py)
-            + w.e1 * (u.e2 * px - u.e0 * pz)
-            + w.e2 * (u.e0 * py - u.e1 * px)
-        )
-        return a, b
+        planar = p - self.q
+        alpha = dot(self.w, cross(planar, self.v))
+        beta = dot(self.w, cross(self.u, planar))
+        return alpha, beta
         # END SOLUTION
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
         # BEGIN SOLUTION week04: plane intersection, then the interior test 0 <= alpha, beta <= 1
-        n, o, d = self.normal, ray.origin, ray.direction
-        denom = n.e0 * d.e0 + n.e1 * d.e1 + n.e2 * d.e2
+        denom = dot(self.normal, ray.direction)
         if denom == 0.0:
             return None  # parallel to the plane
-        t = (self.d - (n.e0 * o.e0 + n.e1 * o.e1 + n.e2 * o.e2)) / denom
+        t = (self.d - dot(self.normal, ray.origin)) / denom
         if not t_min < t < t_max:
             return None
-        a, b = self._coords(Vec3(o.e0 + t * d.e0, o.e1 + t * d.e1, o.e2 + t * d.e2))
-        if 0.0 <= a <= 1.0 and 0.0 <= b <= 1.0:
+        alpha, beta = self._coords(ray.at(t))
+        if 0.0 <= alpha <= 1.0 and 0.0 <= beta <= 1.0:
             return t
         return None
         # END SOLUTION
@@ -70,8 +58,8 @@ class Quad(Hittable):
         return AABB.from_points(q, q + u, q + v, q + u + v).padded()
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
-        n, d = self.normal, ray.direction
-        front_face = n.e0 * d.e0 + n.e1 * d.e1 + n.e2 * d.e2 < 0.0
+        n = self.normal
+        front_face = dot(n, ray.direction) < 0.0
         return HitInfo(ray.at(t), n if front_face else -n, t, front_face, self.material, self)
 
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
@@ -87,8 +75,4 @@ class Quad(Hittable):
         return self._area
 
     def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:
-        q, u, v = self.q, self.u, self.v
-        p = Vec3(
-            q.e0 + r1 * u.e0 + r2 * v.e0, q.e1 + r1 * u.e1 + r2 * v.e1, q.e2 + r1 * u.e2 + r2 * v.e2
-        )
-        return p, self.normal
+        return self.q + self.u * r1 + self.v * r2, self.normal

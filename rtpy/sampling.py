@@ -68,14 +68,15 @@ def random_in_unit_disk() -> Vec3:
     return Vec3(radius * math.cos(phi), radius * math.sin(phi), 0.0)
 
 
-def random_cosine_direction() -> tuple[float, float, float]:
-    """Local (x, y, z) of a direction in the z-up hemisphere with pdf cos(theta) / pi."""
+def random_cosine_direction() -> Vec3:
+    """A direction in the z-up hemisphere with pdf cos(theta) / pi, as local coordinates
+    (x, y, z) (ONB(axis).to_world turns it around an axis)."""
     r = _generator.random
     r1 = r()
     r2 = r()
     phi = 2.0 * math.pi * r1
     s = math.sqrt(r2)
-    return s * math.cos(phi), s * math.sin(phi), math.sqrt(max(0.0, 1.0 - r2))
+    return Vec3(s * math.cos(phi), s * math.sin(phi), math.sqrt(max(0.0, 1.0 - r2)))
 
 
 def power_heuristic(pdf_a: float, pdf_b: float) -> float:

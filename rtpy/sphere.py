@@ -10,7 +10,7 @@ from .hittable import Hittable
 from .onb import local_to_world
 from .ray import Ray
 from .sampling import uniform_sphere
-from .vec3 import Vec3
+from .vec3 import Vec3, dot, unit_vector
 
 
 class Sphere(Hittable):
@@ -20,28 +20,27 @@ class Sphere(Hittable):
         self.center = center
         self.radius = radius
         self.material = material
-        # Plain floats for the hot intersection loop.
-        self._cx, self._cy, self._cz = center.e0, center.e1, center.e2
-        self._r2 = radius * radius
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
         # BEGIN SOLUTION week04: the smallest root t of |o + t d - c|^2 = r^2 inside (t_min, t_max)
-        o, d = ray.origin, ray.direction
-        dx, dy, dz = d.e0, d.e1, d.e2
-        ocx, ocy, ocz = self._cx - o.e0, self._cy - o.e1, self._cz - o.e2  # origin -> center
-        h = dx * ocx + dy * ocy + dz * ocz
-        c_term = ocx * ocx + ocy * ocy + ocz * ocz - self._r2  # > 0: origin outside
-        if h < 0.0 and c_term > 0.0:
+        d, r2 = ray.direction, self.radius * self.radius
+        oc = self.center - ray.origin  # from the ray's origin to the center
+        oc2 = oc.length_squared()
+        h = dot(d, oc)
+        c = oc2 - r2  # > 0: the origin is outside
+        if h < 0.0 and c > 0.0:
             return None  # outside and moving away
-        a = dx * dx + dy * dy + dz * dz
-        # The textbook discriminant h^2 - a*c cancels catastrophically for big
-        # spheres seen from far away. a * (r^2 - |f|^2), with f the offset from
-        # the center to the ray's closest point to it, is the same number
-        # computed without cancellation (pbrt-v4, Ray Tracing Gems ch. 7).
-        k = h / a
-        fx, fy, fz = ocx - k * dx, ocy - k * dy, ocz - k * dz
-        f2 = fx * fx + fy * fy + fz * fz
-        if f2 > self._r2:
+        a = d.length_squared()
+        # The textbook discriminant h^2 - a c tells a hit from a miss, but for big
+        # spheres seen from far away it cancels: its rounding error reaches about
+        # 1e-15 a |oc|^2. Clearly below that, the line passes the sphere by.
+        if h * h - a * c < -1e-14 * a * oc2:
+            return None
+        # Elsewhere a * (r^2 - |f|^2), with f the offset from the center to the ray's
+        # closest point to it, is the same number computed without cancellation
+        # (pbrt-v4, Ray Tracing Gems ch. 7).
+        f2 = (oc - d * (h / a)).length_squared()
+        if f2 > r2:
             return None  # the line passes the sphere by
         r, f = self.radius, math.sqrt(f2)
         disc = a * (r - f) * (r + f)
@@ -50,7 +49,7 @@ class Sphere(Hittable):
         q = h + math.copysign(math.sqrt(disc), h)
         if q == 0.0:
             return None
-        t0 = c_term / q
+        t0 = c / q
         t1 = q / a
         if t0 > t1:
             t0, t1 = t1, t0
@@ -68,28 +67,21 @@ class Sphere(Hittable):
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
         # BEGIN SOLUTION week04: hit point, unit normal facing the ray, front_face
-        c, r = self.center, self.radius
-        p = ray.at(t)
-        nx, ny, nz = p.e0 - c.e0, p.e1 - c.e1, p.e2 - c.e2
-        k = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
-        nx, ny, nz = nx * k, ny * k, nz * k
-        # Put the hit point back onto the surface: removes the rounding of o + t d.
-        p = Vec3(c.e0 + r * nx, c.e1 + r * ny, c.e2 + r * nz)
-        d = ray.direction
-        front_face = d.e0 * nx + d.e1 * ny + d.e2 * nz < 0.0
-        normal = Vec3(nx, ny, nz) if front_face else Vec3(-nx, -ny, -nz)
-        return HitInfo(p, normal, t, front_face, self.material, self)
+        outward = unit_vector(ray.at(t) - self.center)
+        # The hit point put back onto the surface: removes the rounding of o + t d.
+        point = self.center + outward * self.radius
+        front_face = dot(ray.direction, outward) < 0.0
+        normal = outward if front_face else -outward
+        return HitInfo(point, normal, t, front_face, self.material, self)
         # END SOLUTION
 
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
         """RTIOW's spherical coordinates: u = phi / (2 pi) with phi measured from -x
         around +y; v = theta / pi with theta from -y (v = 0 at the south pole)."""
         # BEGIN SOLUTION week07: spherical (u, v) of the hit
-        c, r = self.center, self.radius
-        p = hit.point
-        x, y, z = (p.e0 - c.e0) / r, (p.e1 - c.e1) / r, (p.e2 - c.e2) / r
-        theta = math.acos(max(-1.0, min(1.0, -y)))
-        phi = math.atan2(-z, x) + math.pi
+        n = (hit.point - self.center) / self.radius  # the outward unit normal
+        theta = math.acos(max(-1.0, min(1.0, -n.y())))
+        phi = math.atan2(-n.z(), n.x()) + math.pi
         return phi / (2.0 * math.pi), theta / math.pi
         # END SOLUTION
 
@@ -113,31 +105,63 @@ class Sphere(Hittable):
     # directions they subtend (pbrt-v4's Sphere::Sample), which has far less
     # variance than sampling the area; from inside, uniformly by area.
     def _cone(self, p: Vec3) -> tuple[float, float] | None:
-        """(cos_theta_max, 1 - cos_theta_max) of the cone the sphere subtends at p,
-        or None when p is inside the sphere."""
-        c = self.center
-        dx, dy, dz = c.e0 - p.e0, c.e1 - p.e1, c.e2 - p.e2
-        d2 = dx * dx + dy * dy + dz * dz
+        """(squared distance from p to the center, 1 - cos_theta_max of the cone the
+        sphere subtends at p), or None when p is inside the sphere."""
+        d2 = (self.center - p).length_squared()
         r2 = self.radius * self.radius
         if d2 <= r2 * 1.0000001:
             return None
         sin2 = r2 / d2
-        cos_max = math.sqrt(1.0 - sin2)
-        return cos_max, sin2 / (1.0 + cos_max)  # 1 - cos_max without cancellation
+        return d2, sin2 / (1.0 + math.sqrt(1.0 - sin2))  # 1 - cos_max without cancellation
+
+    def _cone_sample(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float, float] | None:
+        """(direction, its pdf, the distance to the sphere along it) for a direction
+        drawn uniformly in the cone the sphere subtends at p; None from inside."""
+        # Written per component: every light sample of every bounce comes here.
+        c = self.center
+        ax, ay, az = c.e0 - p.e0, c.e1 - p.e1, c.e2 - p.e2  # from p to the center
+        d2 = ax * ax + ay * ay + az * az
+        rr = self.radius * self.radius
+        if d2 <= rr * 1.0000001:
+            return None
+        sin2_max = rr / d2
+        one_minus_cos_max = sin2_max / (1.0 + math.sqrt(1.0 - sin2_max))  # no cancellation
+        cos_t = 1.0 - r1 * one_minus_cos_max
+        sin2_t = max(0.0, 1.0 - cos_t * cos_t)
+        sin_t = math.sqrt(sin2_t)
+        phi = 2.0 * math.pi * r2
+        distance = math.sqrt(d2)
+        k = 1.0 / distance
+        axis = Vec3(ax * k, ay * k, az * k)
+        direction = local_to_world(axis, sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
+        # The nearer root of t^2 - 2 t D cos_t + D^2 - r^2 = 0 (D = distance), written
+        # without cancellation; inside the cone r^2 - D^2 sin_t^2 >= 0 but for rounding.
+        t = (d2 - rr) / (distance * cos_t + math.sqrt(max(0.0, rr - d2 * sin2_t)))
+        return direction, 1.0 / (2.0 * math.pi * one_minus_cos_max), t
 
     def sample_direction(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float] | None:
-        cone = self._cone(p)
-        if cone is None:
+        sample = self._cone_sample(p, r1, r2)
+        if sample is None:
             return super().sample_direction(p, r1, r2)
-        cos_max, one_minus_cos_max = cone
-        cos_t = 1.0 - r1 * one_minus_cos_max
-        sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))
-        phi = 2.0 * math.pi * r2
-        c = self.center
-        axis = Vec3(c.e0 - p.e0, c.e1 - p.e1, c.e2 - p.e2)
-        axis = axis / axis.length()
-        direction = local_to_world(axis, sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
-        return direction, 1.0 / (2.0 * math.pi * one_minus_cos_max)
+        return sample[0], sample[1]
+
+    def sample_hit(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float, HitInfo] | None:
+        """As Hittable.sample_hit; from outside the distance to the sphere follows
+        from the sampled angle, so the ray is not traced."""
+        sample = self._cone_sample(p, r1, r2)
+        if sample is None:
+            return super().sample_hit(p, r1, r2)
+        direction, pdf, t = sample
+        # The point and the outward normal there, as hit_info makes them (seen from
+        # outside, the front face), per component: this runs for every light sample.
+        c, r = self.center, self.radius
+        nx = p.e0 + t * direction.e0 - c.e0
+        ny = p.e1 + t * direction.e1 - c.e1
+        nz = p.e2 + t * direction.e2 - c.e2
+        k = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+        normal = Vec3(nx * k, ny * k, nz * k)
+        point = Vec3(c.e0 + normal.e0 * r, c.e1 + normal.e1 * r, c.e2 + normal.e2 * r)
+        return direction, pdf, HitInfo(point, normal, t, True, self.material, self)
 
     def direction_pdf(self, p: Vec3, hit: HitInfo) -> float:
         cone = self._cone(p)

@@ -40,8 +40,8 @@ class CheckerTexture(Texture):
 
     def value(self, hit: HitInfo) -> Color:
         # BEGIN SOLUTION week07: 3-D checker cells
-        p, k = hit.point, self.inv_scale
-        cell = math.floor(p.e0 * k) + math.floor(p.e1 * k) + math.floor(p.e2 * k)
+        p = hit.point * self.inv_scale
+        cell = math.floor(p.x()) + math.floor(p.y()) + math.floor(p.z())
         return self.even if cell % 2 == 0 else self.odd
         # END SOLUTION
 

@@ -8,7 +8,7 @@ from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import Hittable
 from .ray import Ray
-from .vec3 import Vec3, cross
+from .vec3 import Vec3, cross, dot
 
 # Moller-Trumbore divides by det = e1 . (d x e2), which is |e1| |e2| |d| times
 # about the sine of the angle between the ray and the triangle's plane. When that
@@ -47,28 +47,21 @@ class Triangle(Hittable):
         """Moller-Trumbore: (t, u, v) of the ray's hit with the triangle's plane
         inside the triangle, or None."""
         # BEGIN SOLUTION week04: Moller-Trumbore: (t, u, v) inside the triangle, or None
-        e1, e2, o, d = self.e1, self.e2, ray.origin, ray.direction
-        # p = d x e2
-        px = d.e1 * e2.e2 - d.e2 * e2.e1
-        py = d.e2 * e2.e0 - d.e0 * e2.e2
-        pz = d.e0 * e2.e1 - d.e1 * e2.e0
-        det = e1.e0 * px + e1.e1 * py + e1.e2 * pz
-        if det * det <= self._parallel_det2 * (d.e0 * d.e0 + d.e1 * d.e1 + d.e2 * d.e2):
+        d = ray.direction
+        p = cross(d, self.e2)
+        det = dot(self.e1, p)
+        if det * det <= self._parallel_det2 * d.length_squared():
             return None  # parallel to the plane, within rounding
         inv = 1.0 / det
-        a = self.a
-        sx, sy, sz = o.e0 - a.e0, o.e1 - a.e1, o.e2 - a.e2
-        u = (sx * px + sy * py + sz * pz) * inv
+        s = ray.origin - self.a
+        u = dot(s, p) * inv
         if u < 0.0 or u > 1.0:
             return None
-        # q = s x e1
-        qx = sy * e1.e2 - sz * e1.e1
-        qy = sz * e1.e0 - sx * e1.e2
-        qz = sx * e1.e1 - sy * e1.e0
-        v = (d.e0 * qx + d.e1 * qy + d.e2 * qz) * inv
+        q = cross(s, self.e1)
+        v = dot(d, q) * inv
         if v < 0.0 or u + v > 1.0:
             return None
-        t = (e2.e0 * qx + e2.e1 * qy + e2.e2 * qz) * inv
+        t = dot(self.e2, q) * inv
         return t, u, v
         # END SOLUTION
 
@@ -84,19 +77,16 @@ class Triangle(Hittable):
         return AABB.from_points(self.a, self.b, self.c).padded()
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
-        n, d = self.normal, ray.direction
-        front_face = n.e0 * d.e0 + n.e1 * d.e1 + n.e2 * d.e2 < 0.0
+        n = self.normal
+        front_face = dot(n, ray.direction) < 0.0
         return HitInfo(ray.at(t), n if front_face else -n, t, front_face, self.material, self)
 
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
         # Barycentric coordinates of the hit point from areas of sub-triangles.
         p = hit.point - self.a
         e1, e2 = self.e1, self.e2
-        d00 = e1.e0 * e1.e0 + e1.e1 * e1.e1 + e1.e2 * e1.e2
-        d01 = e1.e0 * e2.e0 + e1.e1 * e2.e1 + e1.e2 * e2.e2
-        d11 = e2.e0 * e2.e0 + e2.e1 * e2.e1 + e2.e2 * e2.e2
-        d20 = p.e0 * e1.e0 + p.e1 * e1.e1 + p.e2 * e1.e2
-        d21 = p.e0 * e2.e0 + p.e1 * e2.e1 + p.e2 * e2.e2
+        d00, d01, d11 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
+        d20, d21 = dot(p, e1), dot(p, e2)
         denom = d00 * d11 - d01 * d01
         u = (d11 * d20 - d01 * d21) / denom
         v = (d00 * d21 - d01 * d20) / denom
@@ -112,10 +102,4 @@ class Triangle(Hittable):
         # Uniform by area: s = sqrt(r1) warps the unit square onto the triangle.
         s = math.sqrt(r1)
         wb, wc = s * (1.0 - r2), s * r2
-        a, e1, e2 = self.a, self.e1, self.e2
-        p = Vec3(
-            a.e0 + wb * e1.e0 + wc * e2.e0,
-            a.e1 + wb * e1.e1 + wc * e2.e1,
-            a.e2 + wb * e1.e2 + wc * e2.e2,
-        )
-        return p, self.normal
+        return self.a + self.e1 * wb + self.e2 * wc, self.normal

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import math
 
+_new = object.__new__
+
 
 class Vec3:
     __slots__ = ("e0", "e1", "e2")
@@ -47,26 +49,42 @@ class Vec3:
         return [self.e0, self.e1, self.e2]
 
     # --- arithmetic -------------------------------------------------------
+    # The operators make their result with object.__new__ and set the three slots
+    # themselves instead of calling the class: every ray makes dozens of vectors,
+    # and skipping __init__ makes each of them cheaper.
     def __add__(self, o: Vec3) -> Vec3:
-        return self.__class__(self.e0 + o.e0, self.e1 + o.e1, self.e2 + o.e2)
+        v = _new(self.__class__)
+        v.e0, v.e1, v.e2 = self.e0 + o.e0, self.e1 + o.e1, self.e2 + o.e2
+        return v
 
     def __sub__(self, o: Vec3) -> Vec3:
-        return self.__class__(self.e0 - o.e0, self.e1 - o.e1, self.e2 - o.e2)
+        v = _new(self.__class__)
+        v.e0, v.e1, v.e2 = self.e0 - o.e0, self.e1 - o.e1, self.e2 - o.e2
+        return v
 
     def __neg__(self) -> Vec3:
-        return self.__class__(-self.e0, -self.e1, -self.e2)
+        v = _new(self.__class__)
+        v.e0, v.e1, v.e2 = -self.e0, -self.e1, -self.e2
+        return v
 
     def __mul__(self, o: Vec3 | float) -> Vec3:
-        if isinstance(o, Vec3):
-            return self.__class__(self.e0 * o.e0, self.e1 * o.e1, self.e2 * o.e2)
-        return self.__class__(self.e0 * o, self.e1 * o, self.e2 * o)
+        v = _new(self.__class__)
+        if isinstance(o, Vec3):  # component-wise, for colours
+            v.e0, v.e1, v.e2 = self.e0 * o.e0, self.e1 * o.e1, self.e2 * o.e2
+        else:
+            v.e0, v.e1, v.e2 = self.e0 * o, self.e1 * o, self.e2 * o
+        return v
 
     def __rmul__(self, s: float) -> Vec3:
-        return self.__class__(self.e0 * s, self.e1 * s, self.e2 * s)
+        v = _new(self.__class__)
+        v.e0, v.e1, v.e2 = self.e0 * s, self.e1 * s, self.e2 * s
+        return v
 
     def __truediv__(self, s: float) -> Vec3:
         k = 1.0 / s
-        return self.__class__(self.e0 * k, self.e1 * k, self.e2 * k)
+        v = _new(self.__class__)
+        v.e0, v.e1, v.e2 = self.e0 * k, self.e1 * k, self.e2 * k
+        return v
 
     def __eq__(self, o: object) -> bool:
         if not isinstance(o, Vec3):
@@ -131,16 +149,14 @@ def cross(a: Vec3, b: Vec3) -> Vec3:
 def unit_vector(v: Vec3) -> Vec3:
     """v / |v|. The zero vector has no direction and raises ZeroDivisionError."""
     # BEGIN SOLUTION week03: v / |v|
-    k = 1.0 / math.sqrt(v.e0 * v.e0 + v.e1 * v.e1 + v.e2 * v.e2)
-    return Vec3(v.e0 * k, v.e1 * k, v.e2 * k)
+    return v / v.length()
     # END SOLUTION
 
 
 def reflect(v: Vec3, n: Vec3) -> Vec3:
     """Mirror v about the plane with unit normal n (v points toward the surface)."""
     # BEGIN SOLUTION week06: mirror v about the unit normal n
-    k = 2.0 * (v.e0 * n.e0 + v.e1 * n.e1 + v.e2 * n.e2)
-    return Vec3(v.e0 - k * n.e0, v.e1 - k * n.e1, v.e2 - k * n.e2)
+    return v - n * (2.0 * dot(v, n))
     # END SOLUTION
 
 
@@ -153,6 +169,15 @@ def refract(uv: Vec3, n: Vec3, etai_over_etat: float) -> Vec3:
     parallel = n * -math.sqrt(abs(1.0 - perp.length_squared()))
     return perp + parallel
     # END SOLUTION
+
+
+def halfvector(view: Vec3, light: Vec3) -> Vec3:
+    """The unit half vector h = (view + light) / |view + light|, halfway between the
+    unit directions to the viewer and to the light (both pointing away from the
+    surface). Blinn-Phong, Cook-Torrance and Ward evaluate their highlights at h.
+    view = -light has no half vector (ZeroDivisionError); above a surface they never
+    are, since both lie on the normal's side."""
+    return unit_vector(view + light)
 
 
 BLACK = Color(0.0, 0.0, 0.0)

@@ -26,13 +26,11 @@ from rtpy.sphere import Sphere
 from rtpy.triangle import Triangle
 from rtpy.vec3 import Vec3, cross
 
+from .vectors import V
+
 MAT = Lambertian()
 FORWARD = Interval(0.0, math.inf)
 INF = math.inf
-
-
-def V(x, y, z) -> Vec3:
-    return Vec3(float(x), float(y), float(z))
 
 
 def bvh_scene(objects) -> Scene:

@@ -8,34 +8,8 @@ import pytest
 
 from rtpy.camera import Camera, parse_aspect_ratio
 from rtpy.sampling import make_generator, use_generator
-from rtpy.vec3 import Vec3
 
-
-def V(x, y, z) -> Vec3:
-    return Vec3(float(x), float(y), float(z))
-
-
-def dot3(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def norm3(a) -> float:
-    return math.sqrt(dot3(a, a))
-
-
-def unit3(a):
-    n = norm3(a)
-    return tuple(x / n for x in a)
-
-
-def cross3(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def angle(a, b) -> float:
-    """Angle between two vectors, accurate for small angles (atan2 of |a x b| and a.b)."""
-    return math.atan2(norm3(cross3(a, b)), dot3(a, b))
-
+from .vectors import V, angle, cross3, dot3, norm3, unit3
 
 LOOK_FROM = (1.0, 2.0, 3.0)
 LOOK_AT = (-2.0, 1.0, -4.0)

@@ -13,19 +13,9 @@ from rtpy.quad import Quad
 from rtpy.ray import Ray
 from rtpy.sampling import make_generator, use_generator
 from rtpy.sphere import Sphere
-from rtpy.vec3 import Color, Vec3
+from rtpy.vec3 import Color
 
-
-def V(x, y, z) -> Vec3:
-    return Vec3(float(x), float(y), float(z))
-
-
-def dot3(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def norm3(a) -> float:
-    return math.sqrt(dot3(a, a))
+from .vectors import V, norm3
 
 
 def test_point_light_sample_on_axis():

@@ -26,11 +26,12 @@ def check_frame(w: Vec3) -> None:
     # Right-handed: u x v = w.
     c = cross(u, v)
     assert abs(c.e0 - w.e0) < TOL and abs(c.e1 - w.e1) < TOL and abs(c.e2 - w.e2) < TOL
-    # to_world maps the local axes to (u, v, w) and is linear.
-    assert f.to_world(0.0, 0.0, 1.0).tolist() == pytest.approx(w.tolist(), abs=1e-15)
-    x = f.to_world(0.3, -0.4, 0.5)
+    # to_world maps the local axes to (u, v, w) and is linear; to_local undoes it.
+    assert f.to_world(Vec3(0.0, 0.0, 1.0)).tolist() == pytest.approx(w.tolist(), abs=1e-15)
+    x = f.to_world(Vec3(0.3, -0.4, 0.5))
     expected = u * 0.3 + v * -0.4 + w * 0.5
     assert x.tolist() == pytest.approx(expected.tolist(), abs=1e-15)
+    assert f.to_local(x).tolist() == pytest.approx([0.3, -0.4, 0.5], abs=1e-15)
     # Lengths are preserved (orthonormal).
     assert math.isclose(x.length(), math.sqrt(0.5), abs_tol=TOL)
 
@@ -104,3 +105,35 @@ def test_local_to_world_at_the_poles(w):
     got = local_to_world(v, 0.6, 0.8, 0.0)
     assert abs(dot(got, v)) < 1e-12
     assert got.length() == pytest.approx(1.0, abs=1e-12)
+
+
+@settings(deadline=None, max_examples=100)
+@given(
+    st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1)),
+    st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1)),
+)
+def test_from_normal_tangent_keeps_the_tangent_direction(normal, tangent):
+    n, t = Vec3(*normal), Vec3(*tangent)
+    assume(n.length() > 1e-3 and t.length() > 1e-3)
+    n, t = n / n.length(), t / t.length()  # the shapes' tangents are unit vectors
+    in_plane = t - n * dot(t, n)
+    # Gram-Schmidt loses about 1e-16 / (the in-plane fraction of the tangent) of
+    # orthogonality: keep that fraction above 1e-3 to check to TOL.
+    assume(in_plane.length() > 1e-3)
+    f = ONB.from_normal_tangent(n, t)
+    check_frame_axes(f, n)
+    # u is the tangent's part in the surface, made unit
+    assert f.u.tolist() == pytest.approx((in_plane / in_plane.length()).tolist(), abs=TOL)
+
+
+def check_frame_axes(f: ONB, w: Vec3) -> None:
+    assert f.w is w
+    for a, b in ((f.u, f.v), (f.u, w), (f.v, w)):
+        assert abs(dot(a, b)) < TOL
+    assert cross(f.u, f.v).tolist() == pytest.approx(w.tolist(), abs=TOL)
+
+
+def test_from_normal_tangent_along_the_normal_falls_back_to_any_frame():
+    n = Vec3(0.0, 0.6, 0.8)
+    for t in (n, -n, n * 3.0, Vec3(0.0, 0.0, 0.0)):
+        check_frame_axes(ONB.from_normal_tangent(n, t), n)

@@ -13,30 +13,12 @@ from rtpy.interval import Interval
 from rtpy.materials import Lambertian
 from rtpy.quad import Quad
 from rtpy.ray import Ray
-from rtpy.vec3 import Vec3
+from rtpy.testing import chi2_sf
+
+from .vectors import ORIGINS, V, check_planar_hit, cross3, dot3, norm3, planar_samples, sub3
 
 MAT = Lambertian()
 EVERYWHERE = Interval(0.0, math.inf)
-
-
-def V(x, y, z) -> Vec3:
-    return Vec3(float(x), float(y), float(z))
-
-
-def cross3(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def dot3(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def norm3(a) -> float:
-    return math.sqrt(dot3(a, a))
-
-
-def sub3(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 def solve_ab(q, u, v, p):
@@ -46,20 +28,6 @@ def solve_ab(q, u, v, p):
     du, dv = dot3(d, u), dot3(d, v)
     det = uu * vv - uv * uv
     return (du * vv - dv * uv) / det, (dv * uu - du * uv) / det
-
-
-def chi2_sf(x: float, k: int) -> float:
-    """P(X > x) for a chi-square variable with k degrees of freedom:
-    Q(a + 1, y) = Q(a, y) + y^a e^-y / Gamma(a + 1), from Q(1/2) = erfc(sqrt y), Q(1) = e^-y."""
-    y = x / 2.0
-    if k % 2:
-        q, a = math.erfc(math.sqrt(y)), 0.5
-    else:
-        q, a = math.exp(-y), 1.0
-    while a < k / 2.0:
-        q += math.exp(a * math.log(y) - y - math.lgamma(a + 1.0)) if y > 0 else 0.0
-        a += 1.0
-    return q
 
 
 # The square [-1, 1]^2 in the plane z = -2, front face +z. With these numbers the
@@ -141,31 +109,11 @@ OBLIQUE = Quad(V(*Q0), V(*U0), V(*V0), MAT)
 
 
 @settings(deadline=None, max_examples=100)
-@given(
-    st.floats(0.0, 1.0),
-    st.floats(0.0, 1.0),
-    st.tuples(st.floats(-5, 5), st.floats(-5, 5), st.floats(-5, 5)),
-)
+@given(st.floats(0.0, 1.0), st.floats(0.0, 1.0), ORIGINS)
 def test_oblique_quad_hit_at_a_b(a, b, origin):
     target = tuple(Q0[i] + a * U0[i] + b * V0[i] for i in range(3))
-    d = sub3(target, origin)
-    n = cross3(U0, V0)
-    # Keep rays that cross the plane at a reasonable angle.
-    if abs(dot3(d, n)) < 0.05 * norm3(d) * norm3(n):
-        return
-    h = OBLIQUE.intersect(Ray(V(*origin), V(*d)), Interval(0.0, math.inf))
-    # Points exactly on an edge may round either way; demand a hit strictly inside.
     inside = 1e-9 < a < 1 - 1e-9 and 1e-9 < b < 1 - 1e-9
-    if not inside and h is None:
-        return
-    assert h is not None
-    assert h.t == pytest.approx(1.0, rel=1e-9)
-    assert (h.u, h.v) == pytest.approx((a, b), abs=1e-9)
-    front = dot3(d, n) < 0.0
-    assert h.front_face is front
-    nn = tuple(x / norm3(n) for x in n)
-    expected_n = nn if front else tuple(-x for x in nn)
-    assert h.normal.tolist() == pytest.approx(list(expected_n), abs=1e-12)
+    check_planar_hit(OBLIQUE, origin, target, cross3(U0, V0), (a, b), inside)
 
 
 @pytest.mark.parametrize("a, b", [(1.05, 0.5), (-0.05, 0.5), (0.5, 1.05), (0.5, -0.05), (2, 2)])
@@ -197,19 +145,11 @@ def test_area():
 
 
 def test_sample_point_is_uniform_over_the_quad():
-    rng = random.Random(2024)
     n_samples = 16000
     counts = [[0] * 4 for _ in range(4)]
-    nrm = cross3(U0, V0)
-    nrm = tuple(x / norm3(nrm) for x in nrm)
-    for _ in range(n_samples):
-        p, normal = OBLIQUE.sample_point(rng.random(), rng.random())
-        assert max(abs(x - y) for x, y in zip(normal.tolist(), nrm, strict=True)) < 1e-14
-        pt = p.tolist()
-        # In the plane ...
-        assert abs(dot3(sub3(pt, Q0), nrm)) < 1e-12
+    for pt in planar_samples(OBLIQUE, n_samples, 2024, Q0, cross3(U0, V0)):
         a, b = solve_ab(Q0, U0, V0, pt)
-        # ... and inside the parallelogram.
+        # In the plane (planar_samples checks that) and inside the parallelogram.
         assert -1e-12 <= a <= 1 + 1e-12 and -1e-12 <= b <= 1 + 1e-12
         counts[min(3, int(a * 4))][min(3, int(b * 4))] += 1
     expected = n_samples / 16

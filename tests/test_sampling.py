@@ -110,7 +110,7 @@ def test_random_cosine_direction_mean_z():
     n = 200_000
     with use_generator(make_generator(1234)):
         samples = [random_cosine_direction() for _ in range(n)]
-    zs = [s[2] for s in samples]
+    zs = [s.z() for s in samples]
     assert min(zs) >= 0.0
     for x, y, z in samples[:2000]:
         assert math.isclose(x * x + y * y + z * z, 1.0, abs_tol=1e-12)

@@ -17,11 +17,9 @@ from rtpy.sphere import Sphere
 from rtpy.triangle import Triangle
 from rtpy.vec3 import Color, Vec3
 
+from .vectors import V
+
 GREY = Lambertian()
-
-
-def V(x, y, z) -> Vec3:
-    return Vec3(float(x), float(y), float(z))
 
 
 RAY = Ray(V(0, 0, 0), V(0, 0, -1))

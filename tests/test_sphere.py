@@ -16,26 +16,12 @@ from rtpy.interval import Interval
 from rtpy.materials import Lambertian
 from rtpy.ray import Ray
 from rtpy.sphere import Sphere
-from rtpy.vec3 import Vec3
+from rtpy.testing import chi2_sf
+
+from .vectors import V, dot3, norm3, sub3
 
 MAT = Lambertian()
 EVERYWHERE = Interval(0.0, math.inf)
-
-
-def V(x, y, z) -> Vec3:
-    return Vec3(float(x), float(y), float(z))
-
-
-def dot3(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def norm3(a) -> float:
-    return math.sqrt(dot3(a, a))
-
-
-def sub3(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 def textbook_roots(o, d, c, r):
@@ -482,17 +468,3 @@ def test_sample_point_uniform_on_sphere():
         zsum += nrm.e2
     # Archimedes: z of a uniform point on the sphere is uniform on [-1, 1].
     assert abs(zsum / n) < 4 * math.sqrt(1.0 / 3.0 / n)
-
-
-def chi2_sf(x: float, k: int) -> float:
-    """P(X > x) for a chi-square variable with k degrees of freedom:
-    Q(a + 1, y) = Q(a, y) + y^a e^-y / Gamma(a + 1), from Q(1/2) = erfc(sqrt y), Q(1) = e^-y."""
-    y = x / 2.0
-    if k % 2:
-        q, a = math.erfc(math.sqrt(y)), 0.5
-    else:
-        q, a = math.exp(-y), 1.0
-    while a < k / 2.0:
-        q += math.exp(a * math.log(y) - y - math.lgamma(a + 1.0)) if y > 0 else 0.0
-        a += 1.0
-    return q

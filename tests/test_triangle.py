@@ -13,31 +13,13 @@ from hypothesis import strategies as st
 from rtpy.interval import Interval
 from rtpy.materials import Lambertian
 from rtpy.ray import Ray
+from rtpy.testing import chi2_sf
 from rtpy.triangle import Triangle
-from rtpy.vec3 import Vec3
+
+from .vectors import ORIGINS, V, check_planar_hit, cross3, dot3, norm3, planar_samples, sub3
 
 MAT = Lambertian()
 EVERYWHERE = Interval(0.0, math.inf)
-
-
-def V(x, y, z) -> Vec3:
-    return Vec3(float(x), float(y), float(z))
-
-
-def cross3(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def dot3(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def norm3(a) -> float:
-    return math.sqrt(dot3(a, a))
-
-
-def sub3(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 def barycentric_bc(a, b, c, p):
@@ -47,20 +29,6 @@ def barycentric_bc(a, b, c, p):
     wb = dot3(cross3(sub3(p, a), sub3(c, a)), n) / nn  # area(a, p, c) / area(a, b, c)
     wc = dot3(cross3(sub3(b, a), sub3(p, a)), n) / nn  # area(a, b, p) / area(a, b, c)
     return wb, wc
-
-
-def chi2_sf(x: float, k: int) -> float:
-    """P(X > x) for a chi-square variable with k degrees of freedom:
-    Q(a + 1, y) = Q(a, y) + y^a e^-y / Gamma(a + 1), from Q(1/2) = erfc(sqrt y), Q(1) = e^-y."""
-    y = x / 2.0
-    if k % 2:
-        q, a = math.erfc(math.sqrt(y)), 0.5
-    else:
-        q, a = math.exp(-y), 1.0
-    while a < k / 2.0:
-        q += math.exp(a * math.log(y) - y - math.lgamma(a + 1.0)) if y > 0 else 0.0
-        a += 1.0
-    return q
 
 
 # Right triangle (0,0), (2,0), (0,2) in the plane z = 0; front face +z; exact arithmetic.
@@ -131,29 +99,12 @@ GENERAL = Triangle(V(*A0), V(*B0), V(*C0), MAT)
 
 
 @settings(deadline=None, max_examples=100)
-@given(
-    st.floats(0.0, 1.0),
-    st.floats(0.0, 1.0),
-    st.tuples(st.floats(-5, 5), st.floats(-5, 5), st.floats(-5, 5)),
-)
+@given(st.floats(0.0, 1.0), st.floats(0.0, 1.0), ORIGINS)
 def test_general_triangle_hit_has_barycentric_uv(s, t, origin):
     wb, wc = (s, t) if s + t <= 1.0 else (1.0 - s, 1.0 - t)
     target = tuple(A0[i] + wb * (B0[i] - A0[i]) + wc * (C0[i] - A0[i]) for i in range(3))
-    d = sub3(target, origin)
-    n = cross3(sub3(B0, A0), sub3(C0, A0))
-    if abs(dot3(d, n)) < 0.05 * norm3(d) * norm3(n):
-        return
-    h = GENERAL.intersect(Ray(V(*origin), V(*d)), EVERYWHERE)
     inside = wb > 1e-9 and wc > 1e-9 and wb + wc < 1 - 1e-9
-    if not inside and h is None:
-        return
-    assert h is not None
-    assert h.t == pytest.approx(1.0, rel=1e-9)
-    assert (h.u, h.v) == pytest.approx((wb, wc), abs=1e-9)
-    front = dot3(d, n) < 0.0
-    assert h.front_face is front
-    nn = tuple(x / norm3(n) for x in n)
-    assert h.normal.tolist() == pytest.approx([x if front else -x for x in nn], abs=1e-12)
+    check_planar_hit(GENERAL, origin, target, cross3(sub3(B0, A0), sub3(C0, A0)), (wb, wc), inside)
 
 
 @pytest.mark.parametrize("wb, wc", [(0.6, 0.6), (-0.05, 0.5), (0.5, -0.05), (1.2, -0.1)])
@@ -186,16 +137,10 @@ def test_area():
 
 def test_sample_point_is_uniform_over_the_triangle():
     """Chi-square over the 16 equal sub-triangles of a 4 x 4 barycentric subdivision."""
-    rng = random.Random(31337)
     n_samples = 16000
     counts: dict[tuple[int, int, bool], int] = {}
     n = cross3(sub3(B0, A0), sub3(C0, A0))
-    nn = tuple(x / norm3(n) for x in n)
-    for _ in range(n_samples):
-        p, normal = GENERAL.sample_point(rng.random(), rng.random())
-        assert max(abs(x - y) for x, y in zip(normal.tolist(), nn, strict=True)) < 1e-14
-        pt = p.tolist()
-        assert abs(dot3(sub3(pt, A0), nn)) < 1e-12
+    for pt in planar_samples(GENERAL, n_samples, 31337, A0, n):
         wb, wc = barycentric_bc(A0, B0, C0, pt)
         assert wb >= -1e-12 and wc >= -1e-12 and wb + wc <= 1 + 1e-12
         fb, fc = wb * 4, wc * 4

@@ -1,4 +1,5 @@
-"""Tests for rtpy.vec3: algebraic identities checked with hypothesis, reflect and refract."""
+"""Tests for rtpy.vec3: algebraic identities checked with hypothesis, reflect, refract and
+halfvector."""
 
 from __future__ import annotations
 
@@ -8,7 +9,18 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from rtpy.vec3 import BLACK, WHITE, Color, Vec3, cross, dot, reflect, refract, unit_vector
+from rtpy.vec3 import (
+    BLACK,
+    WHITE,
+    Color,
+    Vec3,
+    cross,
+    dot,
+    halfvector,
+    reflect,
+    refract,
+    unit_vector,
+)
 
 EPS = 2.220446049250313e-16
 
@@ -286,3 +298,27 @@ def test_refract_known_case_45_degrees():
     sin_t = s / 1.5
     expected = Vec3(sin_t, -math.sqrt(1.0 - sin_t * sin_t), 0.0)
     assert close_vec(out, expected, abs_tol=1e-14)
+
+
+@given(
+    st.floats(0.0, math.pi),
+    st.floats(0.0, 2 * math.pi),
+    st.floats(0.0, math.pi),
+    st.floats(0.0, 2 * math.pi),
+)
+def test_halfvector_is_the_unit_bisector(t1, p1, t2, p2):
+    view, light = random_unit(t1, p1), random_unit(t2, p2)
+    s = view + light
+    assume(norm(s) > 1e-6)
+    h = halfvector(view, light)
+    assert math.isclose(norm(h), 1.0, abs_tol=1e-12)
+    assert math.isclose(dot(h, view), dot(h, light), abs_tol=1e-12)  # equal angles
+    assert close_vec(cross(h, s), Vec3(), abs_tol=1e-12 * norm(s))  # along view + light
+    assert dot(h, s) > 0.0
+
+
+def test_halfvector_known_case_and_no_half_vector_for_opposite_directions():
+    h = halfvector(Vec3(1.0, 0.0, 0.0), Vec3(0.0, 1.0, 0.0))
+    assert comps(h) == pytest.approx((math.sqrt(0.5), math.sqrt(0.5), 0.0), abs=1e-15)
+    with pytest.raises(ZeroDivisionError):
+        halfvector(Vec3(0.0, 0.0, 1.0), Vec3(0.0, 0.0, -1.0))

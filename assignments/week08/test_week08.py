@@ -1,10 +1,12 @@
 # ruff: noqa: E501  (the assertion messages are prose for students)
-"""Week 08 graders: Phong, Blinn-Phong and Cook-Torrance BRDF() and scattering(), and
-the path integrator. Run them with `python -m rtpy grade 08`.
+"""Week 08 graders: the Phong, Blinn-Phong (the course's Blinn) and Cook-Torrance
+reflection models, each with its own BRDF(), pdf() and scattering(), the lobe samplers
+and helpers they call, and the path integrator. Run them with `python -m rtpy grade 08`.
 
-The sampling checks are rtpy.testing's (chi-square test of scattering() against
-pdf(), weight = BRDF * cos / pdf, energy, reciprocity) with fewer samples than
-rtpy's own tests, so grading stays fast; each is Sidak-corrected over its cases.
+Each test names the method it checks and the likely mistake when it fails. The
+sampling checks are rtpy.testing's (chi-square test of scattering() against pdf(),
+weight = BRDF * cos / pdf, energy, reciprocity) with fewer samples than rtpy's own
+tests, so grading stays fast; each is Sidak-corrected over its cases.
 """
 
 import math
@@ -13,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import rtpy.materials.phong as phong
 import rtpy.testing as rt
 from rtpy import Camera, Color, Lambertian, Quad, Scene, Sphere, Vec3
 from rtpy.grading import assert_render_matches, load_reference, points, render_stack, summarize
@@ -20,6 +23,7 @@ from rtpy.materials import BlinnPhong, CookTorrance, DiffuseLight, Phong
 
 HERE = Path(__file__).parent
 ALBEDO = Color(0.5, 0.4, 0.3)
+Z = Vec3(0.0, 0.0, 1.0)
 
 MODELS = {
     "phong": lambda: Phong(ALBEDO, kd=0.5, ks=0.4, exponent=20.0),
@@ -29,13 +33,25 @@ MODELS = {
         ALBEDO, kd=0.5, ks=0.5, roughness=0.3, distribution="beckmann"
     ),
 }
-WHERE = {
-    "phong": "Phong (rtpy/materials/phong.py)",
-    "blinn_phong": "BlinnPhong (rtpy/materials/blinn_phong.py)",
-    "cook_torrance_ggx": "CookTorrance with GGX (rtpy/materials/cook_torrance.py)",
-    "cook_torrance_beckmann": "CookTorrance with Beckmann (rtpy/materials/cook_torrance.py)",
+CLASS = {
+    "phong": "Phong",
+    "blinn_phong": "BlinnPhong",
+    "cook_torrance_ggx": "CookTorrance",
+    "cook_torrance_beckmann": "CookTorrance",
+}
+FILE = {
+    "phong": "rtpy/materials/phong.py",
+    "blinn_phong": "rtpy/materials/blinn_phong.py",
+    "cook_torrance_ggx": "rtpy/materials/cook_torrance.py",
+    "cook_torrance_beckmann": "rtpy/materials/cook_torrance.py",
 }
 ANGLES = (20.0, 70.0)
+
+
+def where(name, method):
+    """Class.method (file), with the distribution for Cook-Torrance."""
+    extra = {"cook_torrance_ggx": " with GGX", "cook_torrance_beckmann": " with Beckmann"}
+    return f"{CLASS[name]}.{method}{extra.get(name, '')} ({FILE[name]})"
 
 
 def random_pairs(n, seed):
@@ -53,77 +69,223 @@ def random_pairs(n, seed):
     return out
 
 
+def rays(wo, wi):
+    return rt.view_ray(Vec3(*wo)), rt.light_ray(Vec3(*wi))
+
+
 def brdf(material, wo, wi):
-    hit = rt.local_hit(material)
-    return np.array(list(material.BRDF(rt.view_ray(Vec3(*wo)), rt.light_ray(Vec3(*wi)), hit)))
+    return np.array(list(material.BRDF(*rays(wo, wi), rt.local_hit(material))))
 
 
-def lobe_check(name, formula):
+def pdf(material, wo, wi):
+    return material.pdf(*rays(wo, wi), rt.local_hit(material))
+
+
+def unit_half(wo, wi):
+    return (wo + wi) / np.linalg.norm(wo + wi)
+
+
+def mirror(wo):
+    """wo mirrored about the normal (0, 0, 1)."""
+    return np.array([-wo[0], -wo[1], wo[2]])
+
+
+# --- the lobes of the BRDFs ------------------------------------------------------------
+
+
+def phong_lobe(m, wo, wi):
+    r = mirror(wi)  # reflect(-wi, normal)
+    return (m.exponent + 2) / (2 * math.pi) * max(0.0, r @ wo) ** m.exponent
+
+
+def blinn_lobe(m, wo, wi):
+    h = unit_half(wo, wi)
+    return (m.exponent + 8) / (8 * math.pi) * max(0.0, h[2]) ** m.exponent
+
+
+def tan2(v):
+    return (1 - v[2] ** 2) / v[2] ** 2
+
+
+def ct_D(m, h):
+    a2 = m.alpha**2
+    if m.distribution == "ggx":
+        return a2 / (math.pi * h[2] ** 4 * (a2 + tan2(h)) ** 2)
+    return math.exp(-tan2(h) / a2) / (math.pi * a2 * h[2] ** 4)
+
+
+def ct_G1(m, v):
+    a2 = m.alpha**2
+    if m.distribution == "ggx":
+        return 2 / (1 + math.sqrt(1 + a2 * tan2(v)))
+    a = 1 / (m.alpha * math.sqrt(tan2(v)))
+    lam = (math.erf(a) - 1) / 2 + math.exp(-a * a) / (2 * a * math.sqrt(math.pi))
+    return 1 / (1 + lam)
+
+
+def ct_lobe(m, wo, wi):
+    h = unit_half(wo, wi)
+    f0 = np.array(list(m.f0))
+    f = f0 + (1 - f0) * (1 - wo @ h) ** 5
+    return ct_D(m, h) * ct_G1(m, wo) * ct_G1(m, wi) * f / (4 * wo[2] * wi[2])
+
+
+LOBES = {
+    "phong": phong_lobe,
+    "blinn_phong": blinn_lobe,
+    "cook_torrance_ggx": ct_lobe,
+    "cook_torrance_beckmann": ct_lobe,
+}
+
+
+def lobe_check(name, mistakes):
     material = MODELS[name]()
     for wo, wi in random_pairs(60, seed=8):
-        expected = material.kd * np.array(list(ALBEDO)) / math.pi + material.ks * formula(
+        expected = material.kd * np.array(list(ALBEDO)) / math.pi + material.ks * LOBES[name](
             material, wo, wi
         )
         got = brdf(material, wo, wi)
         assert np.allclose(got, expected, rtol=1e-6, atol=1e-12), (
-            f"{WHERE[name]}: BRDF(wo={wo.round(3)}, wi={wi.round(3)}) = {got.round(6)}, expected "
-            f"{expected.round(6)} (kd * albedo / pi + ks * the specular lobe)"
+            f"{where(name, 'BRDF')}: BRDF(wo={wo.round(3)}, wi={wi.round(3)}) = {got.round(6)}, "
+            f"expected {expected.round(6)} = kd * albedo / pi + ks * the highlight. {mistakes}"
         )
 
 
 @points(2)
 def test_phong_brdf():
-    """Phong BRDF: (n + 2) / (2 pi) max(0, r . wo)^n"""
-
-    def phong(m, wo, wi):
-        r = np.array([-wi[0], -wi[1], wi[2]])  # reflect wi about the normal
-        return (m.exponent + 2) / (2 * math.pi) * max(0.0, r @ wo) ** m.exponent
-
-    lobe_check("phong", phong)
+    """Phong.BRDF: kd albedo / pi + ks (n + 2) / (2 pi) max(0, r . wo)^n"""
+    lobe_check(
+        "phong",
+        "Check r = reflect(-wi, normal) (wi points away from the surface, reflect wants "
+        "the direction toward it), the normalisation (n + 2) / (2 pi) and the 1 / pi of "
+        "the diffuse part.",
+    )
 
 
 @points(2)
 def test_blinn_phong_brdf():
-    """Blinn-Phong BRDF: (n + 8) / (8 pi) (n . h)^n with the unit half vector"""
-
-    def blinn(m, wo, wi):
-        h = (wo + wi) / np.linalg.norm(wo + wi)
-        return (m.exponent + 8) / (8 * math.pi) * max(0.0, h[2]) ** m.exponent
-
-    lobe_check("blinn_phong", blinn)
-
-
-def ct_formula(m, wo, wi):
-    h = (wo + wi) / np.linalg.norm(wo + wi)
-    a2 = m.alpha**2
-
-    def tan2(v):
-        return (1 - v[2] ** 2) / v[2] ** 2
-
-    if m.distribution == "ggx":
-        d = a2 / (math.pi * h[2] ** 4 * (a2 + tan2(h)) ** 2)
-
-        def g1(v):
-            return 2 / (1 + math.sqrt(1 + a2 * tan2(v)))
-
-    else:
-        d = math.exp(-tan2(h) / a2) / (math.pi * a2 * h[2] ** 4)
-
-        def g1(v):
-            a = 1 / (m.alpha * math.sqrt(tan2(v)))
-            lam = (math.erf(a) - 1) / 2 + math.exp(-a * a) / (2 * a * math.sqrt(math.pi))
-            return 1 / (1 + lam)
-
-    f0 = np.array(list(m.f0))
-    f = f0 + (1 - f0) * (1 - wo @ h) ** 5
-    return d * g1(wo) * g1(wi) * f / (4 * wo[2] * wi[2])
+    """BlinnPhong.BRDF: kd albedo / pi + ks (n + 8) / (8 pi) (normal . h)^n"""
+    lobe_check(
+        "blinn_phong",
+        "Check that h is the unit half vector halfvector(wo, wi) with wo = -ray_view.direction, "
+        "and the normalisation (n + 8) / (8 pi).",
+    )
 
 
 @points(3)
 @pytest.mark.parametrize("name", ["cook_torrance_ggx", "cook_torrance_beckmann"])
 def test_cook_torrance_brdf(name):
-    """Cook-Torrance BRDF: D G F / (4 cos_i cos_o)"""
-    lobe_check(name, ct_formula)
+    """CookTorrance.BRDF: kd albedo / pi + ks D G F / (4 cos_i cos_o)"""
+    lobe_check(
+        name,
+        "Check D(h) at the unit half vector, G = G1(wi) G1(wo), F = schlick_fresnel(f0, "
+        "wo . h) and the 4 cos_i cos_o below.",
+    )
+
+
+PDF_MISTAKES = {
+    "phong": "the highlight's density is (n + 1) / (2 pi) max(0, m . wi)^n around the mirror "
+    "direction m = reflect(ray_view.direction, normal) (not around the normal, and (n + 1), "
+    "not the BRDF's (n + 2))",
+    "blinn_phong": "the highlight's density is the half vector's, (n + 1) / (2 pi) "
+    "(normal . h)^n, times the Jacobian 1 / (4 wo . h) of the reflection about h",
+    "cook_torrance_ggx": "the highlight's density is D(h) cos(theta_h) / (4 wo . h): the "
+    "half vector's density D cos and the Jacobian of the reflection",
+}
+PDF_MISTAKES["cook_torrance_beckmann"] = PDF_MISTAKES["cook_torrance_ggx"]
+
+
+def highlight_pdf(name, m, wo, wi):
+    if name == "phong":
+        return (m.exponent + 1) / (2 * math.pi) * max(0.0, mirror(wo) @ wi) ** m.exponent
+    h = unit_half(wo, wi)
+    if name == "blinn_phong":
+        return (m.exponent + 1) / (2 * math.pi) * h[2] ** m.exponent / (4 * (wo @ h))
+    return ct_D(m, h) * h[2] / (4 * (wo @ h))
+
+
+@points(2)
+@pytest.mark.parametrize("name", list(MODELS))
+def test_pdf(name):
+    """pdf() = p_d cos / pi + (1 - p_d) (the highlight's density)"""
+    material = MODELS[name]()
+    diffuse = material.kd * max(ALBEDO)
+    p_d = diffuse / (diffuse + material.ks)
+    for wo, wi in random_pairs(60, seed=9):
+        expected = p_d * wi[2] / math.pi + (1 - p_d) * highlight_pdf(name, material, wo, wi)
+        got = pdf(material, wo, wi)
+        assert math.isclose(got, expected, rel_tol=1e-6, abs_tol=1e-12), (
+            f"{where(name, 'pdf')}(wo={wo.round(3)}, wi={wi.round(3)}) = {got:.6g}, expected "
+            f"{expected:.6g}: the mixture p_d cos(theta_i) / pi + (1 - p_d) (the highlight's "
+            f"density), p_d = kd max(albedo) / (kd max(albedo) + ks) = {p_d:.4g} "
+            f"(mixture_pdf in rtpy/materials/glossy.py); {PDF_MISTAKES[name]}"
+        )
+
+
+@points(2)
+def test_cosine_power_sampler():
+    """sample_cosine_power and cosine_power_pdf: density (n + 1) / (2 pi) cos^n"""
+    for n in (0.0, 1.0, 8.0, 100.0):
+        for r1, r2 in ((0.1, 0.3), (0.5, 0.8), (0.9, 0.05)):
+            d = np.array(list(phong.sample_cosine_power(n, r1, r2)))
+            cos = r1 ** (1 / (n + 1))
+            s = math.sqrt(1 - cos * cos)
+            expected = np.array(
+                [s * math.cos(2 * math.pi * r2), s * math.sin(2 * math.pi * r2), cos]
+            )
+            assert np.allclose(d, expected, atol=1e-9), (
+                f"sample_cosine_power (rtpy/materials/phong.py)(n={n}, r1={r1}, r2={r2}) = "
+                f"{d.round(6)}, expected {expected.round(6)}: the inverse of the CDF "
+                "1 - cos^(n+1) is cos(theta) = r1^(1 / (n + 1)), the azimuth 2 pi r2, z the axis"
+            )
+        for cos in (0.2, 0.7, 1.0):
+            expected = (n + 1) / (2 * math.pi) * cos**n
+            assert math.isclose(phong.cosine_power_pdf(n, cos), expected, rel_tol=1e-9), (
+                f"cosine_power_pdf (rtpy/materials/phong.py)(n={n}, cos={cos}) = "
+                f"{phong.cosine_power_pdf(n, cos):.6g}, expected (n + 1) / (2 pi) cos^n = {expected:.6g}"
+            )
+        assert phong.cosine_power_pdf(n, -0.3) == 0.0, (
+            "cosine_power_pdf (rtpy/materials/phong.py): 0 behind the axis (cos <= 0)"
+        )
+
+
+@points(3)
+@pytest.mark.parametrize("distribution", ["ggx", "beckmann"])
+def test_cook_torrance_factors(distribution):
+    """CookTorrance.D, G1, F and sample_half_vector"""
+    m = CookTorrance(ALBEDO, kd=0.0, ks=1.0, roughness=0.3, distribution=distribution)
+    name = f"cook_torrance_{distribution}"
+    for t in (0.0, 0.3, 0.8, 1.3):
+        v = np.array([math.sin(t), 0.0, math.cos(t)])
+        got, expected = m.D(Z, Vec3(*v)), ct_D(m, v)
+        assert math.isclose(got, expected, rel_tol=1e-6), (
+            f"{where(name, 'D')}: D(h at {t} rad from the normal) = {got:.6g}, expected "
+            f"{expected:.6g} (normalised: the integral of D cos over the hemisphere is 1)"
+        )
+        got, expected = m.G1(Z, Vec3(*v)), 1.0 if t == 0.0 else ct_G1(m, v)
+        assert math.isclose(got, expected, rel_tol=1e-6), (
+            f"{where(name, 'G1')}: G1(v at {t} rad from the normal) = {got:.6g}, expected "
+            f"Smith's {expected:.6g} (1 at the normal, falling to 0 at grazing)"
+        )
+    for cos in (1.0, 0.5, 0.0):
+        got = m.F(cos).e0
+        expected = m.f0.e0 + (1 - m.f0.e0) * (1 - cos) ** 5
+        assert math.isclose(got, expected, rel_tol=1e-9), (
+            f"schlick_fresnel (rtpy/materials/cook_torrance.py) at cos {cos} = {got:.6g}, "
+            f"expected F0 + (1 - F0) (1 - cos)^5 = {expected:.6g}"
+        )
+    for r1 in (0.1, 0.5, 0.9):
+        h = np.array(list(m.sample_half_vector(r1, 0.3)))
+        cdf = tan2(h) / (m.alpha**2 + tan2(h))
+        if distribution == "beckmann":
+            cdf = 1 - math.exp(-tan2(h) / m.alpha**2)
+        assert math.isclose(np.linalg.norm(h), 1.0, rel_tol=1e-9) and math.isclose(
+            cdf, r1, rel_tol=1e-6
+        ), (
+            f"{where(name, 'sample_half_vector')}({r1}, 0.3) = {h.round(6)}: its angle to the "
+            f"normal should put the CDF of D cos at r1 = {r1} (got {cdf:.6g}); invert it for "
+            "tan^2(theta_h)"
+        )
 
 
 @points(3)
@@ -135,7 +297,7 @@ def test_sampling_follows_pdf(name):
     for theta in ANGLES:
         result = rt.chi2_test(material, theta, n_samples=10_000, theta_bins=8, phi_bins=16, seed=8)
         assert result.passed(alpha), (
-            f"{WHERE[name]}.scattering at {theta} degrees draws directions that do not follow "
+            f"{where(name, 'scattering')} at {theta} degrees draws directions that do not follow "
             f"pdf() (p = {result.p_value:.2g}): {result.summary()}. Check the lobe sampling and "
             "its density (a half-vector density needs the Jacobian 1 / (4 wo . h))"
         )
@@ -149,8 +311,9 @@ def test_weight_is_brdf_cos_over_pdf(name):
     for theta in ANGLES:
         result = rt.check_weights(material, theta, n=200, seed=8)
         assert result.passed, (
-            f"{WHERE[name]}.scattering at {theta} degrees: the attenuation must be "
-            f"BRDF * cos(theta_i) / pdf of the lobe mixture: {result.detail}"
+            f"{where(name, 'scattering')} at {theta} degrees: the attenuation must be "
+            "BRDF * cos(theta_i) / pdf of the lobe mixture (weighted_sample in "
+            f"rtpy/materials/glossy.py): {result.detail}"
         )
 
 
@@ -160,10 +323,10 @@ def test_energy_and_reciprocity(name):
     """albedo <= 1 and BRDF(wo, wi) = BRDF(wi, wo)"""
     material = MODELS[name]()
     result = rt.check_reciprocity(material, n_pairs=200, seed=8)
-    assert result.passed, f"{WHERE[name]}.BRDF is not reciprocal: {result.detail}"
+    assert result.passed, f"{where(name, 'BRDF')} is not reciprocal: {result.detail}"
     for theta in ANGLES:
         result = rt.check_energy(material, theta, n_samples=10_000, seed=8)
-        assert result.passed, f"{WHERE[name]} at {theta} degrees: {result.detail}"
+        assert result.passed, f"{where(name, 'BRDF')} at {theta} degrees: {result.detail}"
 
 
 def three_balls():

@@ -19,7 +19,7 @@ from ..light import Light
 from ..ray import Ray, offset_scale, spawn_ray
 from ..sampling import power_heuristic, random_double
 from ..scene import Scene
-from ..vec3 import BLACK, Color
+from ..vec3 import BLACK, Color, dot
 from .integrator import FORWARD
 
 
@@ -37,7 +37,7 @@ def sample_one_light(
     if sample is None or sample.radiance.is_black():
         return BLACK
     normal, wi = hit.normal, sample.direction
-    cos_i = normal.e0 * wi.e0 + normal.e1 * wi.e1 + normal.e2 * wi.e2
+    cos_i = dot(normal, wi)
     if cos_i <= 0.0:
         return BLACK  # the light is behind the surface
     shadow_ray = spawn_ray(hit.point, normal, wi)

@@ -14,9 +14,14 @@
 |                 |              | distribution ("ggx"; or "beckmann"), ior (1.5), f0 (from ior) |
 | "ward"          | Ward         | albedo ([0.5, 0.5, 0.5]), kd (1), ks (0), alpha_x (0.2), |
 |                 |              | alpha_y (= alpha_x)                            |
+
+Blinn is BlinnPhong under the course's name. The course's module functions of
+RT_material.py are here too, each defined once: reflect, refract and halfvector
+(rtpy/vec3.py) and schlick (rtpy/materials/dielectric.py).
 """
 
-from .blinn_phong import BlinnPhong
+from ..vec3 import halfvector, reflect, refract
+from .blinn_phong import Blinn, BlinnPhong
 from .cook_torrance import CookTorrance
 from .dielectric import Dielectric, schlick
 from .diffuse_light import DiffuseLight
@@ -55,6 +60,7 @@ def register_material(name: str):
 
 __all__ = [
     "MATERIALS",
+    "Blinn",
     "BlinnPhong",
     "CookTorrance",
     "Dielectric",
@@ -66,6 +72,9 @@ __all__ = [
     "OrenNayar",
     "Phong",
     "Ward",
+    "halfvector",
+    "reflect",
+    "refract",
     "register_material",
     "schlick",
 ]

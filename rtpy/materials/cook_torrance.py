@@ -3,7 +3,7 @@
     f_r(wi, wo) = kd * albedo / pi
                 + ks * D(h) * G(wi, wo) * F(wo . h) / (4 (n . wi) (n . wo))
 
-with h = normalize(wi + wo), the half vector. The surface is modelled as a
+with h = halfvector(wo, wi) = normalize(wo + wi), the half vector. The surface is modelled as a
 landscape of tiny perfect mirrors (microfacets); light goes from wi to wo only
 via the facets whose normal is h. The three factors say
 
@@ -37,10 +37,11 @@ Graphics"); D and G are the modern ones of Walter et al. 2007. Only single
 scattering is modelled, so very rough surfaces lose some energy (they look a
 little darker than they should); they never gain energy.
 
-Sampling draws the half vector from D(h) cos(theta_h), which is a probability
-density over the hemisphere of h precisely because of D's normalisation, and
-reflects wo about it. (Sampling only the facets visible from wo, Heitz 2018,
-wastes fewer samples at grazing angles; D cos is the simpler textbook method.)
+Sampling (see rtpy.materials.glossy for the diffuse + highlight mixture) draws the
+half vector from D(h) cos(theta_h), which is a probability density over the
+hemisphere of h precisely because of D's normalisation, and reflects wo about it.
+(Sampling only the facets visible from wo, Heitz 2018, wastes fewer samples at
+grazing angles; D cos is the simpler textbook method.)
 """
 
 from __future__ import annotations
@@ -48,11 +49,16 @@ from __future__ import annotations
 import math
 from typing import Literal
 
+from ..hit_info import HitInfo
+from ..onb import ONB
+from ..ray import Ray
+from ..sampling import generator, random_cosine_direction
+from ..scatter_info import ScatterInfo
 from ..texture import Texture
-from ..vec3 import Color
-from .glossy import GlossyMaterial, Local
+from ..vec3 import BLACK, WHITE, Color, Vec3, cross, dot, halfvector, reflect
+from .glossy import INV_PI, diffuse_probability, mixture_pdf, reflected_density, weighted_sample
+from .material import Material, as_texture, check_strengths
 
-INV_PI = 1.0 / math.pi
 INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
 
 DISTRIBUTIONS = ("ggx", "beckmann")
@@ -66,9 +72,8 @@ MIN_ALPHA = 1e-4
 def schlick_fresnel(f0: Color, cosine: float) -> Color:
     """Schlick's Fresnel reflectance F0 + (1 - F0) (1 - cos)^5, per colour channel."""
     # BEGIN SOLUTION week08: Schlick's F per colour channel
-    c = min(1.0, max(0.0, cosine))
-    m = (1.0 - c) ** 5
-    return Color(f0.e0 + (1.0 - f0.e0) * m, f0.e1 + (1.0 - f0.e1) * m, f0.e2 + (1.0 - f0.e2) * m)
+    m = (1.0 - min(1.0, max(0.0, cosine))) ** 5
+    return f0 + (WHITE - f0) * m
     # END SOLUTION
 
 
@@ -78,7 +83,7 @@ def f0_from_ior(ior: float) -> float:
     return r * r
 
 
-class CookTorrance(GlossyMaterial):
+class CookTorrance(Material):
     """Diffuse plus a Cook-Torrance microfacet highlight.
 
     albedo        colour (or texture) of the diffuse part
@@ -109,7 +114,8 @@ class CookTorrance(GlossyMaterial):
         ior: float = 1.5,
         f0: Color | None = None,
     ) -> None:
-        super().__init__(albedo, kd, ks)
+        self.albedo = as_texture(albedo)
+        self.kd, self.ks = check_strengths(kd, ks)
         if not (isinstance(roughness, int | float) and 0.0 < roughness <= MAX_ROUGHNESS):
             raise ValueError(
                 f"roughness must be a number in (0, {MAX_ROUGHNESS:g}], got {roughness!r}"
@@ -135,18 +141,19 @@ class CookTorrance(GlossyMaterial):
         self.f0 = f0
 
     # --- the three factors ----------------------------------------------------------
-    # Directions are local (z = normal). tan^2(theta) = sin^2 / cos^2 is written with
-    # sin^2 = x^2 + y^2, which keeps its precision near the normal, and the formulas
-    # are rearranged so that no cosine is ever divided by: they stay finite at
-    # grazing angles (where tan is infinite) and for tiny widths.
+    # tan^2(theta) = sin^2 / cos^2 is written with sin^2 = |normal x v|^2, which keeps
+    # its precision near the normal (1 - cos^2 would not), and the formulas are
+    # rearranged so that no cosine is ever divided by: they stay finite at grazing
+    # angles (where tan is infinite) and for tiny widths.
 
-    def D(self, h: Local) -> float:
+    def D(self, normal: Vec3, h: Vec3) -> float:
         """Microfacet density along the unit half vector h (0 below the surface)."""
         # BEGIN SOLUTION week08: GGX and Beckmann normal distributions
-        cos2 = h[2] * h[2]
-        if h[2] <= 0.0 or cos2 == 0.0:
+        cos = dot(normal, h)
+        cos2 = cos * cos
+        if cos <= 0.0 or cos2 == 0.0:
             return 0.0
-        sin2 = h[0] * h[0] + h[1] * h[1]
+        sin2 = cross(normal, h).length_squared()
         a2 = self.alpha * self.alpha
         if self.distribution == "ggx":
             # alpha^2 / (pi cos^4 (alpha^2 + tan^2)^2), multiplied out by cos^4:
@@ -161,13 +168,13 @@ class CookTorrance(GlossyMaterial):
         return math.exp(-exponent) / (math.pi * a2 * cos2 * cos2)
         # END SOLUTION
 
-    def G1(self, v: Local) -> float:
+    def G1(self, normal: Vec3, v: Vec3) -> float:
         """Smith's masking of the unit direction v (1 at the normal, 0 at grazing)."""
         # BEGIN SOLUTION week08: Smith masking G1 for GGX and Beckmann
-        cos = v[2]
+        cos = dot(normal, v)
         if cos <= 0.0:
             return 0.0
-        sin2 = v[0] * v[0] + v[1] * v[1]
+        sin2 = cross(normal, v).length_squared()
         if sin2 == 0.0:
             return 1.0
         a2 = self.alpha * self.alpha
@@ -182,33 +189,13 @@ class CookTorrance(GlossyMaterial):
         return 1.0 / (1.0 + max(0.0, lam))
         # END SOLUTION
 
-    def G(self, wo: Local, wi: Local) -> float:
-        """Shadowing-masking: the separable Smith product G1(wi) G1(wo)."""
-        return self.G1(wi) * self.G1(wo)
-
     def F(self, cosine: float) -> Color:
         """Fresnel reflectance of a facet seen at incidence cosine wo . h."""
         return schlick_fresnel(self.f0, cosine)
 
-    # --- the lobe, its sampling and its density -------------------------------------
-    def specular(self, wo: Local, wi: Local) -> Color:
-        # BEGIN SOLUTION week08: D G F / (4 cos_i cos_o)
-        cos_o, cos_i = wo[2], wi[2]
-        if cos_o <= 0.0 or cos_i <= 0.0:
-            return Color(0.0, 0.0, 0.0)
-        h = _half_vector(wo, wi)
-        if h is None:
-            return Color(0.0, 0.0, 0.0)
-        wo_h = wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2]
-        # D G F / (4 cos_i cos_o), with each G1 divided by its own cosine: G1 vanishes
-        # like its cosine at grazing angles, so each ratio stays finite (at most
-        # about 2 / alpha) even where the product cos_i cos_o would underflow to 0.
-        visibility = (self.G1(wi) / cos_i) * (self.G1(wo) / cos_o) * 0.25
-        return self.F(wo_h) * (self.D(h) * visibility)
-        # END SOLUTION
-
-    def sample_half_vector(self, r1: float, r2: float) -> Local:
-        """A half vector with density D(h) cos(theta_h), from two uniform numbers in [0, 1).
+    def sample_half_vector(self, r1: float, r2: float) -> Vec3:
+        """A half vector with density D(h) cos(theta_h), from two uniform numbers in
+        [0, 1), as local coordinates (x, y, z) around the normal (z).
 
         Inverting the cumulative distribution of theta_h gives
             GGX:      tan^2(theta_h) = alpha^2 r1 / (1 - r1)
@@ -224,35 +211,55 @@ class CookTorrance(GlossyMaterial):
         cos = 1.0 / math.sqrt(1.0 + tan2)
         sin = math.sqrt(tan2) * cos
         phi = 2.0 * math.pi * r2
-        return sin * math.cos(phi), sin * math.sin(phi), cos
+        return Vec3(sin * math.cos(phi), sin * math.sin(phi), cos)
         # END SOLUTION
 
-    def sample_specular(self, wo: Local, r1: float, r2: float) -> Local | None:
-        hx, hy, hz = self.sample_half_vector(r1, r2)
-        wo_h = wo[0] * hx + wo[1] * hy + wo[2] * hz
-        if wo_h <= 0.0:
-            return None  # a facet turned away from the viewer reflects nothing toward it
-        k = 2.0 * wo_h
-        return k * hx - wo[0], k * hy - wo[1], k * hz - wo[2]
-
-    def specular_pdf(self, wo: Local, wi: Local) -> float:
-        """D(h) cos(theta_h) / (4 (wo . h)): the half vector's density times the
-        Jacobian d(w_h) / d(w_i) = 1 / (4 (wo . h)) of the reflection wi = reflect(wo, h)."""
-        # BEGIN SOLUTION week08: D(h) cos(theta_h) / (4 wo . h)
-        h = _half_vector(wo, wi)
-        if h is None:
-            return 0.0
-        wo_h = wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2]
-        if wo_h <= 0.0:
-            return 0.0
-        return self.D(h) * h[2] / (4.0 * wo_h)
+    # --- BRDF, density and sampling -------------------------------------------------
+    def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
+        """kd * albedo / pi + ks * D(h) G(wi, wo) F(wo . h) / (4 cos_i cos_o), with
+        G = G1(wi) G1(wo); black unless wo and wi both lie above the surface."""
+        # BEGIN SOLUTION week08: diffuse plus D G F / (4 cos_i cos_o)
+        normal, wo, wi = hit.normal, -ray_view.direction, ray_light.direction
+        cos_o, cos_i = dot(normal, wo), dot(normal, wi)
+        if cos_o <= 0.0 or cos_i <= 0.0:
+            return BLACK  # reflection only: both directions above the surface
+        f = self.albedo.value(hit) * (self.kd * INV_PI)
+        if self.ks > 0.0:
+            h = halfvector(wo, wi)
+            # Each G1 divided by its own cosine: G1 vanishes like its cosine at grazing
+            # angles, so each ratio stays finite (at most about 2 / alpha) even where the
+            # product cos_i cos_o would underflow to 0.
+            visibility = (self.G1(normal, wi) / cos_i) * (self.G1(normal, wo) / cos_o) * 0.25
+            f = f + self.F(dot(wo, h)) * (self.ks * self.D(normal, h) * visibility)
+        return f
         # END SOLUTION
 
+    def pdf(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> float:
+        """Density of scattering() choosing ray_light's direction: the mixture of
+        cos(theta_i) / pi and D(h) cos(theta_h) / (4 (wo . h)), the half vector's
+        density times the Jacobian d(w_h) / d(w_i) = 1 / (4 (wo . h)) of the
+        reflection wi = reflect(-wo, h); 0 unless wo and wi lie above the surface."""
+        # BEGIN SOLUTION week08: the mixture's density; D(h) cos(theta_h) / (4 wo . h)
+        normal, wo, wi = hit.normal, -ray_view.direction, ray_light.direction
+        cos_i = dot(normal, wi)
+        if dot(normal, wo) <= 0.0 or cos_i <= 0.0:
+            return 0.0
+        h = halfvector(wo, wi)
+        density_h = self.D(normal, h) * dot(normal, h)  # D(h) cos(theta_h), the half vector's
+        highlight = reflected_density(density_h, wo, h)
+        return mixture_pdf(diffuse_probability(self, hit), cos_i, highlight)
+        # END SOLUTION
 
-def _half_vector(wo: Local, wi: Local) -> Local | None:
-    """normalize(wo + wi), or None when wi = -wo."""
-    x, y, z = wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]
-    length = math.sqrt(x * x + y * y + z * z)
-    if length == 0.0:
-        return None
-    return x / length, y / length, z / length
+    def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
+        """The diffuse lobe with probability p_d, else wo reflected about a half
+        vector drawn from D(h) cos(theta_h); weight BRDF * cos / pdf."""
+        # BEGIN SOLUTION week08: pick a lobe; the highlight reflects wo about a facet normal
+        r = generator().random
+        if r() < diffuse_probability(self, hit):
+            wi = ONB(hit.normal).to_world(random_cosine_direction())
+        else:
+            h = ONB(hit.normal).to_world(self.sample_half_vector(r(), r()))
+            # A facet turned away from the viewer reflects wo below the surface (absorbed).
+            wi = reflect(ray_in.direction, h)
+        return weighted_sample(self, ray_in, hit, wi)
+        # END SOLUTION

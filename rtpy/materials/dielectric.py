@@ -9,7 +9,7 @@ from ..ray import Ray, spawn_ray
 from ..sampling import random_double
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
-from ..vec3 import Color, reflect, refract
+from ..vec3 import Color, dot, reflect, refract
 from .material import Material, as_texture
 
 
@@ -45,7 +45,7 @@ class Dielectric(Material):
         # BEGIN SOLUTION week06: (R, reflected ray, refracted ray or None under TIR)
         ratio = 1.0 / self.ior if hit.front_face else self.ior  # eta_incident / eta_transmitted
         d, n = ray_in.direction, hit.normal
-        cos_theta = min(-(d.e0 * n.e0 + d.e1 * n.e1 + d.e2 * n.e2), 1.0)
+        cos_theta = min(-dot(d, n), 1.0)
         sin_theta = math.sqrt(max(0.0, 1.0 - cos_theta * cos_theta))
         reflected = spawn_ray(hit.point, n, reflect(d, n))
         if ratio * sin_theta > 1.0:

@@ -5,12 +5,12 @@ from __future__ import annotations
 import math
 
 from ..hit_info import HitInfo
-from ..onb import local_to_world
+from ..onb import ONB
 from ..ray import Ray, spawn_ray
 from ..sampling import random_cosine_direction
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
-from ..vec3 import BLACK, Color
+from ..vec3 import BLACK, Color, dot
 from .material import Material, as_texture
 
 INV_PI = 1.0 / math.pi
@@ -28,21 +28,20 @@ class Lambertian(Material):
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
         # BEGIN SOLUTION week05: cosine-weighted direction, weight = BRDF * cos / pdf
-        x, y, z = random_cosine_direction()
-        direction = local_to_world(hit.normal, x, y, z)
+        local = random_cosine_direction()  # z = cos(theta) from the normal
+        direction = ONB(hit.normal).to_world(local)
+        # BRDF * cos / pdf = (albedo / pi) * cos / (cos / pi) = albedo
         return ScatterInfo(
-            spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), z * INV_PI
+            spawn_ray(hit.point, hit.normal, direction), self.albedo.value(hit), local.z() * INV_PI
         )
         # END SOLUTION
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
         # BEGIN SOLUTION week05: f_r = albedo / pi above the surface
-        n, wi = hit.normal, ray_light.direction
-        if n.e0 * wi.e0 + n.e1 * wi.e1 + n.e2 * wi.e2 <= 0.0:
+        if dot(hit.normal, ray_light.direction) <= 0.0:
             return BLACK  # light below the surface
         return self.albedo.value(hit) * INV_PI
         # END SOLUTION
 
     def pdf(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> float:
-        n, wi = hit.normal, ray_light.direction
-        return max(0.0, n.e0 * wi.e0 + n.e1 * wi.e1 + n.e2 * wi.e2) * INV_PI
+        return max(0.0, dot(hit.normal, ray_light.direction)) * INV_PI

@@ -22,6 +22,8 @@ scattering() returns and never sample lights at them.
 
 from __future__ import annotations
 
+import math
+
 from ..hit_info import HitInfo
 from ..ray import Ray
 from ..scatter_info import ScatterInfo
@@ -31,6 +33,14 @@ from ..vec3 import BLACK, WHITE, Color
 
 def as_texture(albedo: Color | Texture) -> Texture:
     return albedo if isinstance(albedo, Texture) else SolidColor(albedo)
+
+
+def check_strengths(kd: float, ks: float) -> tuple[float, float]:
+    """(kd, ks) as floats, or ValueError unless both are finite numbers >= 0."""
+    for name, value in (("kd", kd), ("ks", ks)):
+        if not (isinstance(value, int | float) and value >= 0.0 and math.isfinite(value)):
+            raise ValueError(f"{name} must be a finite number >= 0, got {value}")
+    return float(kd), float(ks)
 
 
 class Material:

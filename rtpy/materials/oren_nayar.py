@@ -11,7 +11,7 @@ toward the rim and when lit from behind the viewer. Their "qualitative" model:
     A = 1 - 0.5 s^2 / (s^2 + 0.33),   B = 0.45 s^2 / (s^2 + 0.09)
 
 with s = sigma in radians, theta and phi the polar and azimuthal angles of wi
-and wo in the local frame, alpha = max(theta_i, theta_o), beta = min(theta_i,
+and wo about the normal, alpha = max(theta_i, theta_o), beta = min(theta_i,
 theta_o). sigma = 0 gives A = 1, B = 0: Lambertian.
 
 The qualitative model is an approximation and does not conserve energy
@@ -25,11 +25,12 @@ from __future__ import annotations
 import math
 
 from ..hit_info import HitInfo
+from ..onb import ONB
 from ..ray import Ray, spawn_ray
 from ..sampling import random_cosine_direction
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
-from ..vec3 import BLACK, Color
+from ..vec3 import BLACK, Color, dot
 from .material import Material, as_texture
 
 INV_PI = 1.0 / math.pi
@@ -62,45 +63,48 @@ class OrenNayar(Material):
         self.A = 1.0 - 0.5 * s2 / (s2 + 0.33)
         self.B = 0.45 * s2 / (s2 + 0.09)
 
-    def _factor(self, wo: tuple[float, float, float], wi: tuple[float, float, float]) -> float:
-        """A + B * max(0, cos(phi_i - phi_o)) * sin(alpha) * tan(beta), both directions
-        above the surface (local frame, z = normal)."""
+    def factor(self, cos_o: float, cos_i: float, cos_oi: float) -> float:
+        """A + B * max(0, cos(phi_i - phi_o)) * sin(alpha) * tan(beta) for directions
+        wo and wi above the surface, from cos_o = normal . wo, cos_i = normal . wi and
+        cos_oi = wo . wi."""
         if self.B == 0.0:
             return self.A
         # cos(phi_i - phi_o) * sin(theta_i) * sin(theta_o) is the dot product of the
-        # directions' projections onto the surface, and sin(alpha) * sin(beta) is
-        # sin(theta_i) * sin(theta_o), so the product of the three terms is that dot
-        # product over cos(beta) = the larger cosine. No angles, no division by 0.
-        cos_phi_sin_sin = wi[0] * wo[0] + wi[1] * wo[1]
-        if cos_phi_sin_sin <= 0.0:
+        # directions' projections onto the surface, wo . wi - cos_o cos_i, and
+        # sin(alpha) * sin(beta) is sin(theta_i) * sin(theta_o), so the product of the
+        # three terms is that dot product over cos(beta) = the larger cosine. No
+        # angles, no division by 0.
+        projected = cos_oi - cos_o * cos_i
+        if projected <= 0.0:
             return self.A
-        cos_beta = max(wi[2], wo[2], MIN_COS)
-        return self.A + self.B * cos_phi_sin_sin / cos_beta
+        return self.A + self.B * projected / max(cos_i, cos_o, MIN_COS)
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
-        frame = hit.frame
-        wo = frame.to_local(-ray_view.direction)
-        wi = frame.to_local(ray_light.direction)
-        if wo[2] <= 0.0 or wi[2] <= 0.0:
+        """albedo / pi * factor; black unless wo and wi both lie above the surface."""
+        normal, wo, wi = hit.normal, -ray_view.direction, ray_light.direction
+        cos_o, cos_i = dot(normal, wo), dot(normal, wi)
+        if cos_o <= 0.0 or cos_i <= 0.0:
             return BLACK
-        return self.albedo.value(hit) * (INV_PI * self._factor(wo, wi))
+        return self.albedo.value(hit) * (INV_PI * self.factor(cos_o, cos_i, dot(wo, wi)))
 
     def pdf(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> float:
-        n, d, wi = hit.normal, ray_view.direction, ray_light.direction
-        if n.e0 * d.e0 + n.e1 * d.e1 + n.e2 * d.e2 >= 0.0:
+        normal = hit.normal
+        if dot(normal, ray_view.direction) >= 0.0:
             return 0.0  # viewer below the surface: scattering() absorbs
-        return max(0.0, n.e0 * wi.e0 + n.e1 * wi.e1 + n.e2 * wi.e2) * INV_PI
+        return max(0.0, dot(normal, ray_light.direction)) * INV_PI
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
-        frame = hit.frame
-        wo = frame.to_local(-ray_in.direction)
-        if wo[2] <= 0.0:
+        """A cosine-weighted direction around the normal, as Lambertian's; the weight
+        BRDF * cos / pdf = albedo / pi * factor * cos / (cos / pi) is albedo * factor."""
+        normal = hit.normal
+        cos_o = -dot(normal, ray_in.direction)
+        if cos_o <= 0.0:
+            return None  # viewer below the surface
+        local = random_cosine_direction()  # z = cos(theta_i)
+        wi = ONB(normal).to_world(local)
+        cos_i = dot(normal, wi)
+        if not (cos_i > 0.0 and local.z() > 0.0):
             return None
-        wi = random_cosine_direction()
-        pdf = wi[2] * INV_PI
-        if not pdf > 0.0:
-            return None
-        # BRDF * cos / pdf = albedo / pi * factor * cos / (cos / pi) = albedo * factor.
-        weight = self.albedo.value(hit) * self._factor(wo, wi)
-        direction = frame.to_world(*wi)
-        return ScatterInfo(spawn_ray(hit.point, hit.normal, direction), weight, pdf)
+        factor = self.factor(cos_o, cos_i, -dot(ray_in.direction, wi))
+        weight = self.albedo.value(hit) * factor
+        return ScatterInfo(spawn_ray(hit.point, normal, wi), weight, local.z() * INV_PI)

@@ -46,7 +46,8 @@ class ONB:
             length = np.where(degenerate, 1.0, length)
         frame = cls.__new__(cls)
         frame.w = w
-        frame.u = (ux / length, uy / length, uz / length)
+        inv = 1.0 / length  # as Vec3 / length: one reciprocal, three products
+        frame.u = (ux * inv, uy * inv, uz * inv)
         u = frame.u
         frame.v = (
             w[1] * u[2] - w[2] * u[1],

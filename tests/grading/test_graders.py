@@ -27,15 +27,16 @@ import rtpy.integrators.center as center
 import rtpy.integrators.direct_lighting as direct_lighting
 import rtpy.integrators.path as path_module
 import rtpy.materials.dielectric as dielectric
+import rtpy.materials.glossy as glossy
 import rtpy.materials.mirror as mirror
+import rtpy.materials.phong as phong
 import rtpy.vec3 as vec3
 from rtpy import Camera, CheckerTexture, ImageTexture, PointLight, Quad, Ray, Scene, Sphere
 from rtpy.grading import compare, summarize
 from rtpy.grading.assignment import WEEKS
 from rtpy.io.cli import main
-from rtpy.materials import BlinnPhong, Lambertian, Metal, Phong
-from rtpy.materials.glossy import GlossyMaterial
-from rtpy.vec3 import Color, Vec3
+from rtpy.materials import CookTorrance, Lambertian, Metal, Phong
+from rtpy.vec3 import Vec3
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -61,7 +62,8 @@ def wrap(cls, name, change):
 
 def plant(mp, owner, name, old, new):
     """Replace owner.name by its own source with `old` changed to `new`: a mistake
-    inside a function, such as a forgotten division."""
+    inside a function, such as a forgotten division. A module-level function is
+    replaced in every rtpy module that imported it."""
     function = inspect.unwrap(getattr(owner, name))
     source = textwrap.dedent(inspect.getsource(function))
     assert old in source, f"{name}: {old!r} not in its source"
@@ -69,7 +71,17 @@ def plant(mp, owner, name, old, new):
     module_globals = vars(sys.modules[function.__module__])
     module_globals = {"dot": vec3.dot, **module_globals}
     exec(compile(source.replace(old, new), f"<planted {name}>", "exec"), module_globals, namespace)
-    mp.setattr(owner, name, namespace[name])
+    replace_everywhere(mp, owner, name, function, namespace[name])
+
+
+def replace_everywhere(mp, owner, name, original, replacement):
+    """owner.name = replacement, and the same in every rtpy module that holds original
+    under that name (a module-level function imported by name)."""
+    mp.setattr(owner, name, replacement)
+    if inspect.ismodule(owner):
+        for module_name, module in list(sys.modules.items()):
+            if module_name.startswith("rtpy") and getattr(module, name, None) is original:
+                mp.setattr(module, name, replacement)
 
 
 # --- the mistakes -----------------------------------------------------------------------
@@ -108,7 +120,7 @@ def cosine_with_unnormalised_vector(mp):
         mp,
         direct_lighting,
         "sample_one_light",
-        "cos_i = normal.e0 * wi.e0 + normal.e1 * wi.e1 + normal.e2 * wi.e2",
+        "cos_i = dot(normal, wi)",
         "d = sample.point - hit.point; cos_i = dot(normal, d)",
     )
 
@@ -323,38 +335,49 @@ def fuzz_ignored(mp):
     mp.setattr(Metal, "scattering", scattering)
 
 
-def phong_wrong_normalisation(mp):
-    def change(self, f, wo, wi):
-        return f * ((self.exponent + 1.0) / (self.exponent + 2.0))
+def in_source(label, owner, name, old, new):
+    """The mistake `label`: `old` changed to `new` in the source of owner.name (plant)."""
 
-    mp.setattr(Phong, "specular", wrap(Phong, "specular", change))
+    def mistake(mp):
+        plant(mp, owner, name, old, new)
 
-
-def unnormalised_half_vector(mp):
-    def specular(self, wo, wi):
-        hz = wo[2] + wi[2]  # (wo + wi).z without dividing by |wo + wi|
-        n = self.exponent
-        return Color(1.0, 1.0, 1.0) * ((n + 8.0) / (8.0 * math.pi) * min(hz, 1.5) ** n)
-
-    mp.setattr(BlinnPhong, "specular", specular)
+    mistake.__name__ = label
+    return mistake
 
 
-def half_vector_pdf_without_jacobian(mp):
-    def change(self, pdf, wo, wi):
-        h = [wo[k] + wi[k] for k in range(3)]
-        length = math.sqrt(sum(x * x for x in h))
-        return pdf * 4.0 * sum(wo[k] * h[k] for k in range(3)) / length
-
-    mp.setattr(BlinnPhong, "specular_pdf", wrap(BlinnPhong, "specular_pdf", change))
-
-
-def glossy_no_pdf(mp):
-    def change(self, s, ray_in, hit):
-        if s is not None:
-            s.attenuation = s.attenuation * s.pdf  # BRDF * cos, the 1/pdf forgotten
-        return s
-
-    mp.setattr(GlossyMaterial, "scattering", wrap(GlossyMaterial, "scattering", change))
+# Week 8's mistakes, each one change to the solution's source, the course's own first:
+# Phong's albedo as the BRDF (fr = kd + ks (R.V)^n) and the half vector (v + l) * 0.5.
+WEEK08_MISTAKES = {
+    "phong_albedo_as_brdf": (Phong, "BRDF", "* (self.kd * INV_PI)", "* self.kd"),
+    "course_halfvector": (vec3, "halfvector", "unit_vector(view + light)", "(view + light) * 0.5"),
+    "phong_wrong_normalisation": (Phong, "BRDF", "(n + 2.0) * INV_TWO", "(n + 1.0) * INV_TWO"),
+    "phong_pdf_around_the_normal": (Phong, "pdf", "dot(mirror, wi)", "dot(normal, wi)"),
+    "pdf_without_jacobian": (glossy, "reflected_density", " / (4.0 * wo_h)", ""),
+    "pdf_without_cos_theta_h": (CookTorrance, "pdf", " * dot(normal, h)  #", "  #"),
+    "mixture_pdf_unweighted": (glossy, "mixture_pdf", "(1.0 - p_diffuse) * ", ""),
+    "cosine_power_wrong_inverse": (phong, "sample_cosine_power", "(exponent + 1", "(exponent + 2"),
+    "ggx_without_pi": (CookTorrance, "D", "a2 / (math.pi * k * k)", "a2 / (k * k)"),
+    "weight_without_1_over_pdf": (glossy, "weighted_sample", "* (cos_i / pdf)", "* cos_i"),
+}
+# the grader tests each must fail
+WEEK08_FAILS = {
+    "phong_albedo_as_brdf": ["test_phong_brdf"],
+    "course_halfvector": ["test_blinn_phong_brdf"],
+    "phong_wrong_normalisation": ["test_phong_brdf"],
+    "phong_pdf_around_the_normal": ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
+    "pdf_without_jacobian": ["test_pdf[blinn_phong]", "test_sampling_follows_pdf[blinn_phong]"],
+    "pdf_without_cos_theta_h": [
+        "test_pdf[cook_torrance_ggx]",
+        "test_sampling_follows_pdf[cook_torrance_ggx]",
+    ],
+    "mixture_pdf_unweighted": ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
+    "cosine_power_wrong_inverse": ["test_cosine_power_sampler"],
+    "ggx_without_pi": [
+        "test_cook_torrance_factors[ggx]",
+        "test_cook_torrance_brdf[cook_torrance_ggx]",
+    ],
+    "weight_without_1_over_pdf": ["test_weight_is_brdf_cos_over_pdf[cook_torrance_ggx]"],
+}
 
 
 # (week, mistake, grader tests that must fail)
@@ -386,10 +409,7 @@ PLANTED = [
     ("07", image_v_not_flipped, ["test_image_texture"]),
     ("07", fuzz_not_absorbed, ["test_metal_fuzz"]),
     ("07", fuzz_ignored, ["test_metal_fuzz"]),
-    ("08", phong_wrong_normalisation, ["test_phong_brdf"]),
-    ("08", unnormalised_half_vector, ["test_blinn_phong_brdf"]),
-    ("08", half_vector_pdf_without_jacobian, ["test_sampling_follows_pdf[blinn_phong]"]),
-    ("08", glossy_no_pdf, ["test_weight_is_brdf_cos_over_pdf[cook_torrance_ggx]"]),
+    *[("08", in_source(k, *WEEK08_MISTAKES[k]), WEEK08_FAILS[k]) for k in WEEK08_MISTAKES],
     ("08", light_counted_twice, ["test_path_render_matches_reference"]),
     ("08", path_counts_light_twice, ["test_path_render_matches_reference", "test_path_furnace"]),
     ("08", roulette_not_divided, ["test_path_furnace"]),

@@ -155,7 +155,7 @@ def surface_hits(backend, sphere: Sphere, n: int, seed: int):
     """Points and outward normals where n rays from outside hit the sphere, computed by
     the backend's own hit code (Sphere.hit_info or SphereSet.geometric)."""
     rng = np.random.default_rng(seed)
-    c, r = np.array([sphere._cx, sphere._cy, sphere._cz]), sphere.radius
+    c, r = np.array(sphere.center.tolist()), sphere.radius
     axis = np.array([1.0, 1.0, 1.0]) / math.sqrt(3.0)
     shift = rng.uniform(-1e3, 1e3, size=(n, 3))
     shift -= np.outer(shift @ axis, axis)  # sideways only: every eye stays 1e4 above

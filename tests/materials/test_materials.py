@@ -19,26 +19,11 @@ from rtpy.materials import (
 from rtpy.ray import Ray
 from rtpy.sampling import make_generator, use_generator
 from rtpy.texture import CheckerTexture
-from rtpy.vec3 import Color, Vec3
+from rtpy.vec3 import Color
+
+from ..vectors import V, dot3, norm3, unit3
 
 ALBEDO = Color(0.8, 0.5, 0.25)
-
-
-def V(x, y, z) -> Vec3:
-    return Vec3(float(x), float(y), float(z))
-
-
-def dot3(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def norm3(a) -> float:
-    return math.sqrt(dot3(a, a))
-
-
-def unit3(a):
-    n = norm3(a)
-    return tuple(x / n for x in a)
 
 
 def make_hit(material, normal=(0.0, 1.0, 0.0), point=(0.5, 0.0, -0.25), front_face=True):

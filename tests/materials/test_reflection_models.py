@@ -23,7 +23,6 @@ from dataclasses import dataclass
 import pytest
 
 from rtpy.materials import BlinnPhong, CookTorrance, OrenNayar, Phong, Ward
-from rtpy.materials.phong import cosine_power_pdf
 from rtpy.testing import (
     check_energy,
     check_non_negative_finite,
@@ -33,7 +32,7 @@ from rtpy.testing import (
     draw_samples,
     sidak_alpha,
 )
-from rtpy.vec3 import Color
+from rtpy.vec3 import Color, dot, halfvector
 
 ALBEDO = Color(0.9, 0.6, 0.3)
 ANGLES = (0.0, 45.0, 80.0, 89.9)
@@ -198,31 +197,38 @@ def test_the_family_level_is_sidak_corrected():
 # --- planted mistakes: the same test, at the same level, rejects them --------------------
 
 
+# With kd = 0 (as below) pdf() is the highlight's density alone.
+
+
 class PhongPdfWithLobeNormalisation(Phong):
     """The sampling pdf normalised like the BRDF, (n + 2) / (2 pi) instead of (n + 1)."""
 
-    def specular_pdf(self, wo, wi):
+    def pdf(self, ray_view, ray_light, hit):
         n = self.exponent
-        return cosine_power_pdf(n, self._cos_to_mirror(wo, wi)) * (n + 2.0) / (n + 1.0)
+        return super().pdf(ray_view, ray_light, hit) * (n + 2.0) / (n + 1.0)
+
+
+def half_vector_cosines(ray_view, ray_light, hit) -> tuple[float, float]:
+    """(wo . h, normal . h) with h the half vector of the viewer and the light."""
+    wo = -ray_view.direction
+    h = halfvector(wo, ray_light.direction)
+    return dot(wo, h), dot(hit.normal, h)
 
 
 class BlinnWithoutJacobian(BlinnPhong):
     """The half vector's density used as the density of wi (no 1 / (4 wo.h))."""
 
-    def specular_pdf(self, wo, wi):
-        x, y, z = wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]
-        length = math.sqrt(x * x + y * y + z * z)
-        return cosine_power_pdf(self.exponent, z / length) if length > 0.0 else 0.0
+    def pdf(self, ray_view, ray_light, hit):
+        p = super().pdf(ray_view, ray_light, hit)
+        return p * 4.0 * half_vector_cosines(ray_view, ray_light, hit)[0] if p > 0.0 else 0.0
 
 
 class GGXSampledWithoutCosine(CookTorrance):
     """pdf() claims D(h) / (4 wo.h), forgetting the cos(theta_h) that sampling uses."""
 
-    def specular_pdf(self, wo, wi):
-        p = super().specular_pdf(wo, wi)
-        x, y, z = wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]
-        length = math.sqrt(x * x + y * y + z * z)
-        return p * length / z if z > 0.0 else 0.0
+    def pdf(self, ray_view, ray_light, hit):
+        p = super().pdf(ray_view, ray_light, hit)
+        return p / half_vector_cosines(ray_view, ray_light, hit)[1] if p > 0.0 else 0.0
 
 
 class WardWithSwappedWidths(Ward):

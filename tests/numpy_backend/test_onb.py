@@ -42,5 +42,5 @@ def test_frames_and_coordinates_are_the_scalar_ones():
         for axis, ref_axis in zip((frame.u, frame.v, frame.w), (ref.u, ref.v, ref.w), strict=True):
             assert [c[i] for c in axis] == list(ref_axis)
         assert to_local[i].tolist() == list(ref.to_local(Vec3(*d[i])))
-        assert to_world[i].tolist() == list(ref.to_world(*local[:, i]))
+        assert to_world[i].tolist() == list(ref.to_world(Vec3(*local[:, i])))
         assert fused[i].tolist() == list(scalar_local_to_world(w, *local[:, i]))

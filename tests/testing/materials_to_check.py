@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import math
 
-from rtpy.materials import Lambertian
-from rtpy.materials.glossy import GlossyMaterial
+from rtpy.materials import Lambertian, Phong
 from rtpy.ray import spawn_ray
 from rtpy.sampling import generator
 from rtpy.scatter_info import ScatterInfo
@@ -15,36 +14,13 @@ from rtpy.vec3 import BLACK, Color, Vec3
 INV_PI = 1.0 / math.pi
 
 
-class PhongLobe(GlossyMaterial):
+class PhongLobe(Phong):
     """A correct narrow lobe: f = kd albedo / pi + ks (n+2)/(2 pi) cos^n(alpha), alpha the
     angle between wi and the mirror direction of wo, sampled exactly (pdf (n+1)/(2 pi)
     cos^n(alpha)); samples below the surface are absorbed."""
 
     def __init__(self, exponent: float, kd: float = 0.0, ks: float = 1.0) -> None:
-        super().__init__(Color(0.9, 0.6, 0.3), kd, ks)
-        self.exponent = float(exponent)
-
-    def _cos(self, wo, wi) -> float:
-        return max(0.0, -wi[0] * wo[0] - wi[1] * wo[1] + wi[2] * wo[2])
-
-    def specular(self, wo, wi) -> Color:
-        v = (self.exponent + 2.0) / (2.0 * math.pi) * self._cos(wo, wi) ** self.exponent
-        return Color(v, v, v)
-
-    def specular_pdf(self, wo, wi) -> float:
-        return (self.exponent + 1.0) / (2.0 * math.pi) * self._cos(wo, wi) ** self.exponent
-
-    def sample_specular(self, wo, r1, r2):
-        m = (-wo[0], -wo[1], wo[2])
-        cos_a = r1 ** (1.0 / (self.exponent + 1.0))
-        sin_a = math.sqrt(max(0.0, 1.0 - cos_a * cos_a))
-        sign = math.copysign(1.0, m[2])
-        a = -1.0 / (sign + m[2])
-        b = m[0] * m[1] * a
-        u = (1.0 + sign * m[0] * m[0] * a, sign * b, -sign * m[0])
-        v = (b, sign + m[1] * m[1] * a, -m[1])
-        x, y = sin_a * math.cos(2.0 * math.pi * r2), sin_a * math.sin(2.0 * math.pi * r2)
-        return tuple(x * u[k] + y * v[k] + cos_a * m[k] for k in range(3))
+        super().__init__(Color(0.9, 0.6, 0.3), kd, ks, exponent)
 
 
 class OverNormalised(Lambertian):
