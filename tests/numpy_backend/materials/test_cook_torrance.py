@@ -8,7 +8,8 @@ import pytest
 from rtpy.materials import CookTorrance
 from rtpy.numpy_backend.materials.cook_torrance import cook_torrance_kernel
 
-from .kernel_checks import AZIMUTH, LIBM_ULPS, ULP
+from .kernel_checks import ULP
+from .sampler_checks import AZIMUTH, LIBM_ULPS
 
 
 def half_vector_differences(distribution: str, alpha_scale: float = 1.0) -> np.ndarray:

@@ -15,16 +15,18 @@ from rtpy.testing import chi2_test
 from rtpy.vec3 import Color
 
 from .kernel_checks import (
-    AZIMUTH,
     CHI2_ALPHA,
-    LIBM_ULPS,
     ULP,
     batched_samples,
     check_brdf_and_pdf,
-    check_scattering_equals_scalar,
     compare_with_scalar_sampler,
     random_hits,
     random_wi,
+)
+from .sampler_checks import (
+    AZIMUTH,
+    LIBM_ULPS,
+    check_scattering_equals_scalar,
     use_scalar_local_samplers,
 )
 

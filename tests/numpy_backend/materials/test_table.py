@@ -41,7 +41,6 @@ from .kernel_checks import (
     assert_agrees,
     check_brdf_and_pdf,
     check_samples_match_brdf_and_pdf,
-    check_scattering_equals_scalar,
     compare_with_scalar_sampler,
     head,
     random_hits,
@@ -50,8 +49,8 @@ from .kernel_checks import (
     scalar_hit,
     scalar_per_hit,
     seeds,
-    use_scalar_local_samplers,
 )
+from .sampler_checks import check_scattering_equals_scalar, use_scalar_local_samplers
 
 
 @pytest.mark.parametrize("kind", list(MATERIALS))

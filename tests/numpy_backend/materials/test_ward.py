@@ -11,7 +11,8 @@ from rtpy.materials import Ward
 from rtpy.numpy_backend.materials.ward import WardKernel
 from rtpy.vec3 import Color
 
-from .kernel_checks import AZIMUTH, LIBM_ULPS, ULP, compare_with_scalar_sampler
+from .kernel_checks import ULP, compare_with_scalar_sampler
+from .sampler_checks import AZIMUTH, LIBM_ULPS
 
 
 def half_vector_differences(width_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
