@@ -1,8 +1,10 @@
-"""Orthonormal bases around n unit normals at once: the batched rtpy.onb.
+"""Orthonormal bases around n unit vectors at once: the batched rtpy.onb.
 
-Axes are Columns (three (n,) arrays, see vec3.py). The arithmetic is rtpy.onb's,
-operation for operation, so a frame and the directions it maps agree with the
-scalar ones to the last bit.
+Axes and local coordinates are Columns (three (n,) arrays, see vec3.py), where the
+scalar ONB has Vec3s: ONB(axis).to_world(local) turns local coordinates (x, y, z)
+into the world directions x u + y v + z w. The arithmetic is rtpy.onb's, operation
+for operation, so a frame and the directions it maps agree with the scalar ones to
+the last bit.
 """
 
 from __future__ import annotations
@@ -10,11 +12,11 @@ from __future__ import annotations
 import numpy as np
 
 from .arrays import Rows
-from .vec3 import Columns, components, dot, stack, take
+from .vec3 import Columns, components, cross, dot, stack, take
 
 
 class ONB:
-    """Frames (u, v, w) with w the given unit vectors; right-handed.
+    """Frames (u, v, w) with w the given unit vectors; right-handed (u x v = w).
 
     ONB(w) is Duff et al. 2017's branchless frame ("Building an Orthonormal Basis,
     Revisited"), as rtpy.onb.ONB(w).
@@ -32,30 +34,23 @@ class ONB:
         self.w = w
 
     @classmethod
-    def from_normal_tangent(cls, normal: np.ndarray, tangent: np.ndarray) -> ONB:
-        """rtpy.onb.ONB.from_normal_tangent for (n, 3) arrays: w = normal, u = the
-        tangent made perpendicular to it (Gram-Schmidt), v = w x u; ONB(normal) where
-        the tangent lies along the normal (its perpendicular part shorter than 1e-9)."""
-        w = components(normal)
-        t = components(tangent)
-        k = dot(t, w)
-        ux, uy, uz = t[0] - k * w[0], t[1] - k * w[1], t[2] - k * w[2]
-        length = np.sqrt(ux * ux + uy * uy + uz * uz)
+    def from_normal_tangent(cls, normal: Columns, tangent: Columns) -> ONB:
+        """rtpy.onb.ONB.from_normal_tangent: w = normal, u = the tangent made
+        perpendicular to it (Gram-Schmidt), v = w x u; ONB(normal) where the tangent
+        lies along the normal (its perpendicular part shorter than 1e-9)."""
+        k = dot(tangent, normal)
+        u = tuple(tangent[c] - normal[c] * k for c in range(3))
+        length = np.sqrt(dot(u, u))
         degenerate = length < 1e-9
         if degenerate.any():
             length = np.where(degenerate, 1.0, length)
         frame = cls.__new__(cls)
-        frame.w = w
         inv = 1.0 / length  # as Vec3 / length: one reciprocal, three products
-        frame.u = (ux * inv, uy * inv, uz * inv)
-        u = frame.u
-        frame.v = (
-            w[1] * u[2] - w[2] * u[1],
-            w[2] * u[0] - w[0] * u[2],
-            w[0] * u[1] - w[1] * u[0],
-        )
+        frame.u = (u[0] * inv, u[1] * inv, u[2] * inv)
+        frame.v = cross(normal, frame.u)
+        frame.w = normal
         if degenerate.any():
-            duff = cls(w)
+            duff = cls(normal)
             frame.u = _where(degenerate, duff.u, frame.u)
             frame.v = _where(degenerate, duff.v, frame.v)
         return frame
@@ -66,14 +61,14 @@ class ONB:
         frame.u, frame.v, frame.w = take(self.u, rows), take(self.v, rows), take(self.w, rows)
         return frame
 
-    def to_local(self, d: np.ndarray) -> Columns:
-        """Coordinates (x, y, z) of the world vectors d (n, 3) in the frames (z along w)."""
-        d = components(d)
+    def to_local(self, d: Columns) -> Columns:
+        """Coordinates (x, y, z) of the world vectors d in the frames (z along w)."""
         return dot(d, self.u), dot(d, self.v), dot(d, self.w)
 
-    def to_world(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Columns:
-        """x u + y v + z w."""
+    def to_world(self, a: Columns) -> Columns:
+        """The world vectors x u + y v + z w of the local coordinates a = (x, y, z)."""
         u, v, w = self.u, self.v, self.w
+        x, y, z = a
         return (
             x * u[0] + y * v[0] + z * w[0],
             x * u[1] + y * v[1] + z * w[1],
@@ -87,8 +82,7 @@ def _where(mask: np.ndarray, a: Columns, b: Columns) -> Columns:
 
 def local_to_world(w: Columns, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Columns:
     """rtpy.onb.local_to_world: x u + y v + z w for the frames ONB(w) builds, without
-    building them (the same numbers, as in the scalar code; the hot path of every
-    diffuse bounce)."""
+    building them (the same numbers, as in the scalar code)."""
     w0, w1, w2 = w
     sign = np.copysign(1.0, w2)
     a = -1.0 / (sign + w2)

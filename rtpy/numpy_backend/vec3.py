@@ -1,9 +1,9 @@
-"""n vectors as three (n,) columns: the batched rtpy.vec3 for formulas written per component.
+"""n vectors as three (n,) columns: the batched rtpy.vec3.
 
-Where a formula reads best component by component (a material's local directions,
-a frame's axes), a batch of n vectors is a tuple (x, y, z) of (n,) arrays, so the
-kernels read like the scalar code, which writes `v.e0 * n.e0 + ...` or `wo[0] * wi[0]
-+ ...`. Where vectors are stored and gathered (HitBatch, rays), they are (n, 3) arrays;
+Where the scalar code computes with Vec3 operations (a material's directions, a
+frame's axes), a batch of n vectors is a tuple (x, y, z) of (n,) arrays, and `dot`,
+`cross`, `reflect`, `halfvector`, ... below are the scalar functions on such tuples.
+Where vectors are stored and gathered (HitBatch, rays), they are (n, 3) arrays;
 `components` and `stack` convert, and `row`, `rows_of` and `to_vec3` convert from and
 to the scalar Vec3. Every function uses the scalar code's operations in
 the scalar code's order, so the results agree to the last bit.
@@ -38,6 +38,28 @@ def take(v: Columns, rows: Rows) -> Columns:
 
 def dot(a: Columns, b: Columns) -> np.ndarray:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def negative(v: Columns) -> Columns:
+    """-v (rtpy.vec3.Vec3.__neg__)."""
+    return -v[0], -v[1], -v[2]
+
+
+def cross(a: Columns, b: Columns) -> Columns:
+    """rtpy.vec3.cross: a x b."""
+    (a0, a1, a2), (b0, b1, b2) = a, b
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+def unit_vector(v: Columns) -> Columns:
+    """rtpy.vec3.unit_vector: v / |v|, as Vec3 divides (one reciprocal, three products)."""
+    k = 1.0 / np.sqrt(dot(v, v))
+    return v[0] * k, v[1] * k, v[2] * k
+
+
+def halfvector(view: Columns, light: Columns) -> Columns:
+    """rtpy.vec3.halfvector: the unit half vector (view + light) / |view + light|."""
+    return unit_vector((view[0] + light[0], view[1] + light[1], view[2] + light[2]))
 
 
 def reflect(v: Columns, n: Columns) -> Columns:

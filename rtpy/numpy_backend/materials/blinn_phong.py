@@ -5,32 +5,32 @@ from __future__ import annotations
 import numpy as np
 
 from ...materials.blinn_phong import INV_EIGHT_PI
-from .glossy import Local, positive_power, reflect_about, safe
+from ..onb import ONB
+from ..vec3 import Columns, dot, halfvector, reflect
+from .glossy import positive_power, reflected_density
+from .material import Bounce
 from .phong import PhongKernel, cosine_power_pdf, sample_cosine_power
 
 
 class BlinnPhongKernel(PhongKernel):
-    """ks (n + 8) / (8 pi) max(0, n . h)^n, sampled by drawing h with density
-    (n + 1) / (2 pi) cos^n and reflecting wo about it."""
+    """Diffuse plus ks (n + 8) / (8 pi) (normal . h)^n at the half vector h; h is
+    drawn with density (n + 1) / (2 pi) cos^n around the normal and wo reflected
+    about it."""
 
-    def specular(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
-        hx, hy, hz = wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]
-        length = np.sqrt(hx * hx + hy * hy + hz * hz)
-        n = self.exponent[slots]
-        return (n + 8.0) * INV_EIGHT_PI * positive_power(hz / length, n)
+    def highlight(self, b: Bounce) -> np.ndarray:
+        """BlinnPhong.BRDF's highlight: 0 unless ks > 0."""
+        cos_h = dot(b.normal, halfvector(b.wo, b.wi))  # > 0: wo and wi lie above the surface
+        ks, n = self.ks[b.slots], self.exponent[b.slots]
+        return np.where(ks > 0.0, ks * (n + 8.0) * INV_EIGHT_PI * positive_power(cos_h, n), 0.0)
 
-    def sample_specular(
-        self, slots: np.ndarray, wo: Local, r1: np.ndarray, r2: np.ndarray
-    ) -> tuple[Local, np.ndarray]:
-        h = sample_cosine_power(self.exponent[slots], r1, r2)
-        return reflect_about(wo, h)
+    def highlight_pdf(self, b: Bounce) -> np.ndarray:
+        """BlinnPhong.pdf's highlight: the half vector's density over 4 (wo . h)."""
+        h = halfvector(b.wo, b.wi)
+        density_h = cosine_power_pdf(self.exponent[b.slots], dot(b.normal, h))
+        return reflected_density(density_h, b.wo, h)
 
-    def specular_pdf(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
-        hx, hy, hz = wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]
-        length = np.sqrt(hx * hx + hy * hy + hz * hz)
-        ok = length != 0.0
-        length = safe(length, ok)
-        wo_h = (wo[0] * hx + wo[1] * hy + wo[2] * hz) / length
-        ok &= wo_h > 0.0
-        pdf = cosine_power_pdf(self.exponent[slots], hz / length) / (4.0 * safe(wo_h, ok))
-        return np.where(ok, pdf, 0.0)
+    def sample_highlight(self, b: Bounce, r1: np.ndarray, r2: np.ndarray) -> Columns:
+        """BlinnPhong.scattering's highlight: wo reflected about a half vector drawn
+        around the normal."""
+        h = ONB(b.normal).to_world(sample_cosine_power(self.exponent[b.slots], r1, r2))
+        return reflect(b.d, h)

@@ -10,16 +10,16 @@ import numpy as np
 
 from ...materials import CookTorrance
 from ...materials.cook_torrance import INV_SQRT_PI
+from ..onb import ONB
 from ..sampling import cos_sin_2pi
-from ..vec3 import dot
-from .glossy import GlossyKernel, Local, half_vector, reflect_about, safe
-from .material import color_param, param
+from ..vec3 import Columns, cross, dot, halfvector, reflect
+from .glossy import GlossyKernel, reflected_density
+from .material import Bounce, color_param, param
 
 
 def schlick_fresnel(f0: np.ndarray, cosine: np.ndarray) -> np.ndarray:
-    """rtpy.materials.cook_torrance.schlick_fresnel for colours f0 (n, 3)."""
-    c = np.minimum(1.0, np.maximum(0.0, cosine))
-    m = ((1.0 - c) ** 5)[:, None]
+    """cook_torrance.schlick_fresnel for colours f0 (n, 3)."""
+    m = ((1.0 - np.minimum(1.0, np.maximum(0.0, cosine))) ** 5)[:, None]
     return f0 + (1.0 - f0) * m
 
 
@@ -35,87 +35,101 @@ BECKMANN_G1_ONE = 6.0
 
 
 class CookTorranceKernel(GlossyKernel):
-    """ks D(h) G(wi, wo) F(wo . h) / (4 (n . wi) (n . wo)); half vectors drawn from
-    D(h) cos(theta_h). D, G1 and the half-vector sampling are the distribution's."""
+    """Diffuse plus ks D(h) G(wi, wo) F(wo . h) / (4 cos_i cos_o); half vectors drawn
+    from D(h) cos(theta_h) around the normal, wo reflected about them. D, G1 and the
+    half vector's tan^2 are the distribution's (the subclasses)."""
 
     def __init__(self, materials: Sequence[CookTorrance]) -> None:
         super().__init__(materials)
         self.alpha = param(self.materials, "alpha")
         self.f0 = color_param(self.materials, "f0")
 
-    def D(self, alpha: np.ndarray, h: Local) -> np.ndarray:
-        """The distribution of unit half vectors h; 0 at and below the horizon."""
-        cos2 = h[2] * h[2]
-        ok = (h[2] > 0.0) & (cos2 != 0.0)
-        sin2 = h[0] * h[0] + h[1] * h[1]
-        d, ok = self.distribution(alpha * alpha, safe(cos2, ok), sin2, ok)
-        return np.where(ok, d, 0.0)
+    # --- the three factors ----------------------------------------------------------
+    def D(self, alpha: np.ndarray, normal: Columns, h: Columns) -> np.ndarray:
+        """CookTorrance.D: the density of facets along the unit half vectors h (0 at
+        and below the horizon)."""
+        cos = dot(normal, h)
+        cos2 = cos * cos
+        ok = (cos > 0.0) & (cos2 != 0.0)
+        c = cross(normal, h)
+        sin2 = dot(c, c)
+        return self.distribution(alpha * alpha, np.where(ok, cos2, 1.0), sin2, ok)
 
-    def distribution(self, a2, cos2, sin2, ok) -> tuple[np.ndarray, np.ndarray]:
-        """(D, where it is defined) from alpha^2 and the half vectors' cos^2 and sin^2
-        (cos^2 is 1 where not ok, which is where D is 0)."""
+    def distribution(self, a2, cos2, sin2, ok) -> np.ndarray:
+        """D from alpha^2 and the half vectors' cos^2 and sin^2, 0 where not ok (where
+        cos^2 is 1, a harmless placeholder)."""
         raise NotImplementedError
 
-    def G1(self, alpha: np.ndarray, v: Local) -> np.ndarray:
+    def G1(self, alpha: np.ndarray, normal: Columns, v: Columns) -> np.ndarray:
+        """CookTorrance.G1: Smith's masking of the unit directions v."""
         raise NotImplementedError
 
     def tan2_half_vector(self, alpha: np.ndarray, r1: np.ndarray) -> np.ndarray:
         """tan^2(theta_h) of a half vector drawn from D cos, by the inverted CDF."""
         raise NotImplementedError
 
-    def specular(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
-        alpha = self.alpha[slots]
-        cos_o, cos_i = wo[2], wi[2]
-        h, ok = half_vector(wo, wi)
-        wo_h = dot(wo, h)
-        # G1 / cos per direction, as the scalar code: finite at grazing angles
-        visibility = (self.G1(alpha, wi) / cos_i) * (self.G1(alpha, wo) / cos_o) * 0.25
-        value = schlick_fresnel(self.f0[slots], wo_h) * (self.D(alpha, h) * visibility)[:, None]
-        return np.where(ok[:, None], value, 0.0)
-
-    def sample_specular(
-        self, slots: np.ndarray, wo: Local, r1: np.ndarray, r2: np.ndarray
-    ) -> tuple[Local, np.ndarray]:
-        tan2 = self.tan2_half_vector(self.alpha[slots], r1)
+    def sample_half_vector(self, alpha: np.ndarray, r1: np.ndarray, r2: np.ndarray) -> Columns:
+        """CookTorrance.sample_half_vector: local (x, y, z) around the normal (z)."""
+        tan2 = self.tan2_half_vector(alpha, r1)
         cos = 1.0 / np.sqrt(1.0 + tan2)
         sin = np.sqrt(tan2) * cos
         cos_phi, sin_phi = cos_sin_2pi(r2)
-        return reflect_about(wo, (sin * cos_phi, sin * sin_phi, cos))
+        return sin * cos_phi, sin * sin_phi, cos
 
-    def specular_pdf(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
-        h, ok = half_vector(wo, wi)
-        wo_h = dot(wo, h)
-        ok &= wo_h > 0.0
-        pdf = self.D(self.alpha[slots], h) * h[2] / (4.0 * safe(wo_h, ok))
-        return np.where(ok, pdf, 0.0)
+    # --- the highlight ----------------------------------------------------------------
+    def highlight(self, b: Bounce) -> np.ndarray:
+        """CookTorrance.BRDF's highlight F(wo . h) ks D(h) G1(wi) G1(wo) / (4 cos_i cos_o)."""
+        alpha, normal = self.alpha[b.slots], b.normal
+        h = halfvector(b.wo, b.wi)
+        # Each G1 over its own cosine: finite at grazing angles (see the scalar model).
+        g_i, g_o = self.G1(alpha, normal, b.wi), self.G1(alpha, normal, b.wo)
+        visibility = (g_i / b.cos_i) * (g_o / b.cos_o) * 0.25
+        fresnel = schlick_fresnel(self.f0[b.slots], dot(b.wo, h))
+        return fresnel * (self.ks[b.slots] * self.D(alpha, normal, h) * visibility)[:, None]
+
+    def highlight_pdf(self, b: Bounce) -> np.ndarray:
+        """CookTorrance.pdf's highlight: D(h) cos(theta_h) over 4 (wo . h)."""
+        h = halfvector(b.wo, b.wi)
+        density_h = self.D(self.alpha[b.slots], b.normal, h) * dot(b.normal, h)
+        return reflected_density(density_h, b.wo, h)
+
+    def sample_highlight(self, b: Bounce, r1: np.ndarray, r2: np.ndarray) -> Columns:
+        """CookTorrance.scattering's highlight: wo reflected about a facet normal."""
+        h = ONB(b.normal).to_world(self.sample_half_vector(self.alpha[b.slots], r1, r2))
+        return reflect(b.d, h)
 
 
 class GGXKernel(CookTorranceKernel):
     def distribution(self, a2, cos2, sin2, ok):
-        k = safe(a2 * cos2 + sin2, ok)
-        return a2 / (math.pi * k * k), ok
+        k = np.where(ok, a2 * cos2 + sin2, 1.0)
+        return np.where(ok, a2 / (math.pi * k * k), 0.0)
 
-    def G1(self, alpha: np.ndarray, v: Local) -> np.ndarray:
-        cos = v[2]
+    def G1(self, alpha, normal, v):
+        cos = dot(normal, v)
         up = cos > 0.0
-        sin2 = v[0] * v[0] + v[1] * v[1]
-        c = safe(cos, up)
-        g = 2.0 * c / (c + np.sqrt(c * c + alpha * alpha * sin2))
+        c = cross(normal, v)
+        sin2 = dot(c, c)
+        cos = np.where(up, cos, 1.0)
+        g = 2.0 * cos / (cos + np.sqrt(cos * cos + alpha * alpha * sin2))
         return np.where(up, np.where(sin2 == 0.0, 1.0, g), 0.0)
 
-    def tan2_half_vector(self, alpha: np.ndarray, r1: np.ndarray) -> np.ndarray:
+    def tan2_half_vector(self, alpha, r1):
         return alpha * alpha * r1 / (1.0 - r1)
 
 
 class BeckmannKernel(CookTorranceKernel):
     def distribution(self, a2, cos2, sin2, ok):
-        exponent = sin2 / (a2 * cos2)  # tan^2 / alpha^2
-        ok = ok & ~(exponent > 700.0)
-        return np.exp(-np.where(ok, exponent, 0.0)) / (math.pi * a2 * cos2 * cos2), ok
+        denominator = a2 * cos2
+        ok = ok & (denominator != 0.0)  # underflow for tiny widths at the horizon
+        exponent = sin2 / np.where(ok, denominator, 1.0)  # tan^2 / alpha^2
+        ok &= ~(exponent > 700.0)  # exp underflows
+        d = np.exp(-np.where(ok, exponent, 0.0)) / (math.pi * a2 * cos2 * cos2)
+        return np.where(ok, d, 0.0)
 
-    def G1(self, alpha: np.ndarray, v: Local) -> np.ndarray:
-        cos = v[2]
-        sin2 = v[0] * v[0] + v[1] * v[1]
+    def G1(self, alpha, normal, v):
+        cos = dot(normal, v)
+        c = cross(normal, v)
+        sin2 = dot(c, c)
         g = np.where(cos > 0.0, 1.0, 0.0)  # 1 also where sin2 = 0 and where a >= 6
         slanted = np.flatnonzero((cos > 0.0) & (sin2 != 0.0))
         a = cos[slanted] / (alpha[slanted] * np.sqrt(sin2[slanted]))  # 1 / (alpha tan)
@@ -126,7 +140,7 @@ class BeckmannKernel(CookTorranceKernel):
         g[slanted[near]] = 1.0 / (1.0 + np.maximum(0.0, lam))
         return g
 
-    def tan2_half_vector(self, alpha: np.ndarray, r1: np.ndarray) -> np.ndarray:
+    def tan2_half_vector(self, alpha, r1):
         return -(alpha * alpha) * np.log1p(-r1)
 
 

@@ -1,12 +1,22 @@
-"""GlossyKernel: the batched rtpy.materials.glossy.GlossyMaterial.
+"""The diffuse + highlight mixture of the glossy kernels: the batched rtpy.materials.glossy.
 
-The shading frame from the normal and tangent, the diffuse/specular mixture with
-diffuse probability kd max(albedo) / (kd max(albedo) + ks), absorption of samples
-below the surface, and weight f_r cos / pdf. A subclass (phong.py, blinn_phong.py,
-cook_torrance.py, ward.py) gives the specular lobe as the scalar subclass does
-(specular, sample_specular, specular_pdf), on local directions: Columns (x, y, z)
-of (n,) arrays, z along the normal. Lobes are evaluated only where both directions
-lie above the surface (the callers check, as the scalar GlossyMaterial does).
+The scalar Phong, BlinnPhong, CookTorrance and Ward write BRDF(), pdf() and
+scattering() in world space, each in the same shape. GlossyKernel writes that shape
+once, on Bounces (material.py: the hits with wo, and wi, as columns), and a model's
+kernel gives the lines that differ, in the scalar model's order:
+
+    BRDF()        black unless wo and wi both lie above the surface; else
+                  kd * albedo / pi plus highlight(b), the model's highlight term (ks
+                  included, 0 where the scalar model adds nothing)
+    pdf()         0 unless both lie above; else mixture_pdf(diffuse_probability,
+                  cos_i, highlight_pdf(b)), with the highlight's density of wi
+    scattering()  the diffuse lobe (a cosine-weighted direction around the normal)
+                  with probability p_d, else sample_highlight(b, r1, r2); then
+                  weighted_sample
+
+The functions below are the scalar module's helpers on arrays. Per hit whose viewer
+lies above the surface, scattering() draws three uniform numbers, as the scalar one
+does: the lobe's choice, then the two that make the direction.
 """
 
 from __future__ import annotations
@@ -15,152 +25,127 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ...materials.glossy import MAX_PDF
-from ..arrays import compose, select
+from ...materials.glossy import INV_PI, MAX_PDF
+from ..arrays import max3, select
 from ..hit_info import HitBatch
 from ..onb import ONB
 from ..sampling import cosine_direction
 from ..scatter_info import ScatterBatch
-from ..vec3 import Columns, stack, take
-from .material import INV_PI, AlbedoKernel, param
-
-Local = Columns  # directions in the shading frame, one per hit
+from ..vec3 import Columns, dot, stack
+from .material import AlbedoKernel, Bounce, param
 
 
 def positive_power(c: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """c**n where c > 0, else 0."""
+    """c**n where c > 0, else 0 (the scalar models' `if cos <= 0.0: return 0.0`)."""
     up = c > 0.0
     return np.where(up, np.power(np.where(up, c, 1.0), n), 0.0)
 
 
-def safe(x: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """x where ok, else 1: a denominator or argument that is harmless where the result
-    is replaced anyway."""
-    return np.where(ok, x, 1.0)
+def diffuse_probability(kernel: GlossyKernel, b: Bounce) -> np.ndarray:
+    """glossy.diffuse_probability: p_d = kd max(albedo) / (kd max(albedo) + ks) per
+    hit (1 where both lobes are black)."""
+    diffuse = kernel.kd[b.slots] * max3(b.albedo)
+    total = diffuse + kernel.ks[b.slots]
+    positive = total > 0.0
+    return np.where(positive, diffuse / np.where(positive, total, 1.0), 1.0)
 
 
-def reflect_about(wo: Local, h: Local) -> tuple[Local, np.ndarray]:
-    """wi = 2 (wo . h) h - wo, and where it exists (wo . h > 0)."""
-    wo_h = wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2]
-    k = 2.0 * wo_h
-    return (k * h[0] - wo[0], k * h[1] - wo[1], k * h[2] - wo[2]), wo_h > 0.0
+def mixture_pdf(p_diffuse: np.ndarray, cos_i: np.ndarray, highlight_pdf: np.ndarray):
+    """glossy.mixture_pdf: p_d cos(theta_i) / pi + (1 - p_d) highlight_pdf, at most
+    MAX_PDF."""
+    pdf = p_diffuse * cos_i * INV_PI
+    mixed = p_diffuse < 1.0  # (highlight_pdf may be inf at a grazing half vector)
+    with np.errstate(invalid="ignore"):  # 0 * inf where not mixed: not used
+        pdf = np.where(mixed, pdf + (1.0 - p_diffuse) * highlight_pdf, pdf)
+    return np.minimum(pdf, MAX_PDF, out=pdf)
 
 
-def half_vector(wo: Local, wi: Local) -> tuple[Local, np.ndarray]:
-    """normalize(wo + wi) and where it exists (wi != -wo)."""
-    x, y, z = wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]
-    length = np.sqrt(x * x + y * y + z * z)
-    ok = length != 0.0
-    length = safe(length, ok)
-    return (x / length, y / length, z / length), ok
+def reflected_density(half_vector_density: np.ndarray, wo: Columns, h: Columns) -> np.ndarray:
+    """glossy.reflected_density: the density of wi = reflect(-wo, h) when the unit half
+    vector h is drawn with half_vector_density, that over 4 (wo . h); 0 where h faces
+    away from wo."""
+    wo_h = dot(wo, h)
+    facing = wo_h > 0.0
+    with np.errstate(over="ignore"):  # wo . h subnormal: inf, saturated by mixture_pdf
+        density = half_vector_density / (4.0 * np.where(facing, wo_h, 1.0))
+    return np.where(facing, density, 0.0)
+
+
+def weighted_sample(kernel: GlossyKernel, b: Bounce, wi: Columns, n: int) -> ScatterBatch:
+    """glossy.weighted_sample for the n hits of a batch, b those whose viewer lies
+    above the surface and wi the directions drawn there: the weight
+    BRDF * cos(theta_i) / pdf with the kernel's own BRDF and pdf; absorbed where wi
+    lies below the surface or pdf gives it no density."""
+    cos_i = dot(b.normal, wi)
+    b = b.toward(wi, cos_i).take(select(cos_i > 0.0))  # else drawn below the surface
+    pdf = kernel.pdf_above(b)
+    live = select(pdf > 0.0)
+    b, pdf = b.take(live), pdf[live]
+    weight = kernel.BRDF_above(b) * (b.cos_i / pdf)[:, None]
+    return ScatterBatch.alive_at(n, b.rows, stack(*b.wi), weight, pdf)
 
 
 class GlossyKernel(AlbedoKernel):
-    """Batched GlossyMaterial; subclasses give the lobe."""
+    """Batched diffuse + highlight models; a subclass gives the highlight."""
 
     has_brdf = True
     scatters = True
-    reads_tangent = True
 
     def __init__(self, materials: Sequence) -> None:
         super().__init__(materials)
         self.kd = param(self.materials, "kd")
         self.ks = param(self.materials, "ks")
 
-    # --- the specular lobe (subclasses) ---------------------------------------------
-    def specular(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
-        """The lobe's f_r without ks: (n,) for a white lobe or (n, 3)."""
+    # --- the model's own lines ------------------------------------------------------
+    def highlight(self, b: Bounce) -> np.ndarray:
+        """The term BRDF() adds to kd * albedo / pi: (n,) for a white highlight, or
+        (n, 3)."""
         raise NotImplementedError
 
-    def sample_specular(
-        self, slots: np.ndarray, wo: Local, r1: np.ndarray, r2: np.ndarray
-    ) -> tuple[Local, np.ndarray]:
-        """Directions wi drawn with density specular_pdf, and where there is one
-        (False where the scalar sample_specular returns None)."""
+    def highlight_pdf(self, b: Bounce) -> np.ndarray:
+        """The density with which the highlight lobe of scattering() draws b.wi."""
         raise NotImplementedError
 
-    def specular_pdf(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
+    def sample_highlight(self, b: Bounce, r1: np.ndarray, r2: np.ndarray) -> Columns:
+        """Directions wi drawn from the highlight lobe, from two uniform numbers each."""
         raise NotImplementedError
 
-    # --- shared machinery -----------------------------------------------------------
-    def diffuse_probability(self, slots: np.ndarray, albedo: np.ndarray) -> np.ndarray:
-        diffuse = self.kd[slots] * albedo.max(axis=1)
-        total = diffuse + self.ks[slots]
-        return np.where(total > 0.0, diffuse / safe(total, total > 0.0), 1.0)
+    # --- BRDF, pdf and scattering: the shape the scalar models share ----------------
+    def BRDF_above(self, b: Bounce) -> np.ndarray:
+        """BRDF() where wo and wi both lie above the surface: kd * albedo / pi plus the
+        highlight."""
+        f = b.albedo * (self.kd[b.slots] * INV_PI)[:, None]
+        highlight = self.highlight(b)
+        return f + (highlight if highlight.ndim == 2 else highlight[:, None])
 
-    def _f(self, slots: np.ndarray, albedo: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
-        f = albedo * (self.kd[slots] * INV_PI)[:, None]
-        ks = self.ks[slots]
-        glossy = select(ks > 0.0)
-        s = self.specular(slots[glossy], take(wo, glossy), take(wi, glossy))
-        s = s if s.ndim == 2 else s[:, None]
-        f[glossy] = f[glossy] + s * ks[glossy, None]
-        return f
-
-    def _pdf(self, slots: np.ndarray, p_diffuse: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
-        pdf = p_diffuse * wi[2] * INV_PI
-        mixed = select(p_diffuse < 1.0)
-        with np.errstate(over="ignore"):  # saturated below, as the scalar _pdf
-            p_specular = self.specular_pdf(slots[mixed], take(wo, mixed), take(wi, mixed))
-        pdf[mixed] = pdf[mixed] + (1.0 - p_diffuse[mixed]) * p_specular
-        return np.minimum(pdf, MAX_PDF, out=pdf)
-
-    def _evaluate(self, slots, hits: HitBatch, wi: np.ndarray, want_f: bool, want_pdf: bool):
-        """(f_r or None, pdf or None): BRDF() and pdf() in the shading frame, non-zero
-        only where both directions lie above the surface (reflection only)."""
-        frame = ONB.from_normal_tangent(hits.normal, hits.tangent)
-        wo_l, wi_l = frame.to_local(hits.wo), frame.to_local(wi)
-        up = select((wo_l[2] > 0.0) & (wi_l[2] > 0.0))
-        s, wo_l, wi_l = slots[up], take(wo_l, up), take(wi_l, up)
-        albedo = self.albedo(s, hits, up)
-        f = pdf = None
-        if want_f:
-            f = np.zeros((len(slots), 3))
-            f[up] = self._f(s, albedo, wo_l, wi_l)
-        if want_pdf:
-            pdf = np.zeros(len(slots))
-            pdf[up] = self._pdf(s, self.diffuse_probability(s, albedo), wo_l, wi_l)
-        return f, pdf
+    def pdf_above(self, b: Bounce) -> np.ndarray:
+        """pdf() where wo and wi both lie above the surface: the mixture's density."""
+        return mixture_pdf(diffuse_probability(self, b), b.cos_i, self.highlight_pdf(b))
 
     def BRDF(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
-        return self._evaluate(slots, hits, wi, True, False)[0]
+        b = self.above(slots, hits, wi)
+        return b.spread(self.BRDF_above(b), len(slots))
 
     def pdf(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
-        return self._evaluate(slots, hits, wi, False, True)[1]
+        b = self.above(slots, hits, wi)
+        return b.spread(self.pdf_above(b), len(slots))
 
     def BRDF_and_pdf(self, slots, hits, wi):
-        return self._evaluate(slots, hits, wi, True, True)
+        b = self.above(slots, hits, wi)
+        return b.spread(self.BRDF_above(b), len(slots)), b.spread(self.pdf_above(b), len(slots))
 
     def scattering(
         self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator
     ) -> ScatterBatch:
-        n = len(slots)
-        frame = ONB.from_normal_tangent(hits.normal, hits.tangent)
-        wo = frame.to_local(hits.wo)
-        rows = select(wo[2] > 0.0)  # the viewer below the surface: absorbed
-        slots, wo = slots[rows], take(wo, rows)
-        albedo = self.albedo(slots, hits, rows)
-        p_diffuse = self.diffuse_probability(slots, albedo)
-
-        r = rng.random((3, len(slots)))
-        wi = cosine_direction(r[1], r[2])
-        found = np.ones(len(slots), dtype=bool)
-        lobe = np.flatnonzero(~(r[0] < p_diffuse))  # the specular lobe's samples
+        """The diffuse lobe with probability p_d, else the highlight's; weight
+        BRDF * cos / pdf. Hits whose viewer lies below the surface are absorbed (their
+        pdf() is 0) and draw no numbers."""
+        b = self.above(slots, hits)
+        r = rng.random((3, len(b)))
+        wi = ONB(b.normal).to_world(cosine_direction(r[1], r[2]))
+        lobe = np.flatnonzero(~(r[0] < diffuse_probability(self, b)))
         if len(lobe):
-            r1, r2 = r[1, lobe], r[2, lobe]
-            wi_s, found_s = self.sample_specular(slots[lobe], take(wo, lobe), r1, r2)
+            wi_h = self.sample_highlight(b.take(lobe), r[1, lobe], r[2, lobe])
             for c in range(3):
-                wi[c][lobe] = wi_s[c]
-            found[lobe] = found_s
-
-        keep = select(found & (wi[2] > 0.0))  # below the surface: absorbed
-        slots, wo, wi = slots[keep], take(wo, keep), take(wi, keep)
-        pdf = self._pdf(slots, p_diffuse[keep], wo, wi)
-        live = select(pdf > 0.0)
-        slots, wo, wi, pdf = slots[live], take(wo, live), take(wi, live), pdf[live]
-        keep = compose(keep, live)
-
-        weight = self._f(slots, albedo[keep], wo, wi) * (wi[2] / pdf)[:, None]
-        rows = compose(rows, keep)
-        direction = stack(*frame.take(rows).to_world(*wi))
-        return ScatterBatch.alive_at(n, rows, direction, weight, pdf)
+                wi[c][lobe] = wi_h[c]
+        return weighted_sample(self, b, wi, len(slots))

@@ -9,7 +9,7 @@ import numpy as np
 from ...materials import Lambertian
 from ..arrays import put_rows, select
 from ..hit_info import HitBatch
-from ..onb import local_to_world
+from ..onb import ONB
 from ..sampling import cosine_direction
 from ..scatter_info import ScatterBatch
 from ..vec3 import components, dot, stack
@@ -27,10 +27,11 @@ class LambertianKernel(AlbedoKernel):
     ) -> ScatterBatch:
         n = len(slots)
         r = rng.random((2, n))
-        x, y, z = cosine_direction(r[0], r[1])
-        direction = stack(*local_to_world(components(hits.normal), x, y, z))
+        local = cosine_direction(r[0], r[1])  # z = cos(theta) from the normal
+        direction = stack(*ONB(components(hits.normal)).to_world(local))
+        # BRDF * cos / pdf = (albedo / pi) * cos / (cos / pi) = albedo
         alive = np.ones(n, dtype=bool)
-        return ScatterBatch(direction, self.albedo(slots, hits), z * INV_PI, alive, ~alive)
+        return ScatterBatch(direction, self.albedo(slots, hits), local[2] * INV_PI, alive, ~alive)
 
     def BRDF(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
         return self._brdf(slots, hits, self._cos(hits, wi))

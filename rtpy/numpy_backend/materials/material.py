@@ -28,10 +28,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...materials.material import Material
-from ..arrays import Rows
+from ..arrays import Rows, compose, put_rows, rows, select
 from ..hit_info import HitBatch
+from ..onb import ONB
 from ..scatter_info import ScatterBatch, SpecularRays
 from ..texture import TextureTable
+from ..vec3 import Columns, components, dot, negative, take
 
 INV_PI = 1.0 / math.pi
 
@@ -91,6 +93,117 @@ class AlbedoKernel(Kernel):
 
     def flat_color(self, slots: np.ndarray, hits: HitBatch) -> np.ndarray:
         return self.albedo(slots, hits)
+
+    def above(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray | None = None) -> Bounce:
+        """The hits whose viewer lies above the surface (normal . wo > 0), where
+        scattering() can draw a direction; given the light's directions wi (N, 3), the
+        hits where wi lies above too, where BRDF() can be non-zero (the check the
+        scalar methods make first)."""
+        normal, wo = components(hits.normal), components(hits.wo)
+        cos_o = dot(normal, wo)
+        up = cos_o > 0.0
+        if wi is not None:
+            wi = components(wi)
+            cos_i = dot(normal, wi)
+            up &= cos_i > 0.0
+        k = select(up)
+        s = slots[k]
+        b = Bounce(s, hits, k, take(normal, k), take(wo, k), cos_o[k], self.albedo(s, hits, k))
+        return b if wi is None else b.toward(take(wi, k), cos_i[k])
+
+
+class Bounce:
+    """Hits as the scalar BRDF(), pdf() and scattering() see them past their first
+    check, the viewer above the surface: Columns (see vec3.py) of the rows `rows` of
+    a HitBatch `hits`.
+
+    slots          (n,) each hit's material slot
+    normal, wo     hit.normal and -ray_view.direction, the unit direction to the viewer
+    cos_o          normal . wo (> 0)
+    albedo         (n, 3) the albedo's value at each hit
+    wi, cos_i      ray_light.direction and normal . wi, once given (toward()); None before
+    frame          hit.frame, the shading frame from the normal and the hit's tangent,
+                   made on first use
+    """
+
+    __slots__ = (
+        "slots",
+        "hits",
+        "rows",
+        "normal",
+        "wo",
+        "cos_o",
+        "albedo",
+        "wi",
+        "cos_i",
+        "_frame",
+    )
+
+    def __init__(
+        self,
+        slots: np.ndarray,
+        hits: HitBatch,
+        rows: Rows,
+        normal: Columns,
+        wo: Columns,
+        cos_o: np.ndarray,
+        albedo: np.ndarray,
+    ) -> None:
+        self.slots, self.hits, self.rows = slots, hits, rows
+        self.normal, self.wo, self.cos_o, self.albedo = normal, wo, cos_o, albedo
+        self.wi = self.cos_i = None
+        self._frame = None
+
+    def __len__(self) -> int:
+        return len(self.slots)
+
+    @property
+    def d(self) -> Columns:
+        """ray_view.direction = -wo, toward the surface."""
+        return negative(self.wo)
+
+    @property
+    def frame(self) -> ONB:
+        if self._frame is None:
+            tangent = take(components(self.hits.tangent), self.rows)
+            self._frame = ONB.from_normal_tangent(self.normal, tangent)
+        return self._frame
+
+    def toward(self, wi: Columns, cos_i: np.ndarray) -> Bounce:
+        """These hits with the light's direction wi, cos_i = normal . wi."""
+        b = Bounce(self.slots, self.hits, self.rows, self.normal, self.wo, self.cos_o, self.albedo)
+        b.wi, b.cos_i, b._frame = wi, cos_i, self._frame
+        return b
+
+    def take(self, k: Rows) -> Bounce:
+        """The hits k of these."""
+        if isinstance(k, slice):
+            return self
+        b = Bounce(
+            self.slots[k],
+            self.hits,
+            compose(self.rows, k),
+            take(self.normal, k),
+            take(self.wo, k),
+            self.cos_o[k],
+            rows(self.albedo, k),
+        )
+        if self.wi is not None:
+            b.wi, b.cos_i = take(self.wi, k), self.cos_i[k]
+        if self._frame is not None:
+            b._frame = self._frame.take(k)
+        return b
+
+    def spread(self, values: np.ndarray, n: int) -> np.ndarray:
+        """(n,) or (n, 3) zeros with these hits' `values` at their rows."""
+        if isinstance(self.rows, slice):
+            return values
+        out = np.zeros((n, *values.shape[1:]))
+        if values.ndim == 2:
+            put_rows(out, self.rows, values)
+        else:
+            out[self.rows] = values
+        return out
 
 
 def param(materials: Sequence[Material], name: str) -> np.ndarray:

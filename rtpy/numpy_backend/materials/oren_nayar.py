@@ -8,12 +8,12 @@ import numpy as np
 
 from ...materials import OrenNayar
 from ...materials.oren_nayar import MIN_COS
-from ..arrays import compose, select
+from ..arrays import select
 from ..hit_info import HitBatch
 from ..onb import ONB
 from ..sampling import cosine_direction
 from ..scatter_info import ScatterBatch
-from ..vec3 import Columns, components, dot, stack, take
+from ..vec3 import components, dot, stack
 from .material import INV_PI, AlbedoKernel, param
 
 
@@ -23,52 +23,49 @@ class OrenNayarKernel(AlbedoKernel):
 
     has_brdf = True
     scatters = True
-    reads_tangent = True
 
     def __init__(self, materials: Sequence[OrenNayar]) -> None:
         super().__init__(materials)
         self.A = param(self.materials, "A")
         self.B = param(self.materials, "B")
 
-    def factor(self, slots: np.ndarray, wo: Columns, wi: Columns) -> np.ndarray:
-        """A + B max(0, cos(phi_i - phi_o)) sin(alpha) tan(beta) = A + B (projections'
-        dot product) / (larger cosine), both directions above the surface."""
+    def factor(self, slots, cos_o: np.ndarray, cos_i: np.ndarray, cos_oi: np.ndarray):
+        """OrenNayar.factor: A + B max(0, cos(phi_i - phi_o)) sin(alpha) tan(beta) from
+        cos_o = normal . wo, cos_i = normal . wi and cos_oi = wo . wi, both directions
+        above the surface: A + B (the projections' dot product) / (the larger cosine)."""
         a, b = self.A[slots], self.B[slots]
-        cos_phi_sin_sin = wi[0] * wo[0] + wi[1] * wo[1]
-        cos_beta = np.maximum(np.maximum(wi[2], wo[2]), MIN_COS)
-        rough = (b != 0.0) & (cos_phi_sin_sin > 0.0)
-        return np.where(rough, a + b * cos_phi_sin_sin / cos_beta, a)
+        projected = cos_oi - cos_o * cos_i
+        rough = (b != 0.0) & (projected > 0.0)
+        return np.where(rough, a + b * projected / np.maximum(np.maximum(cos_i, cos_o), MIN_COS), a)
 
     def BRDF(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
-        frame = ONB.from_normal_tangent(hits.normal, hits.tangent)
-        wo_l, wi_l = frame.to_local(hits.wo), frame.to_local(wi)
-        f = np.zeros((len(slots), 3))
-        up = select((wo_l[2] > 0.0) & (wi_l[2] > 0.0))
-        s = slots[up]
-        k = INV_PI * self.factor(s, take(wo_l, up), take(wi_l, up))
-        f[up] = self.albedo(s, hits, up) * k[:, None]
-        return f
+        """albedo / pi * factor; black unless wo and wi both lie above the surface."""
+        b = self.above(slots, hits, wi)
+        k = INV_PI * self.factor(b.slots, b.cos_o, b.cos_i, dot(b.wo, b.wi))
+        return b.spread(b.albedo * k[:, None], len(slots))
 
     def pdf(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
-        # The density of scattering(), from the world normal as OrenNayar.pdf: 0 where
-        # the viewer is below the surface (n . d >= 0 for the arriving direction d = -wo).
-        n = components(hits.normal)
-        viewer_above = ~(dot(n, components(-hits.wo)) >= 0.0)
-        return np.where(viewer_above, np.maximum(0.0, dot(n, components(wi))) * INV_PI, 0.0)
+        # 0 where the viewer is below the surface (n . d >= 0 for the arriving
+        # direction d = -wo): scattering() absorbs there.
+        normal = components(hits.normal)
+        viewer_above = ~(dot(normal, components(-hits.wo)) >= 0.0)
+        return np.where(viewer_above, np.maximum(0.0, dot(normal, components(wi))) * INV_PI, 0.0)
 
     def scattering(
         self, slots: np.ndarray, hits: HitBatch, rng: np.random.Generator
     ) -> ScatterBatch:
-        frame = ONB.from_normal_tangent(hits.normal, hits.tangent)
-        wo = frame.to_local(hits.wo)
-        rows = select(wo[2] > 0.0)
-        r = rng.random((2, len(slots[rows])))
-        wi = cosine_direction(r[0], r[1])
-        pdf = wi[2] * INV_PI
-        live = select(pdf > 0.0)
-        rows, wi, pdf = compose(rows, live), take(wi, live), pdf[live]
-        s = slots[rows]
-        k = self.factor(s, take(wo, rows), wi)
-        direction = stack(*frame.take(rows).to_world(*wi))
-        attenuation = self.albedo(s, hits, rows) * k[:, None]
-        return ScatterBatch.alive_at(len(slots), rows, direction, attenuation, pdf)
+        """A cosine-weighted direction around the normal; the weight BRDF * cos / pdf
+        is albedo * factor. Hits whose viewer lies below the surface are absorbed and
+        draw no numbers."""
+        b = self.above(slots, hits)
+        r = rng.random((2, len(b)))
+        local = cosine_direction(r[0], r[1])  # z = cos(theta_i)
+        wi = ONB(b.normal).to_world(local)
+        cos_i = dot(b.normal, wi)
+        live = select((cos_i > 0.0) & (local[2] > 0.0))
+        b = b.toward(wi, cos_i).take(live)
+        factor = self.factor(b.slots, b.cos_o, b.cos_i, dot(b.wo, b.wi))
+        weight = b.albedo * factor[:, None]
+        return ScatterBatch.alive_at(
+            len(slots), b.rows, stack(*b.wi), weight, local[2][live] * INV_PI
+        )

@@ -9,54 +9,38 @@ import numpy as np
 
 from ...materials import Ward
 from ...materials.ward import MAX_EXPONENT, MIN_COS_PRODUCT
+from ..onb import ONB
 from ..sampling import cos_sin_2pi
-from ..vec3 import dot
-from .glossy import GlossyKernel, Local, half_vector, reflect_about, safe
-from .material import param
+from ..vec3 import Columns, dot, halfvector, reflect
+from .glossy import GlossyKernel, reflected_density
+from .material import Bounce, param
 
 
 class WardKernel(GlossyKernel):
-    """ks exp(-slope exponent) / (4 pi alpha_x alpha_y sqrt(cos_i cos_o)), anisotropic in
-    the tangent frame; half vectors drawn from Walter 2005's density."""
+    """Diffuse plus ks exp(-slope exponent of h) / (4 pi alpha_x alpha_y sqrt(cos_i
+    cos_o)), anisotropic in the shading frame hit.frame; half vectors drawn from
+    Walter 2005's density in that frame, wo reflected about them."""
+
+    reads_tangent = True  # the frame's first axis
 
     def __init__(self, materials: Sequence[Ward]) -> None:
         super().__init__(materials)
         self.ax = param(self.materials, "ax")
         self.ay = param(self.materials, "ay")
 
-    @staticmethod
-    def slope_exponent(ax: np.ndarray, ay: np.ndarray, h: Local) -> np.ndarray:
-        """(hx^2 / ax^2 + hy^2 / ay^2) / hz^2 for any (unnormalised) h; infinite in the
-        tangent plane."""
-        sx, sy = h[0] / ax, h[1] / ay
-        hz2 = h[2] * h[2]
+    def slope_exponent(self, ax, ay, frame: ONB, h: Columns) -> np.ndarray:
+        """Ward.slope_exponent: (hx^2 / alpha_x^2 + hy^2 / alpha_y^2) / hz^2 with h's
+        coordinates in the frame, for h of any length; infinite in the tangent plane."""
+        sx, sy = dot(h, frame.u) / ax, dot(h, frame.v) / ay
+        hz = dot(h, frame.w)
         numerator = sx * sx + sy * sy
+        hz2 = hz * hz
         flat = hz2 == 0.0
-        e = numerator / safe(hz2, ~flat)
-        return np.where(flat, np.where(numerator > 0.0, np.inf, 0.0), e)
+        exponent = numerator / np.where(flat, 1.0, hz2)
+        return np.where(flat, np.where(numerator > 0.0, np.inf, 0.0), exponent)
 
-    def specular(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
-        ax, ay = self.ax[slots], self.ay[slots]
-        h = (wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2])  # the ratios are all that count
-        exponent = self.slope_exponent(ax, ay, h)
-        ok = ~(exponent > MAX_EXPONENT)
-        cos_product = np.maximum(wi[2] * wo[2], MIN_COS_PRODUCT)
-        value = np.exp(-np.where(ok, exponent, 0.0)) / (
-            4.0 * math.pi * ax * ay * np.sqrt(cos_product)
-        )
-        return np.where(ok, value, 0.0)
-
-    def half_vector_pdf(self, ax: np.ndarray, ay: np.ndarray, h: Local) -> np.ndarray:
-        up = h[2] > 0.0
-        exponent = self.slope_exponent(ax, ay, h)
-        ok = up & ~(exponent > MAX_EXPONENT)
-        p = np.exp(-np.where(ok, exponent, 0.0)) / (math.pi * ax * ay * safe(h[2], ok) ** 3)
-        return np.where(ok, p, 0.0)
-
-    def sample_specular(
-        self, slots: np.ndarray, wo: Local, r1: np.ndarray, r2: np.ndarray
-    ) -> tuple[Local, np.ndarray]:
-        ax, ay = self.ax[slots], self.ay[slots]
+    def sample_half_vector(self, ax, ay, r1: np.ndarray, r2: np.ndarray) -> Columns:
+        """Ward.sample_half_vector: local (x along the tangent, y, z along the normal)."""
         cos_angle, sin_angle = cos_sin_2pi(r2)
         phi = np.arctan2(ay * sin_angle, ax * cos_angle)
         cos_phi, sin_phi = np.cos(phi), np.sin(phi)
@@ -64,11 +48,37 @@ class WardKernel(GlossyKernel):
         tan2 = -np.log1p(-r1) / a
         cos = 1.0 / np.sqrt(1.0 + tan2)
         sin = np.sqrt(tan2) * cos
-        return reflect_about(wo, (sin * cos_phi, sin * sin_phi, cos))
+        return sin * cos_phi, sin * sin_phi, cos
 
-    def specular_pdf(self, slots: np.ndarray, wo: Local, wi: Local) -> np.ndarray:
-        h, ok = half_vector(wo, wi)
-        wo_h = dot(wo, h)
-        ok &= wo_h > 0.0
-        pdf = self.half_vector_pdf(self.ax[slots], self.ay[slots], h) / (4.0 * safe(wo_h, ok))
-        return np.where(ok, pdf, 0.0)
+    def half_vector_pdf(self, ax, ay, frame: ONB, h: Columns) -> np.ndarray:
+        """Ward.half_vector_pdf: p_h of the unit half vectors h, 0 below the surface."""
+        cos = dot(h, frame.w)
+        exponent = self.slope_exponent(ax, ay, frame, h)
+        ok = (cos > 0.0) & ~(exponent > MAX_EXPONENT)
+        cos = np.where(ok, cos, 1.0)
+        p = np.exp(-np.where(ok, exponent, 0.0)) / (math.pi * ax * ay * cos**3)
+        return np.where(ok, p, 0.0)
+
+    def highlight(self, b: Bounce) -> np.ndarray:
+        """Ward.BRDF's highlight: 0 unless ks > 0 and the exponent is at most
+        MAX_EXPONENT."""
+        ax, ay = self.ax[b.slots], self.ay[b.slots]
+        wo, wi = b.wo, b.wi
+        h = (wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2])  # h before normalising
+        exponent = self.slope_exponent(ax, ay, b.frame, h)
+        lit = (self.ks[b.slots] > 0.0) & (exponent <= MAX_EXPONENT)
+        root = np.sqrt(np.maximum(b.cos_i * b.cos_o, MIN_COS_PRODUCT))
+        lobe = np.exp(-np.where(lit, exponent, 0.0)) / (4.0 * math.pi * ax * ay * root)
+        return np.where(lit, self.ks[b.slots] * lobe, 0.0)
+
+    def highlight_pdf(self, b: Bounce) -> np.ndarray:
+        """Ward.pdf's highlight: p_h(h) over 4 (wo . h)."""
+        h = halfvector(b.wo, b.wi)
+        density_h = self.half_vector_pdf(self.ax[b.slots], self.ay[b.slots], b.frame, h)
+        return reflected_density(density_h, b.wo, h)
+
+    def sample_highlight(self, b: Bounce, r1: np.ndarray, r2: np.ndarray) -> Columns:
+        """Ward.scattering's highlight: wo reflected about a half vector drawn in the
+        shading frame."""
+        local = self.sample_half_vector(self.ax[b.slots], self.ay[b.slots], r1, r2)
+        return reflect(b.d, b.frame.to_world(local))
