@@ -59,8 +59,10 @@ class BlinnPhong(Material):
         if dot(normal, wo) <= 0.0 or dot(normal, wi) <= 0.0:
             return BLACK  # reflection only: both directions above the surface
         f = self.albedo.value(hit) * (self.kd * INV_PI)
-        if self.ks > 0.0:
-            cos_h = dot(normal, halfvector(wo, wi))  # > 0: wo and wi lie above the surface
+        # h lies above the surface with wo and wi, but two grazing directions can round
+        # normal . h to just below 0, where cos_h**n would be complex
+        cos_h = dot(normal, halfvector(wo, wi))
+        if self.ks > 0.0 and cos_h > 0.0:
             n = self.exponent
             f = f + WHITE * (self.ks * (n + 8.0) * INV_EIGHT_PI * cos_h**n)
         return f

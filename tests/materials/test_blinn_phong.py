@@ -80,6 +80,19 @@ def test_zero_below_the_surface(kd, ks, n, to, po, ti, pi_):
     directions.check_nothing_below(m, direction(NORMAL, to, po), direction(NORMAL, ti, pi_))
 
 
+def test_two_grazing_directions_give_a_real_finite_brdf():
+    """Both directions just above the surface: normal . h rounds to -5.6e-17 here, and
+    a fractional power of it would be complex."""
+    normal = (-0.8108823945056095, -0.08583116976570461, -0.5788806030413352)
+    wo = (0.5610554380483579, 0.16723413221270034, -0.810709282332101)
+    wi = (0.18944846166244864, -0.9744194287380152, -0.12089688693929125)
+    assert dot3(wo, normal) > 0.0 and dot3(wi, normal) > 0.0
+    m = BlinnPhong(Color(*ALBEDO), kd=0.5, ks=0.5, exponent=2.5)
+    f = model_brdf(m, wo, wi, normal=normal)
+    assert all(isinstance(x, float) and math.isfinite(x) for x in f)
+    assert f == pytest.approx([0.5 * a / math.pi for a in ALBEDO], rel=1e-12)
+
+
 def test_the_highlight_peaks_where_the_half_vector_is_the_normal():
     m = BlinnPhong(Color(*ALBEDO), kd=0.0, ks=1.0, exponent=64.0)
     hit = make_hit(m)

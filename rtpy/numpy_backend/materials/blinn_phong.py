@@ -19,7 +19,7 @@ class BlinnPhongKernel(PhongKernel):
 
     def highlight(self, b: Bounce) -> np.ndarray:
         """BlinnPhong.BRDF's highlight: 0 unless ks > 0."""
-        cos_h = dot(b.normal, halfvector(b.wo, b.wi))  # > 0: wo and wi lie above the surface
+        cos_h = dot(b.normal, halfvector(b.wo, b.wi))  # may round to <= 0 when both graze
         ks, n = self.ks[b.slots], self.exponent[b.slots]
         return np.where(ks > 0.0, ks * (n + 8.0) * INV_EIGHT_PI * positive_power(cos_h, n), 0.0)
 
