@@ -239,6 +239,25 @@ def shipped_tests(root: Path, week: str) -> tuple[list[str], list[str]]:
     return kept, left
 
 
+# The student repository's pytest options: `python -m pytest` runs the graders too, and
+# leaves out the slow tier (`python -m pytest -m ""` runs everything).
+STUDENT_PYTEST_OPTIONS = {
+    'testpaths = ["tests"]': 'testpaths = ["tests", "assignments"]',
+    'addopts = "-ra --strict-markers"': "addopts = \"-ra --strict-markers -m 'not slow'\"",
+}
+
+
+def student_pytest_options(pyproject: Path) -> None:
+    """Rewrite pyproject's pytest options as STUDENT_PYTEST_OPTIONS says; AssignmentError
+    where an option to change is not there."""
+    text = pyproject.read_text()
+    for old, new in STUDENT_PYTEST_OPTIONS.items():
+        if old not in text:
+            raise AssignmentError(f"{pyproject.name}: no `{old}` to change for the students")
+        text = text.replace(old, new)
+    pyproject.write_text(text)
+
+
 def make_assignment(week: str | int, out_dir: str | Path, root: str | Path | None = None) -> Path:
     """Write week's student repository to out_dir (which must not exist or be empty).
     Everything is written to a temporary directory next to it and renamed at the end,
@@ -290,13 +309,7 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
             shutil.copytree(path, dest / name, ignore=ignore)
         elif path.exists():
             shutil.copy2(path, dest / name)
-    # `python -m pytest` runs the graders too
-    pyproject = dest / "pyproject.toml"
-    pyproject.write_text(
-        pyproject.read_text().replace(
-            'testpaths = ["tests"]', 'testpaths = ["tests", "assignments"]'
-        )
-    )
+    student_pytest_options(dest / "pyproject.toml")
     # the week's own folder, and the tests that can pass
     shutil.copytree(
         root / "assignments" / f"week{week}", dest / "assignments" / f"week{week}", ignore=ignore
@@ -314,7 +327,9 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
         + f"(`assignments/week{week}/`) and prints your score; "
         + f"`python -m pytest assignments/week{week} -x` shows the first failure's traceback, "
         + "and `python -m pytest` runs the graders with rtpy's own tests that apply this "
-        + "week. `docs/students.md` explains how to work on an assignment and "
+        + "week, all but the slow ones (long statistical and end-to-end tests); "
+        + '`python -m pytest -m ""` runs everything, the slow tests included. '
+        + "`docs/students.md` explains how to work on an assignment and "
         + "`docs/course-map.md` where each name of the course's code is in rtpy. "
         + "Left out because they "
         + "test code you write this week or later, or the numpy backend (withheld here: "

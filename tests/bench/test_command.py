@@ -20,6 +20,7 @@ def read_outputs(out):
     return rows, doc
 
 
+@pytest.mark.slow
 def test_quick_bench_runs_end_to_end_and_its_files_parse(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if not installed
     out, cache = tmp_path / "out", tmp_path / "cache"
@@ -45,6 +46,7 @@ def test_quick_bench_runs_end_to_end_and_its_files_parse(tmp_path, capsys, monke
     assert list(cache.glob("week05_point_light-w16-d*.npz"))
 
 
+@pytest.mark.slow
 def test_bench_plot_is_drawn_when_matplotlib_is_installed(tmp_path):
     pytest.importorskip("matplotlib")
     out = tmp_path / "out"
@@ -71,6 +73,7 @@ def test_bad_bench_options_exit_2_and_write_nothing(tmp_path, capsys, args, mess
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_the_levels_measured(tmp_path):
     """SIGINT to a real bench: it stops, writes the levels finished so far, exits 130."""
     import os

@@ -445,6 +445,7 @@ def test_every_week_has_planted_mistakes():
     assert {w for w, _, _ in PLANTED} == set(WEEKS)
 
 
+@pytest.mark.slow
 def test_graders_pass_on_the_reference(tmp_path, capsys):
     """`python -m rtpy grade WEEK --json` on rtpy's solution: full score, Gradescope format."""
     for week in WEEKS:

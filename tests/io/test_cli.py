@@ -20,6 +20,8 @@ from rtpy.io.cli import main
 from rtpy.io.image import read_pfm
 from rtpy.materials import MATERIALS
 
+from ..tiers import slow_except
+
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
 
 
@@ -133,15 +135,19 @@ def write(tmp_path: Path, text: str) -> Path:
 
 @pytest.mark.parametrize(
     "extra,message",
-    [
+    slow_except(
+        [
+            (["--set", "bogus=1"], "bogus"),
+            (["--set", "spp=0"], "spp"),
+            (["--set", "background=[1, 2]"], "background"),
+            (["--set", "nee"], "KEY=VALUE"),
+            (["-o", "no/such/dir/x.png"], "does not exist"),
+            (["-o", "x.gif"], ".gif"),
+            (["--linear", "x.png"], "x.png"),
+        ],
         (["--set", "bogus=1"], "bogus"),
-        (["--set", "spp=0"], "spp"),
-        (["--set", "background=[1, 2]"], "background"),
-        (["--set", "nee"], "KEY=VALUE"),
         (["-o", "no/such/dir/x.png"], "does not exist"),
-        (["-o", "x.gif"], ".gif"),
-        (["--linear", "x.png"], "x.png"),
-    ],
+    ),
 )
 def test_bad_options_exit_2_and_write_nothing(tmp_path, monkeypatch, extra, message):
     monkeypatch.chdir(tmp_path)
@@ -154,7 +160,10 @@ def test_bad_options_exit_2_and_write_nothing(tmp_path, monkeypatch, extra, mess
 
 @pytest.mark.parametrize(
     "extra",
-    [["--integrator", "pathh"], ["--spp", "-3"], ["--width", "x"], ["--workers", "100000"]],
+    slow_except(
+        [["--integrator", "pathh"], ["--spp", "-3"], ["--width", "x"], ["--workers", "100000"]],
+        ["--spp", "-3"],
+    ),
 )
 def test_argparse_errors_exit_2(extra):
     result = run_cli("render", "week08_three_balls", *extra)
@@ -238,7 +247,8 @@ def wait_for_exit(pid: int, timeout: float = 60) -> bool:
 
 
 @pytest.mark.parametrize(
-    "backend,workers", [("scalar", "1"), ("scalar", "2"), ("numpy", "1"), ("numpy", "2")]
+    "backend,workers",
+    slow_except([("scalar", "1"), ("scalar", "2"), ("numpy", "1"), ("numpy", "2")], ("numpy", "1")),
 )
 def test_ctrl_c_writes_the_finished_samples(tmp_path, workers, backend):
     """SIGINT to a real render once samples are finished: it stops, writes a valid
@@ -260,6 +270,7 @@ def test_ctrl_c_writes_the_finished_samples(tmp_path, workers, backend):
         assert np.asarray(im).max() > 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_second_ctrl_c_exits_at_once(tmp_path, workers):
     """A second SIGINT while the partial image is being written ends the process at

@@ -163,18 +163,21 @@ def case_id(case: tuple[str, float]) -> str:
     return f"{case[0]} @{case[1]:g}deg"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=case_id)
 def test_sampling_follows_pdf(outcomes, case):
     o = outcomes[case]
     assert o.chi2_p >= ALPHA, f"p = {o.chi2_p:.3g} < {ALPHA:.3g}: {o.chi2_summary}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=case_id)
 def test_weight_is_brdf_cos_over_pdf(outcomes, case):
     o = outcomes[case]
     assert o.weights, o.weights_detail
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=case_id)
 def test_albedo_by_sampling_and_quadrature_agree_and_is_bounded(outcomes, case):
     o = outcomes[case]
@@ -250,6 +253,7 @@ PLANTED = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(PLANTED))
 def test_the_grid_test_rejects_planted_sampling_mistakes(name):
     material, angle, phi = PLANTED[name]

@@ -35,6 +35,8 @@ from rtpy.io.bundled import bundled_scenes
 from rtpy.numpy_backend.integrators import direct_lighting
 from rtpy.testing.statistics import BlockTest, block_z_test
 
+from ..tiers import slow_except
+
 ALPHA = 1e-3
 WIDTH = 32
 SCENES = [name for name, _ in bundled_scenes()]
@@ -84,7 +86,7 @@ def check(name: str, integrator: str, spp: int) -> None:
     assert test.passed, "scalar backend: " + test.worst("the numpy backend")
 
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", slow_except(SCENES, "cornell"))
 def test_center_images_agree(name):
     if rtpy.load_scene(name).camera.defocus_angle > 0:
         check(name, "center", 1)  # the lens is sampled: compare as noise
@@ -99,7 +101,7 @@ def test_center_images_agree(name):
 CASES = [(name, integrator) for name in SCENES for integrator in SPP]
 
 
-@pytest.mark.parametrize("name,integrator", CASES)
+@pytest.mark.parametrize("name,integrator", slow_except(CASES, ("cornell", "path")))
 def test_block_means_agree(name, integrator):
     check(name, integrator, SPP[integrator])
 
