@@ -57,12 +57,14 @@ END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
 COPIED = ("pyproject.toml", ".gitignore", "scenes", "docs")
 TEST_WEEKS_FILE = "assignments/test_weeks.toml"
 # Tests that belong to rtpy's own repository only (and are not mapped): the assignment
-# machinery's, which grade every week and generate repositories, and the checks of
-# rtpy's README (a student repository's README.md is the week's).
+# machinery's, which grade every week and generate repositories, the checks of rtpy's
+# README (a student repository's README.md is the week's) and of its layout (which
+# counts the numpy backend's modules and tests).
 MACHINERY_TESTS = (
     "tests/grading/test_graders.py",
     "tests/grading/test_assignment.py",
     "tests/docs/test_pages.py",
+    "tests/test_layout.py",
 )
 # A test file that uses the numpy backend (withheld from student repositories).
 NUMPY_USE = re.compile(r"numpy_backend|[\"']numpy[\"']|rtpy\.BACKENDS")
@@ -380,6 +382,32 @@ def pytest_runtest_setup(item):
 """
 
 
+def _write_instrumented_copy(root: Path, dest: Path) -> None:
+    """rtpy, the tests and what they read, copied to dest with a probe before every
+    solution region that records the week in the log of the test file running it."""
+    for path in sorted((root / "rtpy").rglob("*.py")):
+        target = dest / path.relative_to(root)
+        target.parent.mkdir(parents=True, exist_ok=True)
+
+        def record(r: Region) -> list[str]:
+            lines = (root / r.path).read_text().splitlines(keepends=True)
+            probe = f'{r.indent}_rtpy_armed["{r.week}"] and _rtpy_hit("{r.week}")\n'
+            return [probe, *lines[r.begin : r.end + 1]]
+
+        target.write_text(rewrite(path, root, record))
+    (dest / "rtpy" / "_region_log.py").write_text(REGION_LOG_MODULE)
+    init = dest / "rtpy" / "__init__.py"
+    head = "from __future__ import annotations\n"
+    init.write_text(init.read_text().replace(head, head + "from . import _region_log\n", 1))
+    (dest / "region_log_plugin.py").write_text(REGION_LOG_PLUGIN)
+    for name in (*COPIED, "tests", "README.md"):
+        path = root / name
+        if path.is_dir():
+            shutil.copytree(path, dest / name, ignore=shutil.ignore_patterns("__pycache__"))
+        elif path.exists():
+            shutil.copy2(path, dest / name)
+
+
 def map_tests(
     root: str | Path | None = None,
     pytest_args: tuple[str, ...] = (),
@@ -401,28 +429,7 @@ def map_tests(
             return {k: set(v) for k, v in weeks_of_tests(root).items()}
     with tempfile.TemporaryDirectory(prefix="rtpy-map-tests-") as tmp:
         dest = Path(tmp)
-        for path in sorted((root / "rtpy").rglob("*.py")):
-            rel = path.relative_to(root)
-            target = dest / rel
-            target.parent.mkdir(parents=True, exist_ok=True)
-
-            def record(r: Region) -> list[str]:
-                lines = (root / r.path).read_text().splitlines(keepends=True)
-                probe = f'{r.indent}_rtpy_armed["{r.week}"] and _rtpy_hit("{r.week}")\n'
-                return [probe, *lines[r.begin : r.end + 1]]
-
-            target.write_text(rewrite(path, root, record))
-        (dest / "rtpy" / "_region_log.py").write_text(REGION_LOG_MODULE)
-        init = dest / "rtpy" / "__init__.py"
-        head = "from __future__ import annotations\n"
-        init.write_text(init.read_text().replace(head, head + "from . import _region_log\n", 1))
-        (dest / "region_log_plugin.py").write_text(REGION_LOG_PLUGIN)
-        for name in (*COPIED, "tests", "README.md"):
-            path = root / name
-            if path.is_dir():
-                shutil.copytree(path, dest / name, ignore=shutil.ignore_patterns("__pycache__"))
-            elif path.exists():
-                shutil.copy2(path, dest / name)
+        _write_instrumented_copy(root, dest)
         log = dest / "regions.log"
         env = dict(os.environ, RTPY_REGION_LOG=str(log), PYTHONPATH=str(dest))
         subprocess.run(
