@@ -8,17 +8,8 @@ import math
 import pytest
 
 import rtpy.materials as materials
-from rtpy.materials import (
-    MATERIALS,
-    Dielectric,
-    DiffuseLight,
-    Lambertian,
-    Material,
-    Metal,
-    Mirror,
-    register_material,
-)
-from rtpy.materials.material import as_texture, check_strengths
+from rtpy.materials import MATERIALS, Dielectric, DiffuseLight, Lambertian, Metal, Mirror
+from rtpy.materials.material import Material, as_texture, check_strengths
 from rtpy.texture import CheckerTexture, SolidColor
 from rtpy.vec3 import BLACK, WHITE, Color
 
@@ -80,7 +71,7 @@ def test_lobe_strengths_must_be_finite_numbers_at_least_0(kd, ks, message):
 def test_register_material_makes_a_class_a_scene_file_type(monkeypatch):
     monkeypatch.setattr(materials, "MATERIALS", dict(MATERIALS))
 
-    @register_material("half_grey")
+    @materials.register_material("half_grey")
     class HalfGrey(Lambertian):
         pass
 

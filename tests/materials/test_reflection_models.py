@@ -40,17 +40,20 @@ N_SAMPLES = 100_000
 FAMILY_ALPHA = 0.01
 
 # name -> (constructor, keyword arguments, incident azimuth in degrees)
+# The cosine-power lobes, Phong's and Blinn-Phong's: (label, kd, ks, exponent).
+EXPONENTS = [
+    ("n=1", 0.0, 1.0, 1.0),
+    ("n=10 mix", 0.5, 0.5, 10.0),
+    ("n=100", 0.0, 1.0, 100.0),
+    ("n=1000 mix", 0.3, 0.7, 1000.0),
+    ("n=1e4", 0.0, 1.0, 1e4),
+]
 MODELS: dict[str, tuple[type, dict, float]] = {
-    "phong n=1": (Phong, dict(kd=0.0, ks=1.0, exponent=1.0), 0.0),
-    "phong n=10 mix": (Phong, dict(kd=0.5, ks=0.5, exponent=10.0), 0.0),
-    "phong n=100": (Phong, dict(kd=0.0, ks=1.0, exponent=100.0), 0.0),
-    "phong n=1000 mix": (Phong, dict(kd=0.3, ks=0.7, exponent=1000.0), 0.0),
-    "phong n=1e4": (Phong, dict(kd=0.0, ks=1.0, exponent=1e4), 0.0),
-    "blinn n=1": (BlinnPhong, dict(kd=0.0, ks=1.0, exponent=1.0), 0.0),
-    "blinn n=10 mix": (BlinnPhong, dict(kd=0.5, ks=0.5, exponent=10.0), 0.0),
-    "blinn n=100": (BlinnPhong, dict(kd=0.0, ks=1.0, exponent=100.0), 0.0),
-    "blinn n=1000 mix": (BlinnPhong, dict(kd=0.3, ks=0.7, exponent=1000.0), 0.0),
-    "blinn n=1e4": (BlinnPhong, dict(kd=0.0, ks=1.0, exponent=1e4), 0.0),
+    **{
+        f"{model} {label}": (cls, dict(kd=kd, ks=ks, exponent=n), 0.0)
+        for model, cls in (("phong", Phong), ("blinn", BlinnPhong))
+        for label, kd, ks, n in EXPONENTS
+    },
     "ggx a=0.01": (CookTorrance, dict(kd=0.0, ks=1.0, roughness=0.01), 0.0),
     "ggx a=0.1 mix": (CookTorrance, dict(kd=0.5, ks=0.5, roughness=0.1), 0.0),
     "ggx a=0.5 f0": (

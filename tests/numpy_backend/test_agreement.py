@@ -46,20 +46,15 @@ NUMPY_FACTOR = 4
 SEEDS = (11, 12, 13, 14)
 
 
-@cache
-def render(name: str, integrator: str, backend: str, seed: int, spp: int) -> np.ndarray:
-    scene = rtpy.load_scene(name)
+def render_uncached(name: str, integrator: str, backend: str, seed: int, spp: int) -> np.ndarray:
+    """The linear image of a bundled scene, WIDTH pixels wide (the scalar backend on
+    two processes)."""
+    settings = {"width": WIDTH, "spp": spp, "integrator": integrator, "seed": seed}
     workers = 2 if backend == "scalar" else 1
-    image = rtpy.render(
-        scene,
-        width=WIDTH,
-        spp=spp,
-        integrator=integrator,
-        seed=seed,
-        workers=workers,
-        backend=backend,
-    )
-    return image.linear
+    return rtpy.render(rtpy.load_scene(name), workers=workers, backend=backend, **settings).linear
+
+
+render = cache(render_uncached)
 
 
 def compare(renders_a, spp_a, renders_b, spp_b, alpha: float = ALPHA) -> BlockTest:
@@ -112,17 +107,7 @@ def test_a_biased_kernel_is_flagged(monkeypatch):
     name, integrator, spp = "cornell", "path", SPP["path"]
     scalar = renders(name, integrator, "scalar", spp)
     monkeypatch.setattr(direct_lighting, "emission_weight", lambda _, obj, *a: np.ones(len(obj)))
-    biased = [
-        rtpy.render(
-            rtpy.load_scene(name),
-            width=WIDTH,
-            spp=spp * NUMPY_FACTOR,
-            integrator=integrator,
-            seed=s,
-            backend="numpy",
-        ).linear
-        for s in SEEDS
-    ]
+    biased = [render_uncached(name, integrator, "numpy", s, spp * NUMPY_FACTOR) for s in SEEDS]
     test = compare(scalar, spp, biased, spp * NUMPY_FACTOR)
     assert not test.passed
     assert test.failing_share > 0.25  # many blocks, not one
