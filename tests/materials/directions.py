@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 from rtpy.hit_info import HitInfo
 from rtpy.io.scene_file import SceneError, load_scene_text
+from rtpy.materials import MATERIALS
 from rtpy.ray import Ray
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color, Vec3
@@ -304,6 +305,21 @@ def check_finite(m, pairs, n_samples, normal=NORMAL, tangent=None) -> None:
                     values = [*s.attenuation.tolist(), *s.scattered_ray.direction.tolist()]
                     assert all(math.isfinite(x) for x in [*values, s.pdf])
                     assert min(s.attenuation.tolist()) >= 0.0 and s.pdf > 0.0
+
+
+def check_defaults(cls, name: str, **expected):
+    """The material cls() made with no arguments, after checking that scene files know
+    it as `name`, that it has the attributes `expected` and the grey albedo
+    [0.5, 0.5, 0.5] (which the flat integrators show), and that it is neither specular
+    nor an emitter."""
+    assert MATERIALS[name] is cls
+    m = cls()
+    assert {key: getattr(m, key) for key in expected} == expected
+    hit = make_hit(m)
+    assert m.albedo.value(hit).tolist() == [0.5, 0.5, 0.5]
+    assert m.flat_color(hit).tolist() == [0.5, 0.5, 0.5]
+    assert m.is_specular is False and m.is_emitter is False
+    return m
 
 
 def load_material(keys: str, name: str = "shiny"):

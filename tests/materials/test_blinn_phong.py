@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 
 import rtpy
 from rtpy.io.scene_file import SceneError
-from rtpy.materials import MATERIALS, Blinn, BlinnPhong
+from rtpy.materials import Blinn, BlinnPhong
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
@@ -192,10 +192,7 @@ def test_grazing_angles_and_huge_exponents_give_finite_values(n):
 
 
 def test_defaults_and_registration():
-    m = BlinnPhong()
-    assert (m.kd, m.ks, m.exponent) == (1.0, 0.0, 1.0)
-    assert m.albedo.color == Color(0.5, 0.5, 0.5)
-    assert MATERIALS["blinn_phong"] is BlinnPhong
+    directions.check_defaults(BlinnPhong, "blinn_phong", kd=1.0, ks=0.0, exponent=1.0)
     assert Blinn is BlinnPhong is rtpy.Blinn  # the course's name, importable from rtpy too
 
 

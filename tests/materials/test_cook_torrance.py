@@ -26,7 +26,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from rtpy.materials import MATERIALS, CookTorrance
+from rtpy.materials import CookTorrance
 from rtpy.vec3 import Color, Vec3
 
 from ..tiers import slow_except
@@ -39,6 +39,7 @@ from .directions import (
     X,
     Z,
     brdf,
+    check_defaults,
     check_finite,
     check_mean_weight,
     check_nothing_below,
@@ -48,7 +49,6 @@ from .directions import (
     half_vector_albedo,
     hemisphere_integral,
     load_material,
-    make_hit,
     mixture_pdf,
     pdf,
     theta_nodes,
@@ -395,14 +395,9 @@ def test_the_lobe_reflects_at_most_everything(dist, a):
 
 
 def test_defaults_and_registration():
-    assert MATERIALS["cook_torrance"] is CookTorrance
-    m = CookTorrance()
-    assert (m.kd, m.ks, m.roughness, m.distribution, m.ior) == (1.0, 0.0, 0.5, "ggx", 1.5)
+    defaults = dict(kd=1.0, ks=0.0, roughness=0.5, distribution="ggx", ior=1.5)
+    m = check_defaults(CookTorrance, "cook_torrance", **defaults)
     assert m.f0.tolist() == pytest.approx([0.04] * 3)
-    hit = make_hit(m)
-    assert m.albedo.value(hit).tolist() == [0.5, 0.5, 0.5]
-    assert m.flat_color(hit).tolist() == [0.5, 0.5, 0.5]
-    assert not m.is_specular and not m.is_emitter
 
 
 @pytest.mark.parametrize(

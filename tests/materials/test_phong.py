@@ -21,7 +21,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from rtpy.io.scene_file import SceneError
-from rtpy.materials import MATERIALS, Phong
+from rtpy.materials import Phong
 from rtpy.materials.phong import cosine_power_pdf, sample_cosine_power
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
@@ -35,6 +35,7 @@ from .directions import (
     alive_fraction,
     approx3,
     check_brdf_and_pdf,
+    check_defaults,
     check_finite,
     check_nothing_below,
     check_scattering,
@@ -261,11 +262,7 @@ def test_exponent_zero_is_uniform_around_the_mirror_direction():
 
 
 def test_defaults_and_registration():
-    m = Phong()
-    assert (m.kd, m.ks, m.exponent) == (1.0, 0.0, 1.0)
-    assert m.albedo.color == Color(0.5, 0.5, 0.5)
-    assert MATERIALS["phong"] is Phong
-    assert m.is_specular is False and m.is_emitter is False
+    check_defaults(Phong, "phong", kd=1.0, ks=0.0, exponent=1.0)
 
 
 @pytest.mark.parametrize(
