@@ -19,8 +19,6 @@ from __future__ import annotations
 import contextlib
 import io
 import math
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
@@ -33,6 +31,7 @@ from PIL import Image
 from rtpy.io.cli import main
 from tests.io.scene_text import VALUES, to_toml
 
+from ..commands import run_cli
 from .scene_strategies import fuzz_settings, random_scene, seeds
 
 SMALL = ["--width", "4", "--spp", "1", "--set", "max_depth=2", "--quiet"]
@@ -261,9 +260,7 @@ def test_known_bad_files_give_one_clear_error(tmp_path, index):
     argv = ["render", str(scene), "-o", str(tmp_path / "out.png"), "--quiet"]
     runs = [run_main(argv)]
     if index in SUBPROCESS:
-        result = subprocess.run(
-            [sys.executable, "-m", "rtpy", *argv], capture_output=True, text=True, timeout=60
-        )
+        result = run_cli(*argv)
         runs.append((result.returncode, result.stderr))
     for status, stderr in runs:
         assert status == 2

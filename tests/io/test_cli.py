@@ -6,8 +6,6 @@ import os
 import select
 import signal
 import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -20,15 +18,10 @@ from rtpy.io.cli import main
 from rtpy.io.image import read_pfm
 from rtpy.materials import MATERIALS
 
+from ..commands import read_until, rtpy_command, run_cli
 from ..tiers import slow_except
 
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
-
-
-def run_cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "rtpy", *args], capture_output=True, text=True, timeout=timeout
-    )
 
 
 def test_scenes_lists_every_bundled_scene_with_its_description():
@@ -208,24 +201,7 @@ def test_unknown_scene_name_exits_2():
 
 
 def start_render(*args: str) -> subprocess.Popen:
-    return subprocess.Popen(
-        [sys.executable, "-m", "rtpy", "render", *args], stderr=subprocess.PIPE, text=True
-    )
-
-
-def read_until(proc: subprocess.Popen, done, timeout: float = 120) -> str:
-    """Read the child's stderr until done(what was read) holds; returns what it read.
-    The deadline only ends a test whose child never gets there."""
-    deadline = time.monotonic() + timeout
-    seen = ""
-    while time.monotonic() < deadline:
-        chunk = os.read(proc.stderr.fileno(), 4096).decode()
-        if not chunk:
-            break  # the process ended
-        seen += chunk
-        if done(seen):
-            return seen
-    raise AssertionError(f"not seen within {timeout} s: {seen}")
+    return subprocess.Popen(rtpy_command("render", *args), stderr=subprocess.PIPE, text=True)
 
 
 def some_paths_done(seen: str) -> bool:
