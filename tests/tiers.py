@@ -21,3 +21,16 @@ def slow_except(cases, *fast) -> list:
 
 
 SLOW = (pytest.mark.slow,)
+
+
+# path of a collected test file -> it has a test not marked slow
+FAST_TESTS = pytest.StashKey[dict[str, bool]]()
+
+
+def record_fast_tests(config, items) -> None:
+    """Record in config.stash[FAST_TESTS] the files of the collected items, and whether
+    each has one outside the slow tier (called before -m deselects any)."""
+    fast = config.stash.setdefault(FAST_TESTS, {})
+    for item in items:
+        path = item.path.as_posix()
+        fast[path] = fast.get(path, False) or item.get_closest_marker("slow") is None
