@@ -34,10 +34,11 @@ def test_an_analytic_scene_is_measured_against_its_closed_form(name):
 
 def test_a_scene_file_is_measured_against_a_rendered_reference(tmp_path):
     """A bundled scene by name, at the width asked for (its own without one); its
-    reference is rendered when first asked for and cached."""
+    reference is rendered (by the "numpy" backend) when first asked for, and cached."""
     bs = load_bench_scene("week05_point_light", width=6, cache=tmp_path, reference_spp=4)
     assert bs.name == "week05_point_light" and bs.camera.width == 6
     assert load_bench_scene("week05_point_light", width=None).camera.width > 6
     ref = bs.reference_for(2)
     assert not ref.exact and ref.image.shape == (bs.camera.height, 6, 3)
+    assert "numpy" in ref.source
     assert list(tmp_path.glob("week05_point_light-w6-d2*.npz"))
