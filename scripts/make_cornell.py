@@ -10,13 +10,11 @@ Run ``python scripts/make_cornell.py``; re-running it rewrites the file byte-ide
 """
 
 import math
-from pathlib import Path
 
-SCENES = Path(__file__).resolve().parent.parent / "scenes"
+from scene_toml import Vec, fmt, vec, write_scene
+
 OUT_NAME = "cornell.toml"
 DESCRIPTION = "Cornell box (RTIOW book 2) lit by a ceiling quad light"
-
-Vec = tuple[float, float, float]
 
 # The room: (comment, q, u, v, material), exactly as in the book.
 WALLS: list[tuple[str, Vec, Vec, Vec, str]] = [
@@ -39,16 +37,6 @@ BOXES: list[tuple[str, Vec, float, Vec]] = [
     ("tall box", (165, 330, 165), 15, (265, 0, 295)),
     ("short box", (165, 165, 165), -18, (130, 0, 65)),
 ]
-
-
-def fmt(x: float) -> str:
-    """A number rounded to 6 decimals, without trailing zeros or a negative zero."""
-    s = f"{round(float(x), 6):.6f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
-
-
-def vec(v: Vec) -> str:
-    return "[" + ", ".join(fmt(c) for c in v) + "]"
 
 
 def add(a: Vec, b: Vec) -> Vec:
@@ -175,12 +163,7 @@ def build() -> str:
 
 
 def main() -> None:
-    text = build()
-    assert len(DESCRIPTION) < 70
-    SCENES.mkdir(exist_ok=True)
-    path = SCENES / OUT_NAME
-    path.write_text(text, encoding="utf-8", newline="\n")
-    print(f"wrote {path}")
+    write_scene(OUT_NAME, DESCRIPTION, build())
 
 
 if __name__ == "__main__":

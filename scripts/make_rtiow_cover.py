@@ -13,24 +13,12 @@ Run ``python scripts/make_rtiow_cover.py``; re-running it rewrites the file byte
 
 import math
 import random
-from pathlib import Path
 
-SCENES = Path(__file__).resolve().parent.parent / "scenes"
+from scene_toml import Vec, fmt, vec, write_scene
+
 OUT_NAME = "rtiow_cover.toml"
 DESCRIPTION = "RTIOW book 1 final scene: random small spheres around three big ones"
 SEED = 2020
-
-Vec = tuple[float, float, float]
-
-
-def fmt(x: float) -> str:
-    """A number rounded to 6 decimals, without trailing zeros or a negative zero."""
-    s = f"{round(float(x), 6):.6f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
-
-
-def vec(v: Vec) -> str:
-    return "[" + ", ".join(fmt(c) for c in v) + "]"
 
 
 def cell_name(a: int, b: int) -> str:
@@ -128,12 +116,7 @@ def build() -> str:
 
 
 def main() -> None:
-    assert len(DESCRIPTION) < 70
-    text = build()
-    SCENES.mkdir(exist_ok=True)
-    path = SCENES / OUT_NAME
-    path.write_text(text, encoding="utf-8", newline="\n")
-    print(f"wrote {path}")
+    write_scene(OUT_NAME, DESCRIPTION, build())
 
 
 if __name__ == "__main__":

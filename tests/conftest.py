@@ -2,12 +2,24 @@
 
 Hypothesis explores new random examples on every local run; under CI (CI=true)
 it is derandomized, so a CI run is reproducible and never fails by chance.
+
+Before -m "not slow" deselects anything, the collected test files are recorded with
+whether each has a test outside the slow tier (tests/test_layout.py checks that
+every one has).
 """
 
 import os
 
+import pytest
 from hypothesis import settings
+
+from .tiers import record_fast_tests
 
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
 settings.register_profile("dev", deadline=None)
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    record_fast_tests(config, items)

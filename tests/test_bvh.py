@@ -328,6 +328,7 @@ def first_mismatch(example) -> str | None:
     return None
 
 
+@pytest.mark.slow
 @settings(max_examples=200, suppress_health_check=[HealthCheck.too_slow])
 @given(scenes_with_queries())
 def test_bvh_hits_equal_brute_force_hits(example):

@@ -10,13 +10,7 @@ import numpy as np
 import rtpy.integrators.center as center
 import rtpy.vec3 as vec3
 from rtpy import Camera, Color, HitInfo, Interval, Scene, Vec3
-from rtpy.grading import (
-    assert_render_matches,
-    load_reference,
-    points,
-    render_stack,
-    summarize,
-)
+from rtpy.grading import assert_renders_match, points, reference_summary
 from rtpy.materials import DiffuseLight, Lambertian
 from rtpy.testing import chi2_sf
 
@@ -209,19 +203,17 @@ REFERENCE = {"name": "jittered_sky", "seeds": tuple(range(100, 108)), "spp": 32}
 
 
 def make_reference_summary():
-    settings = dict(RENDER, spp=REFERENCE["spp"])
-    stack = render_stack(sky_scene(), REFERENCE["seeds"], **settings)
-    return summarize(stack, REFERENCE["spp"])
+    return reference_summary(sky_scene(), RENDER, REFERENCE)
 
 
 @points(2)
 def test_sky_render_matches_reference():
     """jittered render of the sky matches the reference (camera rays and pixel jitter)"""
-    stack = render_stack(sky_scene(), SEEDS, **RENDER)
-    assert_render_matches(
-        stack,
-        RENDER["spp"],
-        load_reference(HERE / "reference" / f"{REFERENCE['name']}.npz"),
+    assert_renders_match(
+        sky_scene(),
+        SEEDS,
+        RENDER,
+        HERE / "reference" / f"{REFERENCE['name']}.npz",
         "jittered render of the sky (rtpy/camera.py: _ray_through, get_ray) differs from the "
         "reference beyond its noise: rays through the wrong points of the pixels (pixel "
         "(0, 0) is the top-left one; a jittered sample is uniform over -0.5..0.5 around the "

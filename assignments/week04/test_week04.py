@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from rtpy import Camera, Color, Interval, Lambertian, Quad, Ray, Scene, Sphere, Triangle, Vec3
-from rtpy.grading import assert_image_matches, points, render_stack
+from rtpy.grading import assert_image_matches, deterministic_image, points
 
 HERE = Path(__file__).parent
 M = Lambertian()
@@ -89,6 +89,17 @@ def test_sphere_hit_info():
         )
 
 
+def plane_t(o, d, corner, e1, e2, inside):
+    """t > 0 where the ray o + t d meets the plane corner + a e1 + b e2 at a point with
+    inside(a, b), else None (also for a ray parallel to the plane)."""
+    n = np.cross(e1, e2)
+    if abs(n @ d) <= 1e-9:
+        return None
+    t = n @ (corner - o) / (n @ d)
+    a, b = np.linalg.lstsq(np.stack([e1, e2], 1), o + t * d - corner, rcond=None)[0]
+    return t if t > 0 and inside(a, b) else None
+
+
 @points(3)
 def test_quad_hit():
     """Quad.hit_t: the plane, then 0 <= alpha, beta <= 1"""
@@ -96,13 +107,7 @@ def test_quad_hit():
     for k in range(300):
         q, u, w = rng.uniform(-1, 1, 3), rng.normal(size=3), rng.normal(size=3)
         o, d = random_ray(rng, q + 0.5 * u + 0.5 * w)
-        n = np.cross(u, w)
-        expected = None
-        if abs(n @ d) > 1e-9:
-            t = n @ (q - o) / (n @ d)
-            a, b = np.linalg.lstsq(np.stack([u, w], 1), o + t * d - q, rcond=None)[0]
-            if t > 0 and 0 <= a <= 1 and 0 <= b <= 1:
-                expected = t
+        expected = plane_t(o, d, q, u, w, lambda a, b: 0 <= a <= 1 and 0 <= b <= 1)
         got = Quad(v(q), v(u), v(w), M).hit_t(Ray(v(o), v(d)), 0.0, math.inf)
         check_t(got, expected, f"Quad.hit_t (rtpy/quad.py), case {k}")
 
@@ -114,14 +119,9 @@ def test_triangle_hit():
     for k in range(300):
         a, b, c = (rng.uniform(-1.5, 1.5, 3) for _ in range(3))
         o, d = random_ray(rng, (a + b + c) / 3)
-        e1, e2 = b - a, c - a
-        n = np.cross(e1, e2)
-        expected = None
-        if abs(n @ d) > 1e-9:
-            t = n @ (a - o) / (n @ d)
-            bu, bv = np.linalg.lstsq(np.stack([e1, e2], 1), o + t * d - a, rcond=None)[0]
-            if t > 0 and bu >= 0 and bv >= 0 and bu + bv <= 1:
-                expected = t
+        expected = plane_t(
+            o, d, a, b - a, c - a, lambda bu, bv: bu >= 0 and bv >= 0 and bu + bv <= 1
+        )
         got = Triangle(v(a), v(b), v(c), M).hit_t(Ray(v(o), v(d)), 0.0, math.inf)
         check_t(got, expected, f"Triangle._barycentric (rtpy/triangle.py), case {k}")
 
@@ -168,13 +168,13 @@ REFERENCE = {"name": "center_shapes"}
 
 
 def make_reference_image():
-    return render_stack(shapes_scene(), (0,), integrator="center", spp=1)[0]
+    return deterministic_image(shapes_scene(), integrator="center")
 
 
 @points(2)
 def test_center_render_matches_reference():
     """center integrator render of spheres, a quad and a triangle matches the reference"""
-    image = render_stack(shapes_scene(), (0,), integrator="center", spp=1)[0]
+    image = deterministic_image(shapes_scene(), integrator="center")
     reference = np.load(HERE / "reference" / f"{REFERENCE['name']}.npy")
     assert_image_matches(
         image, reference, "center render", "check which object is closest "

@@ -12,7 +12,7 @@ import numpy as np
 
 import rtpy.testing as rt
 from rtpy import Color, Interval, Lambertian, PointLight, Quad, Ray, Scene, Sphere, Vec3
-from rtpy.grading import assert_render_matches, load_reference, points, render_stack
+from rtpy.grading import assert_renders_match, points, reference_summary
 from rtpy.integrators import DirectIntegrator
 from rtpy.materials import DiffuseLight
 from rtpy.render_settings import RenderSettings
@@ -191,23 +191,17 @@ REFERENCE = {"name": "direct_area_light", "seeds": tuple(range(100, 108)), "spp"
 
 
 def make_reference_summary():
-    from rtpy.grading import summarize
-
-    settings = dict(RENDER, spp=REFERENCE["spp"])
-    return summarize(
-        render_stack(area_light_scene(), REFERENCE["seeds"], **settings), REFERENCE["spp"]
-    )
+    return reference_summary(area_light_scene(), RENDER, REFERENCE)
 
 
 @points(4)
 def test_direct_render_matches_reference():
     """direct integrator: area and point light render matches the reference (light counted once)"""
-    stack = render_stack(area_light_scene(), SEEDS, **RENDER)
-    reference = load_reference(HERE / "reference" / f"{REFERENCE['name']}.npz")
-    assert_render_matches(
-        stack,
-        RENDER["spp"],
-        reference,
+    assert_renders_match(
+        area_light_scene(),
+        SEEDS,
+        RENDER,
+        HERE / "reference" / f"{REFERENCE['name']}.npz",
         "direct integrator (rtpy/integrators/direct_lighting.py) differs from the reference "
         "beyond its noise. Too bright near the light: light counted twice (the emission a "
         "BRDF-sampled ray finds must carry the MIS weight); too dark: a missing 1/pdf or "

@@ -10,7 +10,7 @@ import numpy as np
 import rtpy.materials.dielectric as dielectric
 import rtpy.vec3 as vec3
 from rtpy import Camera, Color, HitInfo, Lambertian, PointLight, Quad, Ray, Scene, Sphere, Vec3
-from rtpy.grading import assert_image_matches, points, render_stack
+from rtpy.grading import assert_image_matches, deterministic_image, points
 from rtpy.materials import Dielectric, Mirror
 from rtpy.sampling import make_generator, use_generator
 
@@ -180,7 +180,7 @@ REFERENCE = {"name": "whitted_optics"}
 
 
 def make_reference_image():
-    return render_stack(optics_scene(), (0,), integrator="whitted", spp=1, max_depth=8)[0]
+    return deterministic_image(optics_scene(), integrator="whitted", max_depth=8)
 
 
 @points(3)
@@ -188,7 +188,7 @@ def test_whitted_render_matches_reference():
     """whitted render of a glass and a mirror ball matches the reference"""
     # Whitted with a point light and a pinhole is deterministic; spp 1 shows
     # each pixel's jittered sample, so the seed fixes the image.
-    image = render_stack(optics_scene(), (0,), integrator="whitted", spp=1, max_depth=8)[0]
+    image = deterministic_image(optics_scene(), integrator="whitted", max_depth=8)
     reference = np.load(HERE / "reference" / f"{REFERENCE['name']}.npy")
     assert_image_matches(
         image, reference, "whitted render", "glass that renders dark or opaque means "

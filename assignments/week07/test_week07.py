@@ -19,7 +19,7 @@ from rtpy import (
     Sphere,
     Vec3,
 )
-from rtpy.grading import assert_image_matches, points, render_stack
+from rtpy.grading import assert_image_matches, deterministic_image, points
 from rtpy.materials import Lambertian, Metal
 from rtpy.sampling import make_generator, use_generator
 
@@ -188,13 +188,13 @@ REFERENCE = {"name": "center_textures"}
 
 
 def make_reference_image():
-    return render_stack(texture_scene(), (0,), integrator="center", spp=1)[0]
+    return deterministic_image(texture_scene(), integrator="center")
 
 
 @points(2)
 def test_texture_render_matches_reference():
     """center render of checker and image textures matches the reference"""
-    image = render_stack(texture_scene(), (0,), integrator="center", spp=1)[0]
+    image = deterministic_image(texture_scene(), integrator="center")
     reference = np.load(HERE / "reference" / f"{REFERENCE['name']}.npy")
     assert_image_matches(
         image, reference, "center render with textures",

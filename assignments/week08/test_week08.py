@@ -18,7 +18,7 @@ import pytest
 import rtpy.materials.phong as phong
 import rtpy.testing as rt
 from rtpy import Camera, Color, Lambertian, Quad, Scene, Sphere, Vec3
-from rtpy.grading import assert_render_matches, load_reference, points, render_stack, summarize
+from rtpy.grading import assert_renders_match, points, reference_summary, render_stack
 from rtpy.materials import BlinnPhong, CookTorrance, DiffuseLight, Phong
 
 HERE = Path(__file__).parent
@@ -354,18 +354,17 @@ REFERENCE = {"name": "path_three_balls", "seeds": tuple(range(100, 108)), "spp":
 
 
 def make_reference_summary():
-    settings = dict(RENDER, spp=REFERENCE["spp"])
-    return summarize(render_stack(three_balls(), REFERENCE["seeds"], **settings), REFERENCE["spp"])
+    return reference_summary(three_balls(), RENDER, REFERENCE)
 
 
 @points(4)
 def test_path_render_matches_reference():
     """path integrator: three glossy balls under a quad light match the reference"""
-    stack = render_stack(three_balls(), SEEDS, **RENDER)
-    assert_render_matches(
-        stack,
-        RENDER["spp"],
-        load_reference(HERE / "reference" / f"{REFERENCE['name']}.npz"),
+    assert_renders_match(
+        three_balls(),
+        SEEDS,
+        RENDER,
+        HERE / "reference" / f"{REFERENCE['name']}.npz",
         "path integrator (rtpy/integrators/path.py) with the week's materials differs from "
         "the reference beyond its noise. Too bright: light counted twice (MIS weight of "
         "emission found by a bounce) or a weight without 1/pdf; too dark: Russian roulette "

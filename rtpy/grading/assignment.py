@@ -57,12 +57,14 @@ END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
 COPIED = ("pyproject.toml", ".gitignore", "scenes", "docs")
 TEST_WEEKS_FILE = "assignments/test_weeks.toml"
 # Tests that belong to rtpy's own repository only (and are not mapped): the assignment
-# machinery's, which grade every week and generate repositories, and the checks of
-# rtpy's README (a student repository's README.md is the week's).
+# machinery's, which grade every week and generate repositories, the checks of rtpy's
+# README (a student repository's README.md is the week's) and of its layout (which
+# counts the numpy backend's modules and tests).
 MACHINERY_TESTS = (
     "tests/grading/test_graders.py",
     "tests/grading/test_assignment.py",
     "tests/docs/test_pages.py",
+    "tests/test_layout.py",
 )
 # A test file that uses the numpy backend (withheld from student repositories).
 NUMPY_USE = re.compile(r"numpy_backend|[\"']numpy[\"']|rtpy\.BACKENDS")
@@ -239,6 +241,25 @@ def shipped_tests(root: Path, week: str) -> tuple[list[str], list[str]]:
     return kept, left
 
 
+# The student repository's pytest options: `python -m pytest` runs the graders too, and
+# leaves out the slow tier (`python -m pytest -m ""` runs everything).
+STUDENT_PYTEST_OPTIONS = {
+    'testpaths = ["tests"]': 'testpaths = ["tests", "assignments"]',
+    'addopts = "-ra --strict-markers"': "addopts = \"-ra --strict-markers -m 'not slow'\"",
+}
+
+
+def student_pytest_options(pyproject: Path) -> None:
+    """Rewrite pyproject's pytest options as STUDENT_PYTEST_OPTIONS says; AssignmentError
+    where an option to change is not there."""
+    text = pyproject.read_text()
+    for old, new in STUDENT_PYTEST_OPTIONS.items():
+        if old not in text:
+            raise AssignmentError(f"{pyproject.name}: no `{old}` to change for the students")
+        text = text.replace(old, new)
+    pyproject.write_text(text)
+
+
 def make_assignment(week: str | int, out_dir: str | Path, root: str | Path | None = None) -> Path:
     """Write week's student repository to out_dir (which must not exist or be empty).
     Everything is written to a temporary directory next to it and renamed at the end,
@@ -290,13 +311,7 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
             shutil.copytree(path, dest / name, ignore=ignore)
         elif path.exists():
             shutil.copy2(path, dest / name)
-    # `python -m pytest` runs the graders too
-    pyproject = dest / "pyproject.toml"
-    pyproject.write_text(
-        pyproject.read_text().replace(
-            'testpaths = ["tests"]', 'testpaths = ["tests", "assignments"]'
-        )
-    )
+    student_pytest_options(dest / "pyproject.toml")
     # the week's own folder, and the tests that can pass
     shutil.copytree(
         root / "assignments" / f"week{week}", dest / "assignments" / f"week{week}", ignore=ignore
@@ -314,7 +329,9 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
         + f"(`assignments/week{week}/`) and prints your score; "
         + f"`python -m pytest assignments/week{week} -x` shows the first failure's traceback, "
         + "and `python -m pytest` runs the graders with rtpy's own tests that apply this "
-        + "week. `docs/students.md` explains how to work on an assignment and "
+        + "week, all but the slow ones (long statistical and end-to-end tests); "
+        + '`python -m pytest -m ""` runs everything, the slow tests included. '
+        + "`docs/students.md` explains how to work on an assignment and "
         + "`docs/course-map.md` where each name of the course's code is in rtpy. "
         + "Left out because they "
         + "test code you write this week or later, or the numpy backend (withheld here: "
@@ -365,6 +382,32 @@ def pytest_runtest_setup(item):
 """
 
 
+def _write_instrumented_copy(root: Path, dest: Path) -> None:
+    """rtpy, the tests and what they read, copied to dest with a probe before every
+    solution region that records the week in the log of the test file running it."""
+    for path in sorted((root / "rtpy").rglob("*.py")):
+        target = dest / path.relative_to(root)
+        target.parent.mkdir(parents=True, exist_ok=True)
+
+        def record(r: Region) -> list[str]:
+            lines = (root / r.path).read_text().splitlines(keepends=True)
+            probe = f'{r.indent}_rtpy_armed["{r.week}"] and _rtpy_hit("{r.week}")\n'
+            return [probe, *lines[r.begin : r.end + 1]]
+
+        target.write_text(rewrite(path, root, record))
+    (dest / "rtpy" / "_region_log.py").write_text(REGION_LOG_MODULE)
+    init = dest / "rtpy" / "__init__.py"
+    head = "from __future__ import annotations\n"
+    init.write_text(init.read_text().replace(head, head + "from . import _region_log\n", 1))
+    (dest / "region_log_plugin.py").write_text(REGION_LOG_PLUGIN)
+    for name in (*COPIED, "tests", "README.md"):
+        path = root / name
+        if path.is_dir():
+            shutil.copytree(path, dest / name, ignore=shutil.ignore_patterns("__pycache__"))
+        elif path.exists():
+            shutil.copy2(path, dest / name)
+
+
 def map_tests(
     root: str | Path | None = None,
     pytest_args: tuple[str, ...] = (),
@@ -386,28 +429,7 @@ def map_tests(
             return {k: set(v) for k, v in weeks_of_tests(root).items()}
     with tempfile.TemporaryDirectory(prefix="rtpy-map-tests-") as tmp:
         dest = Path(tmp)
-        for path in sorted((root / "rtpy").rglob("*.py")):
-            rel = path.relative_to(root)
-            target = dest / rel
-            target.parent.mkdir(parents=True, exist_ok=True)
-
-            def record(r: Region) -> list[str]:
-                lines = (root / r.path).read_text().splitlines(keepends=True)
-                probe = f'{r.indent}_rtpy_armed["{r.week}"] and _rtpy_hit("{r.week}")\n'
-                return [probe, *lines[r.begin : r.end + 1]]
-
-            target.write_text(rewrite(path, root, record))
-        (dest / "rtpy" / "_region_log.py").write_text(REGION_LOG_MODULE)
-        init = dest / "rtpy" / "__init__.py"
-        head = "from __future__ import annotations\n"
-        init.write_text(init.read_text().replace(head, head + "from . import _region_log\n", 1))
-        (dest / "region_log_plugin.py").write_text(REGION_LOG_PLUGIN)
-        for name in (*COPIED, "tests", "README.md"):
-            path = root / name
-            if path.is_dir():
-                shutil.copytree(path, dest / name, ignore=shutil.ignore_patterns("__pycache__"))
-            elif path.exists():
-                shutil.copy2(path, dest / name)
+        _write_instrumented_copy(root, dest)
         log = dest / "regions.log"
         env = dict(os.environ, RTPY_REGION_LOG=str(log), PYTHONPATH=str(dest))
         subprocess.run(

@@ -96,6 +96,27 @@ def assert_render_matches(stack: np.ndarray, spp: int, reference: dict, what: st
     assert result.passed, f"{what}: {result.worst()}"
 
 
+def reference_summary(scene, render: dict, reference: dict) -> dict[str, np.ndarray]:
+    """What a grader stores as its reference: the summary of renders of scene with the
+    grader's `render` settings, at reference["spp"] with the seeds reference["seeds"]."""
+    spp = reference["spp"]
+    return summarize(render_stack(scene, reference["seeds"], **dict(render, spp=spp)), spp)
+
+
+def assert_renders_match(scene, seeds, render: dict, reference: str | Path, what: str) -> None:
+    """Renders of scene, one per seed with the `render` settings, agree with the
+    reference summary stored at `reference` (assert_render_matches)."""
+    stack = render_stack(scene, seeds, **render)
+    assert_render_matches(stack, render["spp"], load_reference(reference), what)
+
+
+def deterministic_image(scene, **settings) -> np.ndarray:
+    """The render at spp 1 with seed 0, for graders that compare an image with their
+    reference to rounding: the "center" integrator's, or one jittered sample per pixel
+    of an integrator that draws no other random number (Whitted's with point lights)."""
+    return render_stack(scene, (0,), spp=1, **settings)[0]
+
+
 def assert_image_matches(
     image: np.ndarray, reference: np.ndarray, what: str, hint: str, rtol: float, atol: float
 ) -> None:

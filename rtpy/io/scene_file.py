@@ -130,13 +130,7 @@ class _Loader(TableReader):
             for i, t in enumerate(self.array_of_tables(data, "lights"))
         ]
         return Scene(
-            objects=objects,
-            point_lights=lights,
-            background=background,
-            sky=sky,
-            camera=camera,
-            settings=settings,
-            name=self.path.stem,
+            objects, lights, background, sky, camera=camera, settings=settings, name=self.path.stem
         )
 
     def camera(self, t: dict) -> Camera:

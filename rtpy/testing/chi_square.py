@@ -365,21 +365,26 @@ def chi2_test(
         raise ValueError("a specular (delta) material has no density to test")
     start = time.perf_counter()
     samples = get_samples(material, incident_deg, n_samples, seed, phi_deg, samples)
+    hist = _histogram(samples, theta_bins, phi_bins)
+    ray_view = incident_ray(incident_deg, phi_deg)
+    bins = _BinIntegrals(material, ray_view, (theta_bins, phi_bins), samples.n, node_spacing)
+    integral, errors = bins.integrate_all(hist, samples.n)
+    result = _assess(samples, hist, bins, integral, errors, min_expected)
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def _assess(samples: Samples, hist: _Histogram, bins, integral, errors, min_expected):
+    """The Chi2Result of the samples binned in hist against the integrals of pdf()
+    over the bins (and their estimated errors)."""
     n = samples.n
     n_absorbed = int(np.count_nonzero(samples.status == ABSORBED))
     n_specular = int(np.count_nonzero(samples.status == SPECULAR))
-    hist = _histogram(samples, theta_bins, phi_bins)
-
-    ray_view = incident_ray(incident_deg, phi_deg)
-    bins = _BinIntegrals(material, ray_view, (theta_bins, phi_bins), n, node_spacing)
-    integral, errors = bins.integrate_all(hist, n)
-
     expected = n * integral
     pdf_integral = float(integral.sum())
     expected_absorbed = max(0.0, n * (1.0 - pdf_integral))
     observed_absorbed = float(n_absorbed + n_specular)
     message = _outright_failure(bins.bad_values, pdf_integral, errors, hist, integral)
-
     uncertainty = n * float(errors.sum())
     statistic, n_categories = _pearson(
         hist.observed, expected, observed_absorbed, expected_absorbed, uncertainty, min_expected
@@ -392,7 +397,9 @@ def chi2_test(
         message = "too few samples for a test (all bins pooled into one)"
     else:
         p_value = chi2_sf(statistic, dof)
-
+    worst = _worst(
+        hist.observed, expected, min_expected, observed_absorbed, expected_absorbed, pdf_integral
+    )
     return Chi2Result(
         p_value=p_value,
         statistic=statistic,
@@ -402,23 +409,15 @@ def chi2_test(
         n_specular=n_specular,
         expected_absorbed=expected_absorbed,
         pdf_integral=pdf_integral,
-        upper_integral=float(integral[: theta_bins // 2].sum()),
+        upper_integral=float(integral[: integral.shape[0] // 2].sum()),
         integration_error=float(errors.sum()),
         pdf_evaluations=bins.evaluations,
         n_categories=n_categories,
         observed=hist.observed,
         expected=expected,
-        worst=_worst(
-            hist.observed,
-            expected,
-            min_expected,
-            observed_absorbed,
-            expected_absorbed,
-            pdf_integral,
-        ),
+        worst=worst,
         message=message,
         note=f"quadrature of pdf() uncertain by {uncertainty:.1f} samples"
         if uncertainty > 1.0
         else "",
-        seconds=time.perf_counter() - start,
     )

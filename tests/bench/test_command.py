@@ -12,6 +12,8 @@ import pytest
 from rtpy.bench.scenes import VARIANTS
 from rtpy.io.cli import main
 
+from ..commands import read_until, rtpy_command
+
 
 def read_outputs(out):
     with (out / "bench.csv").open() as f:
@@ -20,6 +22,7 @@ def read_outputs(out):
     return rows, doc
 
 
+@pytest.mark.slow
 def test_quick_bench_runs_end_to_end_and_its_files_parse(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if not installed
     out, cache = tmp_path / "out", tmp_path / "cache"
@@ -45,6 +48,7 @@ def test_quick_bench_runs_end_to_end_and_its_files_parse(tmp_path, capsys, monke
     assert list(cache.glob("week05_point_light-w16-d*.npz"))
 
 
+@pytest.mark.slow
 def test_bench_plot_is_drawn_when_matplotlib_is_installed(tmp_path):
     pytest.importorskip("matplotlib")
     out = tmp_path / "out"
@@ -71,28 +75,24 @@ def test_bad_bench_options_exit_2_and_write_nothing(tmp_path, capsys, args, mess
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_the_levels_measured(tmp_path):
     """SIGINT to a real bench: it stops, writes the levels finished so far, exits 130."""
-    import os
     import signal
     import subprocess
-    import time
 
     out = tmp_path / "out"
     args = ["bench", "plane_sky_band", "--spp", "1,2,4,8,100000", "--width", "16"]
     parent_handler = signal.getsignal(signal.SIGINT)
     proc = subprocess.Popen(
-        [sys.executable, "-m", "rtpy", *args, "--out", str(out)],
+        rtpy_command(*args, "--out", str(out)),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
         # a child inherits an ignored SIGINT; make sure Ctrl-C reaches it as in a shell
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
-    deadline = time.monotonic() + 60
-    seen = ""
-    while time.monotonic() < deadline and "spp 8:" not in seen:
-        seen += os.read(proc.stderr.fileno(), 4096).decode()
+    seen = read_until(proc, lambda text: "spp 8:" in text)
     # Level 8 is recorded before its line is printed; from here on, wherever the
     # signal lands (between levels or inside the render of 100000 spp), the run
     # stops with the levels 1, 2, 4 and 8.

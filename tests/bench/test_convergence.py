@@ -62,6 +62,7 @@ def unbiased():
     return merged
 
 
+@pytest.mark.slow
 def test_every_unbiased_integrator_passes_the_convergence_check(unbiased):
     assert unbiased.problems() == []
     fitted = {(f.scene, f.integrator) for f in unbiased.fits if f.slope is not None}
@@ -74,12 +75,14 @@ def test_every_unbiased_integrator_passes_the_convergence_check(unbiased):
             assert abs(f.slope + 1) < SLOPE_TOLERANCE, f
 
 
+@pytest.mark.slow
 def test_slope_standard_error_is_small_enough(unbiased):
     for f in unbiased.fits:
         if f.slope is not None:
             assert 0 < f.slope_se <= SLOPE_TOLERANCE / 4, f
 
 
+@pytest.mark.slow
 def test_exact_scenes_have_zero_error(unbiased):
     """The convex furnace (every sample exact) and direct light inside the glowing
     sphere have no error beyond rounding: no slope to fit, and no bias."""
@@ -89,6 +92,7 @@ def test_exact_scenes_have_zero_error(unbiased):
             assert not lv.significant
 
 
+@pytest.mark.slow
 def test_nee_only_and_mis_agree_with_the_exact_image(unbiased):
     """On the sphere-light plane, light sampling alone, BRDF sampling alone and MIS
     all converge to the closed form, and MIS is the most efficient at 64 spp."""

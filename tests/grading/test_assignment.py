@@ -37,6 +37,7 @@ from rtpy.grading.assignment import (
     map_tests,
     regions_in,
     shipped_tests,
+    student_pytest_options,
     weeks_of_tests,
 )
 from rtpy.io.cli import main
@@ -57,7 +58,8 @@ import pytest
 from rtpy.grading import grade
 results = grade(sys.argv[1])
 shipped = sys.argv[2:]
-status = pytest.main(["-q", "-p", "no:cacheprovider", *shipped]) if shipped else 0
+# -m "": every shipped test, the slow ones too (the repository's default leaves them out)
+status = pytest.main(["-q", "-p", "no:cacheprovider", "-m", "", *shipped]) if shipped else 0
 print(json.dumps({"grade": results, "shipped": int(status)}))
 """
 
@@ -104,6 +106,15 @@ def test_bad_week_and_non_empty_output_are_refused(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["full"]  # nothing half-written
 
 
+def test_student_pytest_options_refuse_a_pyproject_without_them(tmp_path):
+    """The student repository's pyproject.toml gets its pytest options by replacing
+    rtpy's; a pyproject where one is missing is refused, not silently left as it is."""
+    pyproject = tmp_path / "pyproject.toml"
+    pyproject.write_text('[tool.pytest.ini_options]\ntestpaths = ["tests"]\naddopts = "-ra"\n')
+    with pytest.raises(AssignmentError, match="addopts"):
+        student_pytest_options(pyproject)
+
+
 def check_regions(repo: Path, week: str) -> None:
     """Week `week` and later: the region's code is gone and a stub naming the week's
     task and the function stands in its place. Earlier weeks: the code is there."""
@@ -119,13 +130,18 @@ def check_regions(repo: Path, week: str) -> None:
             assert block in text, f"{r.path}: {r.function}: week {r.week} solution missing"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("week", WEEKS)
 def test_student_repository(tmp_path, week):
     repo = make_assignment(week, tmp_path / f"week{week}")
     check_regions(repo, week)
     assert not (repo / "rtpy" / "numpy_backend" / "scene.py").exists()
     with open(repo / "pyproject.toml", "rb") as f:  # pip install needs every listed package
-        setup = tomllib.load(f)["tool"]["setuptools"]
+        tool = tomllib.load(f)["tool"]
+    setup, options = tool["setuptools"], tool["pytest"]["ini_options"]
+    assert options["testpaths"] == ["tests", "assignments"]
+    assert "-m 'not slow'" in options["addopts"]  # the student's everyday loop
+    assert 'python -m pytest -m ""' in (repo / "README.md").read_text()  # and everything
     for package in setup["packages"]:
         folder = setup["package-dir"].get(package, package.replace(".", "/"))
         assert (repo / folder).is_dir() and any((repo / folder).iterdir()), package
@@ -159,10 +175,7 @@ def test_map_tests_of_some_files_records_their_weeks_and_keeps_the_rest(tmp_path
     (tmp_path / "rtpy").mkdir()
     (tmp_path / "rtpy" / "__init__.py").write_text("from __future__ import annotations\n")
     (tmp_path / "rtpy" / "shade.py").write_text(
-        "def twice(x):\n"
-        "    # BEGIN SOLUTION week05: twice\n"
-        "    return 2 * x\n"
-        "    # END SOLUTION\n"
+        "def twice(x):\n    # BEGIN SOLUTION week05: twice\n    return 2 * x\n    # END SOLUTION\n"
     )
     (tmp_path / "tests").mkdir()
     (tmp_path / "tests" / "test_shade.py").write_text(

@@ -32,7 +32,7 @@ import rtpy.materials.mirror as mirror
 import rtpy.materials.phong as phong
 import rtpy.vec3 as vec3
 from rtpy import Camera, CheckerTexture, ImageTexture, PointLight, Quad, Ray, Scene, Sphere
-from rtpy.grading import compare, summarize
+from rtpy.grading import compare, render_stack, summarize
 from rtpy.grading.assignment import WEEKS
 from rtpy.io.cli import main
 from rtpy.materials import CookTorrance, Lambertian, Metal, Phong
@@ -445,6 +445,7 @@ def test_every_week_has_planted_mistakes():
     assert {w for w, _, _ in PLANTED} == set(WEEKS)
 
 
+@pytest.mark.slow
 def test_graders_pass_on_the_reference(tmp_path, capsys):
     """`python -m rtpy grade WEEK --json` on rtpy's solution: full score, Gradescope format."""
     for week in WEEKS:
@@ -468,8 +469,8 @@ def test_graders_pass_on_the_reference(tmp_path, capsys):
 def test_noise_aware_comparison_accepts_noise_and_rejects_bias():
     """compare(): two independent renders of the same scene agree; 5 % more light does not."""
     scene = grader("05").area_light_scene()
-    a = summarize(grader("05").render_stack(scene, (1, 2, 3, 4), integrator="direct", spp=8), 8)
-    b = summarize(grader("05").render_stack(scene, (5, 6, 7, 8), integrator="direct", spp=8), 8)
+    a = summarize(render_stack(scene, (1, 2, 3, 4), integrator="direct", spp=8), 8)
+    b = summarize(render_stack(scene, (5, 6, 7, 8), integrator="direct", spp=8), 8)
     assert compare(a, b).passed
     brighter = dict(b, mean=b["mean"] * 1.05)
     assert not compare(a, brighter).passed

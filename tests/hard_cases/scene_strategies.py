@@ -20,6 +20,7 @@ import math
 import os
 import random
 
+from hypothesis import HealthCheck, Phase, settings
 from hypothesis import strategies as st
 
 from rtpy.materials import MATERIALS
@@ -33,6 +34,19 @@ seeds = st.integers(0, 2**64 - 1)
 def examples(n: int) -> int:
     """n examples, times FUZZ_EXAMPLES."""
     return max(1, int(n * FUZZ_SCALE))
+
+
+def fuzz_settings(n: int) -> settings:
+    """The hypothesis settings of a fuzz test: examples(n) examples, derandomized, with
+    no deadline and no complaint about slow examples (each renders or runs a command);
+    a failure is shrunk but not explained."""
+    return settings(
+        max_examples=examples(n),
+        derandomize=True,
+        deadline=None,
+        suppress_health_check=[HealthCheck.too_slow],
+        phases=[Phase.explicit, Phase.reuse, Phase.generate, Phase.shrink],
+    )
 
 
 def cross(a, b) -> list[float]:

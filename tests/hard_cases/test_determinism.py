@@ -15,12 +15,13 @@ from __future__ import annotations
 
 import os
 import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import rtpy
+
+from ..commands import rtpy_command
 
 CASES = [
     ("cornell", {"integrator": "path", "spp": 2, "max_depth": 6}),
@@ -58,7 +59,7 @@ def test_same_image_in_another_process_with_another_hash_seed(tmp_path, backend)
     name, settings = CASES[0]
     out = tmp_path / "run.npy"
     env = {**os.environ, "PYTHONHASHSEED": "4242"}
-    argv = [sys.executable, "-m", "rtpy", "render", name, "--backend", backend]
+    argv = rtpy_command("render", name, "--backend", backend)
     kw = render_kw(backend, settings)
     argv += ["--width", str(kw["width"]), "--seed", "12345", "--workers", "2", "--quiet"]
     argv += [f"--set={k}={str(v).lower()}" for k, v in kw.items() if k in ("spp", "max_depth")]

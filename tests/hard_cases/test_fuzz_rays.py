@@ -24,14 +24,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import given
 
 from rtpy import Lambertian, Quad, Scene, Sphere, Triangle, Vec3
 from rtpy.interval import Interval
 from rtpy.numpy_backend.scene import BatchScene
 from rtpy.ray import Ray
 
-from .scene_strategies import examples, seeds
+from .scene_strategies import fuzz_settings, seeds
 
 N_RAYS = 40
 # Hits are o + t d rounded (the sphere puts it back on the surface): allow 1e-9 of
@@ -175,7 +175,7 @@ def numpy_hits(shape, o, d):
             yield i, (batch.t[k], batch.point[k], batch.normal[k], batch.u[k], batch.v[k])
 
 
-@settings(max_examples=examples(40), derandomize=True, deadline=None)
+@fuzz_settings(40)
 @given(seed=seeds)
 def test_random_rays_hit_every_primitive_soundly_on_both_backends(seed):
     rng = np.random.default_rng(seed)

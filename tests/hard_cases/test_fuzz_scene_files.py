@@ -19,21 +19,20 @@ from __future__ import annotations
 import contextlib
 import io
 import math
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, Phase, event, given, settings
+from hypothesis import event, given
 from hypothesis import strategies as st
 from PIL import Image
 
 from rtpy.io.cli import main
 from tests.io.scene_text import VALUES, to_toml
 
-from .scene_strategies import examples, random_scene, seeds
+from ..commands import run_cli
+from .scene_strategies import fuzz_settings, random_scene, seeds
 
 SMALL = ["--width", "4", "--spp", "1", "--set", "max_depth=2", "--quiet"]
 
@@ -198,13 +197,7 @@ def texture_png(tmp_path_factory) -> Path:
     return path
 
 
-@settings(
-    max_examples=examples(100),
-    derandomize=True,
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow],
-    phases=[Phase.explicit, Phase.reuse, Phase.generate, Phase.shrink],
-)
+@fuzz_settings(100)
 @given(case=broken_files(), backend=st.sampled_from(["scalar", "numpy"]))
 def test_broken_scene_file_renders_or_gives_one_clear_error(texture_png, case, backend):
     """The naive loader lets these through to the renderer, which then fails with a
@@ -267,9 +260,7 @@ def test_known_bad_files_give_one_clear_error(tmp_path, index):
     argv = ["render", str(scene), "-o", str(tmp_path / "out.png"), "--quiet"]
     runs = [run_main(argv)]
     if index in SUBPROCESS:
-        result = subprocess.run(
-            [sys.executable, "-m", "rtpy", *argv], capture_output=True, text=True, timeout=60
-        )
+        result = run_cli(*argv)
         runs.append((result.returncode, result.stderr))
     for status, stderr in runs:
         assert status == 2
@@ -313,7 +304,7 @@ OPTION_VALUES = {
 }  # fmt: skip
 
 
-@settings(max_examples=examples(60), derandomize=True, deadline=None)
+@fuzz_settings(60)
 @given(
     options=st.lists(
         st.sampled_from(sorted(OPTION_VALUES)).flatmap(

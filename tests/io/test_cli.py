@@ -6,8 +6,6 @@ import os
 import select
 import signal
 import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -20,13 +18,10 @@ from rtpy.io.cli import main
 from rtpy.io.image import read_pfm
 from rtpy.materials import MATERIALS
 
+from ..commands import read_until, rtpy_command, run_cli
+from ..tiers import slow_except
+
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
-
-
-def run_cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "rtpy", *args], capture_output=True, text=True, timeout=timeout
-    )
 
 
 def test_scenes_lists_every_bundled_scene_with_its_description():
@@ -133,15 +128,19 @@ def write(tmp_path: Path, text: str) -> Path:
 
 @pytest.mark.parametrize(
     "extra,message",
-    [
+    slow_except(
+        [
+            (["--set", "bogus=1"], "bogus"),
+            (["--set", "spp=0"], "spp"),
+            (["--set", "background=[1, 2]"], "background"),
+            (["--set", "nee"], "KEY=VALUE"),
+            (["-o", "no/such/dir/x.png"], "does not exist"),
+            (["-o", "x.gif"], ".gif"),
+            (["--linear", "x.png"], "x.png"),
+        ],
         (["--set", "bogus=1"], "bogus"),
-        (["--set", "spp=0"], "spp"),
-        (["--set", "background=[1, 2]"], "background"),
-        (["--set", "nee"], "KEY=VALUE"),
         (["-o", "no/such/dir/x.png"], "does not exist"),
-        (["-o", "x.gif"], ".gif"),
-        (["--linear", "x.png"], "x.png"),
-    ],
+    ),
 )
 def test_bad_options_exit_2_and_write_nothing(tmp_path, monkeypatch, extra, message):
     monkeypatch.chdir(tmp_path)
@@ -154,7 +153,10 @@ def test_bad_options_exit_2_and_write_nothing(tmp_path, monkeypatch, extra, mess
 
 @pytest.mark.parametrize(
     "extra",
-    [["--integrator", "pathh"], ["--spp", "-3"], ["--width", "x"], ["--workers", "100000"]],
+    slow_except(
+        [["--integrator", "pathh"], ["--spp", "-3"], ["--width", "x"], ["--workers", "100000"]],
+        ["--spp", "-3"],
+    ),
 )
 def test_argparse_errors_exit_2(extra):
     result = run_cli("render", "week08_three_balls", *extra)
@@ -199,24 +201,7 @@ def test_unknown_scene_name_exits_2():
 
 
 def start_render(*args: str) -> subprocess.Popen:
-    return subprocess.Popen(
-        [sys.executable, "-m", "rtpy", "render", *args], stderr=subprocess.PIPE, text=True
-    )
-
-
-def read_until(proc: subprocess.Popen, done, timeout: float = 120) -> str:
-    """Read the child's stderr until done(what was read) holds; returns what it read.
-    The deadline only ends a test whose child never gets there."""
-    deadline = time.monotonic() + timeout
-    seen = ""
-    while time.monotonic() < deadline:
-        chunk = os.read(proc.stderr.fileno(), 4096).decode()
-        if not chunk:
-            break  # the process ended
-        seen += chunk
-        if done(seen):
-            return seen
-    raise AssertionError(f"not seen within {timeout} s: {seen}")
+    return subprocess.Popen(rtpy_command("render", *args), stderr=subprocess.PIPE, text=True)
 
 
 def some_paths_done(seen: str) -> bool:
@@ -238,7 +223,8 @@ def wait_for_exit(pid: int, timeout: float = 60) -> bool:
 
 
 @pytest.mark.parametrize(
-    "backend,workers", [("scalar", "1"), ("scalar", "2"), ("numpy", "1"), ("numpy", "2")]
+    "backend,workers",
+    slow_except([("scalar", "1"), ("scalar", "2"), ("numpy", "1"), ("numpy", "2")], ("numpy", "1")),
 )
 def test_ctrl_c_writes_the_finished_samples(tmp_path, workers, backend):
     """SIGINT to a real render once samples are finished: it stops, writes a valid
@@ -260,6 +246,7 @@ def test_ctrl_c_writes_the_finished_samples(tmp_path, workers, backend):
         assert np.asarray(im).max() > 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_second_ctrl_c_exits_at_once(tmp_path, workers):
     """A second SIGINT while the partial image is being written ends the process at

@@ -14,37 +14,30 @@ from rtpy.io.values import Invalid, Range
 
 from .scene_text import MINIMAL, assert_names, error_of
 
-
-def test_wrong_type():
-    err = error_of('[camera]\nvfov = "wide"\n')
-    assert_names(err, "[camera]", "vfov")
-    assert "expected a number" in str(err) and '"wide"' in str(err)
-    err = error_of("[camera]\nlook_from = [1, 2]\n")
-    assert_names(err, "[camera]", "look_from")
-    assert "3" in str(err)
-    err = error_of('[render]\nsky = "yes"\n')
-    assert_names(err, "[render]", "sky")
-    assert "true or false" in str(err)
-    err = error_of("[render]\nnee = 1\n")
-    assert_names(err, "[render]", "nee")
+LIGHT = '[[lights]]\ntype = "point"\nposition = [0, true, 0]\nintensity = [1, 1, 1]\n'
 
 
-def test_float_for_integer_key_is_refused_with_a_hint():
-    err = error_of("[render]\nspp = 16.0\n")
-    assert_names(err, "[render]", "spp")
-    assert "integer" in str(err) and "write 16" in str(err)
-    err = error_of("[camera]\nwidth = 300.5\n")
-    assert_names(err, "[camera]", "width")
-
-
-def test_bool_is_not_a_number():
-    err = error_of("[camera]\nvfov = true\n")
-    assert_names(err, "[camera]", "vfov")
-    err = error_of("[render]\nspp = true\n")
-    assert_names(err, "[render]", "spp")
-    err = error_of('[[lights]]\ntype = "point"\nposition = [0, true, 0]\nintensity = [1, 1, 1]\n')
-    assert_names(err, "[[lights]] #1", "position")
-    assert "booleans are not numbers" in str(err)
+@pytest.mark.parametrize(
+    "text, table, key, words",
+    [
+        ('[camera]\nvfov = "wide"\n', "[camera]", "vfov", ["expected a number", '"wide"']),
+        ("[camera]\nlook_from = [1, 2]\n", "[camera]", "look_from", ["3"]),
+        ('[render]\nsky = "yes"\n', "[render]", "sky", ["true or false"]),
+        ("[render]\nnee = 1\n", "[render]", "nee", []),
+        # an integer key: a float is refused with a hint
+        ("[render]\nspp = 16.0\n", "[render]", "spp", ["integer", "write 16"]),
+        ("[camera]\nwidth = 300.5\n", "[camera]", "width", []),
+        # a boolean is not a number
+        ("[camera]\nvfov = true\n", "[camera]", "vfov", []),
+        ("[render]\nspp = true\n", "[render]", "spp", []),
+        (LIGHT, "[[lights]] #1", "position", ["booleans are not numbers"]),
+    ],
+)
+def test_a_value_of_the_wrong_type_is_refused(text, table, key, words):
+    err = error_of(text)
+    assert_names(err, table, key)
+    for word in words:
+        assert word in str(err)
 
 
 @pytest.mark.parametrize("value", ["nan", "inf", "-inf", "+inf", "-nan"])

@@ -15,13 +15,15 @@ from hypothesis import strategies as st
 
 from rtpy.hit_info import HitInfo
 from rtpy.io.scene_file import SceneError, load_scene_text
+from rtpy.materials import MATERIALS
 from rtpy.ray import Ray
 from rtpy.sampling import make_generator, use_generator
-from rtpy.vec3 import Vec3
+from rtpy.vec3 import Color, Vec3
 
 from ..vectors import cross3, dot3, unit3
 
 ALBEDO = (0.8, 0.5, 0.25)
+ALBEDO_COLOR = Color(*ALBEDO)
 POINT = (0.5, -0.25, 2.0)
 
 
@@ -30,6 +32,7 @@ POINT = (0.5, -0.25, 2.0)
 NORMAL = unit3((0.3, -0.5, 0.8))
 TANGENT = unit3(cross3(NORMAL, (0.0, 0.0, 1.0)))
 Z, X = (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)
+UP = (0.0, 1.0, 0.0)
 
 
 # Directions above the surface (degrees from the normal, azimuths), and weights kd, ks.
@@ -101,11 +104,24 @@ def half(wo, wi):
     return unit3(tuple(wo[i] + wi[i] for i in range(3)))
 
 
-def make_hit(material, normal=NORMAL, tangent=None) -> HitInfo:
-    hit = HitInfo(Vec3(*POINT), Vec3(*normal), 1.0, True, material)
+def make_hit(material, normal=NORMAL, tangent=None, point=POINT, front_face=True) -> HitInfo:
+    """A hit whose normal faces the arriving ray (as HitInfo promises); front_face False
+    for a ray that arrives from inside the object."""
+    hit = HitInfo(Vec3(*point), Vec3(*normal), 1.0, front_face, material)
     if tangent is not None:
         hit.tangent = Vec3(*tangent)
     return hit
+
+
+def incoming(direction, hit) -> Ray:
+    """A ray arriving at the hit point along `direction` (pointing toward the surface)."""
+    d = Vec3(*unit3(direction))
+    return Ray(hit.point - d, d)
+
+
+def leaving(direction, hit) -> Ray:
+    """A ray leaving the hit point along `direction`."""
+    return Ray(hit.point, Vec3(*unit3(direction)))
 
 
 def view_ray(wo) -> Ray:
@@ -289,6 +305,21 @@ def check_finite(m, pairs, n_samples, normal=NORMAL, tangent=None) -> None:
                     values = [*s.attenuation.tolist(), *s.scattered_ray.direction.tolist()]
                     assert all(math.isfinite(x) for x in [*values, s.pdf])
                     assert min(s.attenuation.tolist()) >= 0.0 and s.pdf > 0.0
+
+
+def check_defaults(cls, name: str, **expected):
+    """The material cls() made with no arguments, after checking that scene files know
+    it as `name`, that it has the attributes `expected` and the grey albedo
+    [0.5, 0.5, 0.5] (which the flat integrators show), and that it is neither specular
+    nor an emitter."""
+    assert MATERIALS[name] is cls
+    m = cls()
+    assert {key: getattr(m, key) for key in expected} == expected
+    hit = make_hit(m)
+    assert m.albedo.value(hit).tolist() == [0.5, 0.5, 0.5]
+    assert m.flat_color(hit).tolist() == [0.5, 0.5, 0.5]
+    assert m.is_specular is False and m.is_emitter is False
+    return m
 
 
 def load_material(keys: str, name: str = "shiny"):

@@ -19,7 +19,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rtpy.io.scene_file import SceneError
-from rtpy.materials import MATERIALS, Lambertian, OrenNayar
+from rtpy.materials import Lambertian, OrenNayar
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
@@ -28,6 +28,7 @@ from .directions import (
     ALBEDO,
     NORMAL,
     brdf,
+    check_defaults,
     check_finite,
     check_nothing_below,
     check_scattering,
@@ -244,11 +245,7 @@ def test_grazing_angles_give_finite_values(sigma, normal):
 
 
 def test_defaults_and_registration():
-    m = OrenNayar()
-    assert m.sigma == 20.0
-    assert m.albedo.color == Color(0.5, 0.5, 0.5)
-    assert MATERIALS["oren_nayar"] is OrenNayar
-    assert m.is_specular is False and m.is_emitter is False
+    check_defaults(OrenNayar, "oren_nayar", sigma=20.0)
 
 
 @pytest.mark.parametrize("sigma", [-1.0, -1e-9, 90.0, 95.0, math.nan, math.inf, "20", True])

@@ -40,17 +40,20 @@ N_SAMPLES = 100_000
 FAMILY_ALPHA = 0.01
 
 # name -> (constructor, keyword arguments, incident azimuth in degrees)
+# The cosine-power lobes, Phong's and Blinn-Phong's: (label, kd, ks, exponent).
+EXPONENTS = [
+    ("n=1", 0.0, 1.0, 1.0),
+    ("n=10 mix", 0.5, 0.5, 10.0),
+    ("n=100", 0.0, 1.0, 100.0),
+    ("n=1000 mix", 0.3, 0.7, 1000.0),
+    ("n=1e4", 0.0, 1.0, 1e4),
+]
 MODELS: dict[str, tuple[type, dict, float]] = {
-    "phong n=1": (Phong, dict(kd=0.0, ks=1.0, exponent=1.0), 0.0),
-    "phong n=10 mix": (Phong, dict(kd=0.5, ks=0.5, exponent=10.0), 0.0),
-    "phong n=100": (Phong, dict(kd=0.0, ks=1.0, exponent=100.0), 0.0),
-    "phong n=1000 mix": (Phong, dict(kd=0.3, ks=0.7, exponent=1000.0), 0.0),
-    "phong n=1e4": (Phong, dict(kd=0.0, ks=1.0, exponent=1e4), 0.0),
-    "blinn n=1": (BlinnPhong, dict(kd=0.0, ks=1.0, exponent=1.0), 0.0),
-    "blinn n=10 mix": (BlinnPhong, dict(kd=0.5, ks=0.5, exponent=10.0), 0.0),
-    "blinn n=100": (BlinnPhong, dict(kd=0.0, ks=1.0, exponent=100.0), 0.0),
-    "blinn n=1000 mix": (BlinnPhong, dict(kd=0.3, ks=0.7, exponent=1000.0), 0.0),
-    "blinn n=1e4": (BlinnPhong, dict(kd=0.0, ks=1.0, exponent=1e4), 0.0),
+    **{
+        f"{model} {label}": (cls, dict(kd=kd, ks=ks, exponent=n), 0.0)
+        for model, cls in (("phong", Phong), ("blinn", BlinnPhong))
+        for label, kd, ks, n in EXPONENTS
+    },
     "ggx a=0.01": (CookTorrance, dict(kd=0.0, ks=1.0, roughness=0.01), 0.0),
     "ggx a=0.1 mix": (CookTorrance, dict(kd=0.5, ks=0.5, roughness=0.1), 0.0),
     "ggx a=0.5 f0": (
@@ -163,18 +166,21 @@ def case_id(case: tuple[str, float]) -> str:
     return f"{case[0]} @{case[1]:g}deg"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=case_id)
 def test_sampling_follows_pdf(outcomes, case):
     o = outcomes[case]
     assert o.chi2_p >= ALPHA, f"p = {o.chi2_p:.3g} < {ALPHA:.3g}: {o.chi2_summary}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=case_id)
 def test_weight_is_brdf_cos_over_pdf(outcomes, case):
     o = outcomes[case]
     assert o.weights, o.weights_detail
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=case_id)
 def test_albedo_by_sampling_and_quadrature_agree_and_is_bounded(outcomes, case):
     o = outcomes[case]
@@ -250,6 +256,7 @@ PLANTED = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(PLANTED))
 def test_the_grid_test_rejects_planted_sampling_mistakes(name):
     material, angle, phi = PLANTED[name]

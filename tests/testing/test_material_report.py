@@ -11,6 +11,7 @@ from rtpy.testing import assert_material, check_material
 from .materials_to_check import CrashesAtGrazing, OverNormalised
 
 
+@pytest.mark.slow
 def test_check_material_passes_lambertian_and_reports_every_check():
     report = check_material(Lambertian())
     assert report.passed, str(report)
