@@ -2,22 +2,33 @@
 
 Hypothesis explores new random examples on every local run; under CI (CI=true)
 it is derandomized, so a CI run is reproducible and never fails by chance.
+Hypothesis also mixes constants from the modules already imported into its examples,
+so every rtpy module is imported here first: a test then draws the same examples
+whether it runs alone or in the whole suite.
 
 Before -m "not slow" deselects anything, the collected test files are recorded with
 whether each has a test outside the slow tier (tests/test_layout.py checks that
 every one has).
 """
 
+import importlib
 import os
+import pkgutil
 
 import pytest
 from hypothesis import settings
+
+import rtpy
 
 from .tiers import record_fast_tests
 
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
 settings.register_profile("dev", deadline=None)
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+for module in pkgutil.walk_packages(rtpy.__path__, "rtpy."):
+    if not module.name.endswith("__main__"):
+        importlib.import_module(module.name)
 
 
 @pytest.hookimpl(tryfirst=True)

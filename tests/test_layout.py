@@ -49,9 +49,6 @@ UNMIRRORED = {
     "rtpy/numpy_backend/materials/blinn_phong.py": (
         "tests/numpy_backend/materials/test_table.py, against the scalar model"
     ),
-    "rtpy/numpy_backend/materials/cook_torrance.py": (
-        "tests/numpy_backend/materials/test_table.py, against the scalar model"
-    ),
     "rtpy/numpy_backend/materials/oren_nayar.py": (
         "tests/numpy_backend/materials/test_table.py, against the scalar model"
     ),
