@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import io
 import os
+import secrets
 import stat
-import tempfile
 from collections.abc import Callable, Collection
 from pathlib import Path
 
@@ -115,18 +115,34 @@ def check_writable(
         if p.is_dir():
             raise OutputError(f"{where}: it is an existing directory")
         # What atomic_write will do (name too long, read-only file system, ...).
-        _temporary_file(p, delete=True).close()
+        tmp = _new_temporary_file(p)
+        tmp.unlink()
+        _temporary_files.discard(tmp)
     except OSError as e:
         raise OutputError(f"{where}: {e.strerror or e}") from None
     return p
 
 
-def _temporary_file(target: Path, delete: bool):
-    """The temporary file atomic_write writes before renaming it to target (its name
-    cut so that it is no longer than any name the file system takes)."""
-    return tempfile.NamedTemporaryFile(
-        delete=delete, dir=target.parent, prefix="." + target.name[:200] + ".", suffix=".tmp"
-    )
+# Temporary files of writes in progress, for a process that must exit at once.
+_temporary_files: set[Path] = set()
+
+
+def _new_temporary_file(target: Path) -> Path:
+    """Create the empty temporary file atomic_write writes before renaming it to
+    target, next to it (its name cut so that it is no longer than any name the file
+    system takes). The name is listed in ``_temporary_files`` before the file exists,
+    so that a signal at any moment finds every file it must remove."""
+    while True:
+        tmp = target.parent / f".{target.name[:200]}.{secrets.token_hex(4)}.tmp"
+        _temporary_files.add(tmp)
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+            return tmp
+        except FileExistsError:
+            _temporary_files.discard(tmp)
+        except BaseException:
+            _temporary_files.discard(tmp)
+            raise
 
 
 def check_image_path(path: StrPath) -> Path:
@@ -201,9 +217,7 @@ def atomic_write(path: StrPath, write_fn: Callable[[Path], object]) -> Path:
         mode = stat.S_IMODE(os.stat(target).st_mode)
     except OSError:
         mode = _new_file_mode()
-    with _temporary_file(target, delete=False) as tmp:
-        tmp_path = Path(tmp.name)
-        _temporary_files.add(tmp_path)
+    tmp_path = _new_temporary_file(target)
     try:
         write_fn(tmp_path)
         with open(tmp_path, "rb+") as f:  # make sure the data is on disk before renaming
@@ -216,10 +230,6 @@ def atomic_write(path: StrPath, write_fn: Callable[[Path], object]) -> Path:
     finally:
         _temporary_files.discard(tmp_path)
     return target
-
-
-# Temporary files of writes in progress, for a process that must exit at once.
-_temporary_files: set[Path] = set()
 
 
 def remove_temporary_files() -> None:

@@ -13,6 +13,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from PIL import Image
 
+from rtpy.io import image
 from rtpy.io.image import (
     OutputError,
     RenderedImage,
@@ -320,6 +321,26 @@ def test_failed_write_png_leaves_no_file(tmp_path: Path, monkeypatch: pytest.Mon
     monkeypatch.setattr(Image.Image, "save", fail)
     with pytest.raises(Boom):
         write_png(tmp_path / "img.png", rgb([0.5]), 2.0)
+    assert listing(tmp_path) == []
+
+
+def test_a_signal_as_the_temporary_file_appears_finds_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A second Ctrl-C removes the temporary files of writes in progress and exits;
+    if it lands just after the temporary file is created, before atomic_write
+    returns to Python code, that file must already be listed."""
+    real_open = os.open
+
+    def open_then_signal(path, flags, *args):
+        fd = real_open(path, flags, *args)
+        os.close(fd)
+        image.remove_temporary_files()  # what the signal handler does before os._exit
+        raise Boom("exited")
+
+    monkeypatch.setattr(image.os, "open", open_then_signal)
+    with pytest.raises(Boom):
+        write_npy(tmp_path / "out.npy", rgb([0.5]))
     assert listing(tmp_path) == []
 
 
