@@ -69,10 +69,10 @@ class Vec3:
 
     def __mul__(self, o: Vec3 | float) -> Vec3:
         v = _new(self.__class__)
-        if isinstance(o, Vec3):  # component-wise, for colours
-            v.e0, v.e1, v.e2 = self.e0 * o.e0, self.e1 * o.e1, self.e2 * o.e2
-        else:
+        if type(o) is float or not isinstance(o, Vec3):
             v.e0, v.e1, v.e2 = self.e0 * o, self.e1 * o, self.e2 * o
+        else:  # component-wise, for colours
+            v.e0, v.e1, v.e2 = self.e0 * o.e0, self.e1 * o.e1, self.e2 * o.e2
         return v
 
     def __rmul__(self, s: float) -> Vec3:
