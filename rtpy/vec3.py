@@ -121,14 +121,8 @@ class Color(Vec3):
 
     __slots__ = ()
 
-    def r(self) -> float:
-        return self.e0
-
-    def g(self) -> float:
-        return self.e1
-
-    def b(self) -> float:
-        return self.e2
+    # r(), g(), b(): the components x(), y(), z() under their colour names
+    r, g, b = Vec3.x, Vec3.y, Vec3.z
 
 
 Point3 = Vec3
