@@ -56,7 +56,10 @@ class HitInfo:
         u: float | None = None,
         v: float | None = None,
     ) -> None:
-        self.point, self.normal, self.t, self.front_face = point, normal, t, front_face
+        self.point = point
+        self.normal = normal
+        self.t = t
+        self.front_face = front_face
         self.material, self.obj = material, obj
         self._u, self._v = u, v  # None: computed on first access, as are these two
         self._tangent = self._frame = None
