@@ -67,10 +67,9 @@ class Scene:
 
     # Below this many objects the queries test every object (the loop of week 4's
     # exercise), from it on they walk the BVH. The BVH pays from about 8 objects
-    # (measured on the first n objects of rtiow_cover and on the bundled scenes:
-    # material_gallery's 9 render 6% faster with it, week05_point_light's 7 10%
-    # slower); 10 keeps the loop in use for the scenes of the weekly exercises.
-    # 0: always use the BVH.
+    # (measured on the first n objects of rtiow_cover and on the bundled scenes);
+    # 10 keeps the loop in use for the scenes of the weekly exercises. 0: always
+    # use the BVH.
     bvh_min_objects: int = 10
 
     def add_object(self, obj: Hittable) -> None:
