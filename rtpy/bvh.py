@@ -13,10 +13,10 @@ Conventions:
 - Objects are hit strictly inside the ray interval (t_min < t < t_max), as in
   Scene. Box tests accept the closed interval (t_min <= t <= t_max): a box test
   may let through a ray that then misses every object, never the other way round.
-- The result is exactly that of testing every object in list order
-  (Scene.find_intersection_brute_force): the smallest t, and among objects hit at
-  the same t the one earliest in the list. The floats are the objects' own, so
-  they are bit-identical too.
+- The result is exactly that of testing every object in list order (the Scene
+  queries' brute_force=True): the smallest t, and among objects hit at the same t
+  the one earliest in the list. The floats are the objects' own, so they are
+  bit-identical too.
 - Boxes are a little larger than the objects in them, because the box test and
   an object's hit test round differently. A shape's bounding_box() is padded by
   BOX_PADDING of its coordinates' size, which gives flat shapes (an axis-aligned
@@ -123,87 +123,18 @@ class AABB:
             0.5 * (self.z0 + self.z1),
         )
 
-    def entry(
-        self,
-        ox: float,
-        oy: float,
-        oz: float,
-        dx: float,
-        dy: float,
-        dz: float,
-        t_min: float,
-        t_max: float,
-    ) -> float | None:
-        """The slab test: where the ray o + t d enters the box within [t_min, t_max].
-
-        Returns the smallest t in [t_min, t_max] with o + t d in the box (t_min
-        itself when the ray starts inside), or None when there is none. The box is
-        the intersection of three slabs, x0 <= x <= x1 and so on; the ray is inside
-        the x slab for t between (x0 - ox) / dx and (x1 - ox) / dx, and inside the
-        box where the three slabs' intervals and [t_min, t_max] overlap. A ray
-        parallel to a slab (d = 0 on that axis) is inside it for every t or none.
-
-        The three axes run the same code, written out: a loop over the axes makes
-        this, the BVH's most frequent call, about twice as slow.
-        """
-        if dx == 0.0:
-            if ox < self.x0 or ox > self.x1:
-                return None
-        else:
-            t_lo = (self.x0 - ox) / dx
-            t_hi = (self.x1 - ox) / dx
-            if t_lo > t_hi:  # the ray runs toward -x
-                t_lo, t_hi = t_hi, t_lo
-            if t_lo > t_min:
-                t_min = t_lo
-            if t_hi < t_max:
-                t_max = t_hi
-            if t_min > t_max:
-                return None
-        if dy == 0.0:
-            if oy < self.y0 or oy > self.y1:
-                return None
-        else:
-            t_lo = (self.y0 - oy) / dy
-            t_hi = (self.y1 - oy) / dy
-            if t_lo > t_hi:
-                t_lo, t_hi = t_hi, t_lo
-            if t_lo > t_min:
-                t_min = t_lo
-            if t_hi < t_max:
-                t_max = t_hi
-            if t_min > t_max:
-                return None
-        if dz == 0.0:
-            if oz < self.z0 or oz > self.z1:
-                return None
-        else:
-            t_lo = (self.z0 - oz) / dz
-            t_hi = (self.z1 - oz) / dz
-            if t_lo > t_hi:
-                t_lo, t_hi = t_hi, t_lo
-            if t_lo > t_min:
-                t_min = t_lo
-            if t_hi < t_max:
-                t_max = t_hi
-            if t_min > t_max:
-                return None
-        return t_min
-
-    def hit(self, ray: Ray, t_min: float, t_max: float) -> bool:
-        """True when the ray passes through the box for some t in [t_min, t_max]."""
-        o, d = ray.origin, ray.direction
-        return self.entry(o.e0, o.e1, o.e2, d.e0, d.e1, d.e2, t_min, t_max) is not None
-
 
 class BVHNode:
     """A box and either two children (interior node) or a few objects (leaf).
 
     `items` holds a leaf's objects with their positions in the scene's list, as
-    (index, object) pairs; it is None for an interior node.
+    (index, object) pairs; it is None for an interior node. An interior node's
+    objects were split along `axis` (0, 1, 2: x, y, z), those with the smaller
+    centroids going left. The box is kept as `bounds` = (x0, y0, z0, x1, y1, z1),
+    the form the search reads.
     """
 
-    __slots__ = ("box", "left", "right", "items")
+    __slots__ = ("bounds", "left", "right", "items", "axis")
 
     def __init__(
         self,
@@ -211,11 +142,15 @@ class BVHNode:
         left: BVHNode | None = None,
         right: BVHNode | None = None,
         items: list[tuple[int, Hittable]] | None = None,
+        axis: int = 0,
     ) -> None:
-        self.box = box
-        self.left = left
-        self.right = right
-        self.items = items
+        self.bounds = (box.x0, box.y0, box.z0, box.x1, box.y1, box.z1)
+        self.left, self.right, self.items, self.axis = left, right, items, axis
+
+    @property
+    def box(self) -> AABB:
+        b = self.bounds
+        return AABB(Vec3(b[0], b[1], b[2]), Vec3(b[3], b[4], b[5]))
 
 
 class BVH:
@@ -223,7 +158,8 @@ class BVH:
 
     Built once from the list; it does not see later changes to the list (Scene
     rebuilds it). Objects whose bounding_box() is None or not finite (unbounded
-    shapes) are kept out of the tree and tested on every ray.
+    shapes) are kept out of the tree, in a leaf of their own with an infinite box,
+    which the search visits first on every ray.
 
     margin  how much every object's box is grown; None: ROUNDING_MARGIN times the
             largest coordinate magnitude of all the boxes
@@ -242,83 +178,93 @@ class BVH:
             margin = ROUNDING_MARGIN * max((box.magnitude() for _, _, box in bounded), default=0.0)
         bounded = [(index, obj, box.grown(margin)) for index, obj, box in bounded]
         self.root: BVHNode | None = _build(bounded) if bounded else None
+        # Where a search starts, the last first.
+        self.start: list[BVHNode] = [] if self.root is None else [self.root]
+        if self.unbounded:
+            inf = math.inf
+            everywhere = AABB(Vec3(-inf, -inf, -inf), Vec3(inf, inf, inf))
+            self.start.append(BVHNode(everywhere, items=self.unbounded))
 
     def closest_hit(self, ray: Ray, t_min: float, t_max: float) -> tuple[Hittable, float] | None:
         """(object, t) of the closest hit with t_min < t < t_max, ties going to the
-        object earliest in the list; None when nothing is hit.
+        object earliest in the list; None when nothing is hit."""
+        return self._search(ray, t_min, t_max, None, False)
 
-        Depth first with a stack of (node, t where the ray enters its box); the
-        nearer child is visited first, and boxes are tested against [t_min, best_t],
-        so every hit found shrinks the part of the ray still to be searched.
+    def any_hit(self, ray: Ray, t_min: float, t_max: float, ignore: Hittable | None = None) -> bool:
+        """True if some object other than `ignore` is hit with t_min < t < t_max."""
+        return self._search(ray, t_min, t_max, ignore, True) is not None
+
+    def _search(
+        self, ray: Ray, t_min: float, t_max: float, ignore: Hittable | None, first: bool
+    ) -> tuple[Hittable, float] | None:
+        """(object, t) of the closest hit with t_min < t < t_max, or with first=True
+        of the first hit found; objects other than `ignore` only.
+
+        Depth first with a stack of nodes; of two children the one on the side the
+        ray comes from along their split axis is visited first, and a box is tested
+        against [t_min, best_t] when its node comes off the stack, so every hit found
+        shrinks the part of the ray still to be searched.
         """
         o, d = ray.origin, ray.direction
         ox, oy, oz, dx, dy, dz = o.e0, o.e1, o.e2, d.e0, d.e1, d.e2
+        # Per axis: 1 / d (inf where d = 0, see the slab test) and the positions in
+        # a node's bounds (x0, y0, z0, x1, y1, z1) of the faces the ray meets first
+        # (n) and last (f) along it: the low ones when d >= 0, else the high ones.
+        ix = 1.0 / dx if dx != 0.0 else math.inf
+        iy = 1.0 / dy if dy != 0.0 else math.inf
+        iz = 1.0 / dz if dz != 0.0 else math.inf
+        nx, ny, nz = (0 if ix > 0.0 else 3), (1 if iy > 0.0 else 4), (2 if iz > 0.0 else 5)
+        fx, fy, fz = 3 - nx, 5 - ny, 7 - nz
+        backward = (nx == 3, ny == 4, nz == 5)  # the ray runs toward -x, -y, -z
         best_t, best_index, best_obj = t_max, -1, None
         # The bound passed to hit_t. Once something is hit it is the next float
         # above best_t, so that a hit at the same t still comes back and the list
         # index can decide. (hit_t with a smaller t_max returns the same t or None.)
         limit = t_max
-        for index, obj in self.unbounded:
-            t = obj.hit_t(ray, t_min, limit)
-            if t is not None and (t, index) < (best_t, best_index):
-                best_t, best_index, best_obj = t, index, obj
-                limit = math.nextafter(t, math.inf)
-        root = self.root
-        entry = None if root is None else root.box.entry(ox, oy, oz, dx, dy, dz, t_min, best_t)
-        stack: list[tuple[BVHNode, float]] = [] if entry is None else [(root, entry)]
+        stack = self.start[:]
         while stack:
-            node, entry = stack.pop()
-            if entry > best_t:
-                continue  # a hit found since this node was pushed is closer than its box
-            if node.items is not None:
-                for index, obj in node.items:  # as for the unbounded objects above
-                    t = obj.hit_t(ray, t_min, limit)
-                    if t is not None and (t, index) < (best_t, best_index):
-                        best_t, best_index, best_obj = t, index, obj
-                        limit = math.nextafter(t, math.inf)
+            node = stack.pop()
+            # The slab test. The ray is inside the box's x slab for t between
+            # x0 = (near x face - ox) / dx and x1 = (far x face - ox) / dx, likewise
+            # for y and z, and in the box where the three intervals and
+            # [t_min, best_t] overlap. A ray parallel to a slab (1 / d = inf) gets
+            # -inf .. inf inside it, an empty interval outside, and nan = 0 * inf
+            # where it runs in a face's plane: nan loses every comparison, so it
+            # leaves the interval as it is, as a closed box wants. Written out, not
+            # as a loop over the axes or a call: this runs for every node visited.
+            b = node.bounds
+            x0, x1 = (b[nx] - ox) * ix, (b[fx] - ox) * ix
+            y0, y1 = (b[ny] - oy) * iy, (b[fy] - oy) * iy
+            enter = x0 if x0 > t_min else t_min
+            enter = y0 if y0 > enter else enter
+            leave = x1 if x1 < best_t else best_t
+            leave = y1 if y1 < leave else leave
+            if enter > leave:
+                continue  # misses the box, or meets it only outside [t_min, best_t]
+            z0, z1 = (b[nz] - oz) * iz, (b[fz] - oz) * iz
+            if z0 > leave or z1 < enter:
                 continue
-            left, right = node.left, node.right
-            left_entry = left.box.entry(ox, oy, oz, dx, dy, dz, t_min, best_t)
-            right_entry = right.box.entry(ox, oy, oz, dx, dy, dz, t_min, best_t)
-            # Push the farther child first so that the nearer one is visited first:
-            # its hits shrink best_t, and the farther box may then be skipped.
-            if left_entry is None:
-                if right_entry is not None:
-                    stack.append((right, right_entry))
-            elif right_entry is None:
-                stack.append((left, left_entry))
-            elif left_entry <= right_entry:
-                stack.append((right, right_entry))
-                stack.append((left, left_entry))
-            else:
-                stack.append((left, left_entry))
-                stack.append((right, right_entry))
+            items = node.items
+            if items is None:
+                if backward[node.axis]:  # the right child, higher along the axis, first
+                    stack.append(node.left)
+                    stack.append(node.right)
+                else:
+                    stack.append(node.right)
+                    stack.append(node.left)
+                continue
+            for index, obj in items:
+                if obj is ignore:
+                    continue
+                t = obj.hit_t(ray, t_min, limit)
+                if t is not None and (t, index) < (best_t, best_index):
+                    if first:
+                        return obj, t
+                    best_t, best_index, best_obj = t, index, obj
+                    limit = math.nextafter(t, math.inf)
         if best_obj is None:
             return None
         return best_obj, best_t
-
-    def any_hit(
-        self, ray: Ray, t_min: float, t_max: float, ignore: Hittable | None = None
-    ) -> bool:
-        """True if some object other than `ignore` is hit with t_min < t < t_max."""
-        for _, obj in self.unbounded:
-            if obj is not ignore and obj.hit_t(ray, t_min, t_max) is not None:
-                return True
-        o, d = ray.origin, ray.direction
-        ox, oy, oz, dx, dy, dz = o.e0, o.e1, o.e2, d.e0, d.e1, d.e2
-        stack = [] if self.root is None else [self.root]
-        while stack:
-            node = stack.pop()
-            if node.box.entry(ox, oy, oz, dx, dy, dz, t_min, t_max) is None:
-                continue
-            if node.items is None:
-                stack.append(node.right)
-                stack.append(node.left)
-            else:
-                for _, obj in node.items:
-                    if obj is not ignore and obj.hit_t(ray, t_min, t_max) is not None:
-                        return True
-        return False
 
     def depth(self) -> int:
         """Number of levels (a lone leaf is 1; an empty tree 0)."""
@@ -348,22 +294,27 @@ def _build(items: list[tuple[int, Hittable, AABB]]) -> BVHNode:
     n = len(items)
     if n == 1:
         return BVHNode(box, items=[(items[0][0], items[0][1])])
-    weighted_area, ordered, k = _cheapest_split(items)
+    weighted_area, ordered, k, axis = _cheapest_split(items)
     area = box.surface_area()
     # leaf cost <= split cost, both multiplied by area (which may be 0 for a flat box)
     if n <= LEAF_SIZE and n * area <= TRAVERSAL_COST * area + weighted_area:
         return BVHNode(box, items=[(index, obj) for index, obj, _ in items])
-    return BVHNode(box, left=_build(ordered[:k]), right=_build(ordered[k:]))
+    return BVHNode(box, left=_build(ordered[:k]), right=_build(ordered[k:]), axis=axis)
 
 
 def _cheapest_split(
     items: list[tuple[int, Hittable, AABB]],
-) -> tuple[float, list[tuple[int, Hittable, AABB]], int]:
-    """(weighted_area, ordered, k): the split into ordered[:k] and ordered[k:] with
-    the least weighted_area = area(left) * k + area(right) * (n - k), trying every k
-    on each of the three axes with the items sorted by their centroids along it."""
+) -> tuple[float, list[tuple[int, Hittable, AABB]], int, int]:
+    """(weighted_area, ordered, k, axis): the split into ordered[:k] and ordered[k:]
+    with the least weighted_area = area(left) * k + area(right) * (n - k), trying every
+    k on each of the three axes with the items sorted by their centroids along it."""
     n = len(items)
-    best: tuple[float, list[tuple[int, Hittable, AABB]], int] = (math.inf, items, n // 2)
+    best: tuple[float, list[tuple[int, Hittable, AABB]], int, int] = (
+        math.inf,
+        items,
+        n // 2,
+        0,
+    )
     centroids = [item[2].centroid() for item in items]
     for axis in range(3):
         order = sorted(range(n), key=lambda i: centroids[i][axis])
@@ -377,6 +328,6 @@ def _cheapest_split(
         for k in range(1, n):
             weighted_area = box.surface_area() * k + right_area[k] * (n - k)
             if weighted_area < best[0]:
-                best = (weighted_area, ordered, k)
+                best = (weighted_area, ordered, k, axis)
             box = box.union(ordered[k][2])
     return best

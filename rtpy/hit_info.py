@@ -60,12 +60,9 @@ class HitInfo:
         self.normal = normal
         self.t = t
         self.front_face = front_face
-        self.material = material
-        self.obj = obj
-        self._u = u
-        self._v = v
-        self._tangent = None
-        self._frame = None
+        self.material, self.obj = material, obj
+        self._u, self._v = u, v  # None: computed on first access, as are these two
+        self._tangent = self._frame = None
 
     def _compute_uv(self) -> None:
         if self.obj is None:

@@ -120,3 +120,18 @@ class Hittable:
         if cos_light < 1e-12:
             return 0.0
         return dist2 / (cos_light * self.area())
+
+
+class FlatShape(Hittable):
+    """A flat shape (Quad, Triangle): the subclass sets `normal`, the unit normal of
+    its front face, `_tangent`, its unit tangent along increasing u, and `_area`."""
+
+    normal: Vec3
+    _tangent: Vec3
+    _area: float
+
+    def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
+        return self._tangent
+
+    def area(self) -> float:
+        return self._area

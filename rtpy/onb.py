@@ -61,10 +61,10 @@ class ONB:
         )
 
 
-def local_to_world(w: Vec3, x: float, y: float, z: float) -> Vec3:
+def local_to_world(w: Vec3 | tuple[float, float, float], x: float, y: float, z: float) -> Vec3:
     """x * u + y * v + z * w for the frame ONB(w) builds, without building it
-    (the same numbers)."""
-    w0, w1, w2 = w.e0, w.e1, w.e2
+    (the same numbers). w is a unit Vec3 or its three components."""
+    w0, w1, w2 = w
     sign = math.copysign(1.0, w2)
     a = -1.0 / (sign + w2)
     b = w0 * w1 * a

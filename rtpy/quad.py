@@ -6,12 +6,12 @@ import math
 
 from .bvh import AABB
 from .hit_info import HitInfo
-from .hittable import Hittable
+from .hittable import FlatShape
 from .ray import Ray
 from .vec3 import Vec3, cross, dot
 
 
-class Quad(Hittable):
+class Quad(FlatShape):
     """Front face normal = normalize(u x v); surface coordinates (u, v) = (a, b)."""
 
     def __init__(self, q: Vec3, u: Vec3, v: Vec3, material) -> None:
@@ -67,12 +67,6 @@ class Quad(Hittable):
         a, b = self._coords(hit.point)
         return min(1.0, max(0.0, a)), min(1.0, max(0.0, b))
         # END SOLUTION
-
-    def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
-        return self._tangent
-
-    def area(self) -> float:
-        return self._area
 
     def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:
         return self.q + self.u * r1 + self.v * r2, self.normal

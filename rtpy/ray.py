@@ -29,7 +29,10 @@ class Ray:
 
 def offset_scale(p: Vec3) -> float:
     """How far a ray leaving point p must start from the surface (world units)."""
-    m = max(abs(p.e0), abs(p.e1), abs(p.e2))
+    # The largest |coordinate|, compared by hand: the builtin max() costs more.
+    m, y, z = abs(p.e0), abs(p.e1), abs(p.e2)
+    m = y if y > m else m
+    m = z if z > m else m
     return SPAWN_ABSOLUTE_OFFSET + SPAWN_RELATIVE_OFFSET * m
 
 
@@ -40,9 +43,7 @@ def spawn_ray(point: Vec3, normal: Vec3, direction: Vec3) -> Ray:
     surface to the side `direction` goes to, so the new ray cannot re-hit the
     surface it starts on; it works for reflected and refracted rays alike.
     """
-    eps = SPAWN_ABSOLUTE_OFFSET + SPAWN_RELATIVE_OFFSET * max(
-        abs(point.e0), abs(point.e1), abs(point.e2)
-    )
+    eps = offset_scale(point)
     if direction.e0 * normal.e0 + direction.e1 * normal.e1 + direction.e2 * normal.e2 < 0.0:
         eps = -eps
     origin = Vec3(

@@ -71,21 +71,21 @@ def plan_units(
 def render_unit(scene: Scene, camera: Camera, integrator, seed: int, unit: Unit) -> np.ndarray:
     """Sum of `unit.spp` radiance samples for each pixel of the unit's tile:
     an array (tile height, tile width, 3)."""
-    out = np.zeros((unit.y1 - unit.y0, unit.x1 - unit.x0, 3))
+    sums = []  # (r, g, b) per pixel, row by row: one array at the end, not one write per pixel
     radiance = integrator.compute_scattering
     get_ray = camera.get_center_ray if integrator.uses_center_ray else camera.get_ray
+    samples = range(unit.spp)
     with use_generator(make_generator(seed, unit.tile, unit.batch)):
         for j in range(unit.y0, unit.y1):
-            row = out[j - unit.y0]
             for i in range(unit.x0, unit.x1):
                 r = g = b = 0.0
-                for _ in range(unit.spp):
+                for _ in samples:
                     c = radiance(get_ray(i, j), scene)
                     r += c.e0
                     g += c.e1
                     b += c.e2
-                row[i - unit.x0] = (r, g, b)
-    return out
+                sums.append((r, g, b))
+    return np.array(sums, dtype=np.float64).reshape(unit.y1 - unit.y0, unit.x1 - unit.x0, 3)
 
 
 class PixelSums:

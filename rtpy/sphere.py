@@ -127,16 +127,18 @@ class Sphere(Hittable):
         sin2_max = rr / d2
         one_minus_cos_max = sin2_max / (1.0 + math.sqrt(1.0 - sin2_max))  # no cancellation
         cos_t = 1.0 - r1 * one_minus_cos_max
-        sin2_t = max(0.0, 1.0 - cos_t * cos_t)
+        sin2_t = 1.0 - cos_t * cos_t
+        sin2_t = sin2_t if sin2_t > 0.0 else 0.0  # max(0, .), cheaper than the builtin
         sin_t = math.sqrt(sin2_t)
         phi = 2.0 * math.pi * r2
         distance = math.sqrt(d2)
         k = 1.0 / distance
-        axis = Vec3(ax * k, ay * k, az * k)
+        axis = (ax * k, ay * k, az * k)  # unit, toward the center
         direction = local_to_world(axis, sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
         # The nearer root of t^2 - 2 t D cos_t + D^2 - r^2 = 0 (D = distance), written
         # without cancellation; inside the cone r^2 - D^2 sin_t^2 >= 0 but for rounding.
-        t = (d2 - rr) / (distance * cos_t + math.sqrt(max(0.0, rr - d2 * sin2_t)))
+        room = rr - d2 * sin2_t
+        t = (d2 - rr) / (distance * cos_t + math.sqrt(room if room > 0.0 else 0.0))
         return direction, 1.0 / (2.0 * math.pi * one_minus_cos_max), t
 
     def sample_direction(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float] | None:

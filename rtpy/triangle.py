@@ -6,7 +6,7 @@ import math
 
 from .bvh import AABB
 from .hit_info import HitInfo
-from .hittable import Hittable
+from .hittable import FlatShape
 from .ray import Ray
 from .vec3 import Vec3, cross, dot
 
@@ -18,7 +18,7 @@ from .vec3 import Vec3, cross, dot
 PARALLEL_TOLERANCE = 1e-6
 
 
-class Triangle(Hittable):
+class Triangle(FlatShape):
     """Front face normal = normalize((b - a) x (c - a)).
 
     Surface coordinates (u, v) are the barycentric weights of b and c, so the
@@ -91,12 +91,6 @@ class Triangle(Hittable):
         u = (d11 * d20 - d01 * d21) / denom
         v = (d00 * d21 - d01 * d20) / denom
         return min(1.0, max(0.0, u)), min(1.0, max(0.0, v))
-
-    def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
-        return self._tangent
-
-    def area(self) -> float:
-        return self._area
 
     def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:
         # Uniform by area: s = sqrt(r1) warps the unit square onto the triangle.

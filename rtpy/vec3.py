@@ -69,10 +69,10 @@ class Vec3:
 
     def __mul__(self, o: Vec3 | float) -> Vec3:
         v = _new(self.__class__)
-        if isinstance(o, Vec3):  # component-wise, for colours
-            v.e0, v.e1, v.e2 = self.e0 * o.e0, self.e1 * o.e1, self.e2 * o.e2
-        else:
+        if type(o) is float or not isinstance(o, Vec3):
             v.e0, v.e1, v.e2 = self.e0 * o, self.e1 * o, self.e2 * o
+        else:  # component-wise, for colours
+            v.e0, v.e1, v.e2 = self.e0 * o.e0, self.e1 * o.e1, self.e2 * o.e2
         return v
 
     def __rmul__(self, s: float) -> Vec3:
@@ -108,7 +108,9 @@ class Vec3:
         return abs(self.e0) < eps and abs(self.e1) < eps and abs(self.e2) < eps
 
     def max_component(self) -> float:
-        return max(self.e0, self.e1, self.e2)
+        # max(e0, e1, e2) without the builtin, whose call costs more than the comparisons
+        m = self.e1 if self.e1 > self.e0 else self.e0
+        return self.e2 if self.e2 > m else m
 
     def is_black(self) -> bool:
         return self.e0 == 0.0 and self.e1 == 0.0 and self.e2 == 0.0
@@ -119,14 +121,8 @@ class Color(Vec3):
 
     __slots__ = ()
 
-    def r(self) -> float:
-        return self.e0
-
-    def g(self) -> float:
-        return self.e1
-
-    def b(self) -> float:
-        return self.e2
+    # r(), g(), b(): the components x(), y(), z() under their colour names
+    r, g, b = Vec3.x, Vec3.y, Vec3.z
 
 
 Point3 = Vec3

@@ -21,9 +21,11 @@ Both render the same width, spp and max_depth, each in a fresh process (the cour
 with its own Renderer, which samples the lamp as a point light at every bounce),
 --repeat times, alternating (course, rtpy, course, rtpy, ...); the fastest run of
 each is reported, since on a shared machine the best of a few runs is the least
-disturbed one. It prints paths/s (camera paths per wall-clock second of rendering)
-for each and the ratio rtpy / course. --rtpy DIR adds a row for another rtpy
-checkout (for example the base of a change), measured in the same rounds.
+disturbed one. It prints, for each, the render's wall-clock and CPU seconds and
+paths/s (camera paths per CPU second of rendering: other processes on the machine
+slow the wall clock far more than the CPU time), and the ratio rtpy / course.
+--rtpy DIR adds a row for another rtpy checkout (for example the base of a change),
+measured in the same rounds.
 """
 
 from __future__ import annotations
@@ -116,10 +118,7 @@ def render_course(course_dir: str, width: int, spp: int, max_depth: int, seed: i
     scene.add_object(rto.Sphere(vec(*center), radius, rtl.Diffuse_light(rtu.Color(*emit))))
 
     renderer = rtren.Renderer(camera, rti.Integrator(), scene)
-    start = time.perf_counter()
-    renderer.render()
-    seconds = time.perf_counter() - start
-    return {"seconds": seconds, "paths": camera.img_width * camera.img_height * spp}
+    return timed(renderer.render, lambda _: camera.img_width * camera.img_height * spp)
 
 
 def render_rtpy(width: int, spp: int, max_depth: int, seed: int) -> dict:
@@ -144,12 +143,21 @@ def render_rtpy(width: int, spp: int, max_depth: int, seed: int) -> dict:
         width=width,
         focus_distance=FOCUS_DISTANCE,
     )
-    start = time.perf_counter()
-    image = rtpy.render(
-        scene, camera=camera, spp=spp, max_depth=max_depth, seed=seed, workers=1, quiet=True
-    )
-    seconds = time.perf_counter() - start
-    return {"seconds": seconds, "paths": image.width * image.height * spp}
+
+    def render():
+        return rtpy.render(
+            scene, camera=camera, spp=spp, max_depth=max_depth, seed=seed, workers=1, quiet=True
+        )
+
+    return timed(render, lambda image: image.width * image.height * spp)
+
+
+def timed(render, count_paths) -> dict:
+    """Run render(); its wall-clock and CPU seconds and count_paths(its result)."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    result = render()
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    return {"seconds": wall, "cpu_seconds": cpu, "paths": count_paths(result)}
 
 
 def run_child(kind: str, args: argparse.Namespace, rtpy_dir: str | None = None) -> dict:
@@ -196,7 +204,7 @@ def main() -> None:
     for _ in range(max(1, args.repeat)):
         for label, kind, rtpy_dir in rows:
             r = run_child(kind, args, rtpy_dir)
-            r["paths_per_second"] = r["paths"] / r["seconds"]
+            r["paths_per_second"] = r["paths"] / r["cpu_seconds"]
             if label not in best or r["paths_per_second"] > best[label]["paths_per_second"]:
                 best[label] = r
     print(
@@ -204,7 +212,10 @@ def main() -> None:
         f"best of {max(1, args.repeat)}:"
     )
     for label, r in best.items():
-        line = f"  {label}: {r['seconds']:.2f} s, {r['paths_per_second']:,.1f} paths/s"
+        line = (
+            f"  {label}: {r['seconds']:.2f} s (CPU {r['cpu_seconds']:.2f} s), "
+            f"{r['paths_per_second']:,.1f} paths/s"
+        )
         if "course" in best and label != "course":
             ratio = r["paths_per_second"] / best["course"]["paths_per_second"]
             line += f", {ratio:.2f}x the course's"

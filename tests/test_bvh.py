@@ -41,70 +41,103 @@ def bvh_scene(objects) -> Scene:
 
 
 # --- the slab test -----------------------------------------------------------
+# BVH._search tests a node's box when the node comes off its stack; a probe object
+# whose box is a given box shows whether a ray got through: the search calls its
+# hit_t exactly then.
 
 UNIT_BOX = AABB(V(-1, -1, -1), V(1, 1, 1))
 
 
-def entry(box: AABB, origin, direction, t_min=0.0, t_max=INF):
-    return box.entry(*map(float, origin), *map(float, direction), t_min, t_max)
+class Probe(Hittable):
+    """An object with a given bounding box that counts the calls of its hit_t."""
+
+    def __init__(self, box: AABB) -> None:
+        self.box = box
+        self.material = MAT
+        self.calls = 0
+
+    def bounding_box(self) -> AABB:
+        return self.box
+
+    def hit_t(self, ray, t_min, t_max):
+        self.calls += 1
+        return None
+
+
+def enters(box: AABB, origin, direction, t_min=0.0, t_max=INF) -> bool:
+    """Whether the BVH's box test lets the ray through `box` (the box exactly: no
+    rounding margin) for some t in [t_min, t_max]."""
+    probe = Probe(box)
+    ray = Ray(Vec3(*map(float, origin)), Vec3(*map(float, direction)))
+    BVH([probe], margin=0.0).any_hit(ray, t_min, t_max)
+    return probe.calls == 1
 
 
 @pytest.mark.parametrize(
     "origin, direction, t_min, t_max, expected",
     [
-        ((0, 0, 5), (0, 0, -1), 0.0, INF, 4.0),  # straight in through the +z face
-        ((0, 0, -5), (0, 0, 1), 0.0, INF, 4.0),  # from the other side
-        ((0, 0, 5), (0, 0, -2), 0.0, INF, 2.0),  # t is in units of the direction's length
-        ((0, 0, 5), (0, 0, 1), 0.0, INF, None),  # pointing away
-        ((0, 0, 5), (0, 0, -1), 0.0, 3.9, None),  # the box is beyond t_max
-        ((0, 0, 5), (0, 0, -1), 0.0, 4.0, 4.0),  # entering exactly at t_max counts
-        ((0, 0, 5), (0, 0, -1), 6.0, INF, 6.0),  # t_min inside the box
-        ((0, 0, 5), (0, 0, -1), 6.5, INF, None),  # t_min past the box
-        ((0, 0, 5), (0, 0, -1), -INF, INF, 4.0),
-        ((0, 0, -5), (0, 0, -1), -INF, INF, -6.0),  # behind the origin, when allowed
-        ((0.5, 0.2, 0), (1, 2, 3), 0.0, INF, 0.0),  # starts inside: enters at t_min
-        ((0.5, 0.2, 0), (1, 2, 3), 0.25, INF, 0.25),
-        ((1, 0, 0), (1, 0, 0), 0.0, INF, 0.0),  # starts on a face, leaving
-        ((2, 0, 0), (-1, 1, 0), 0.0, INF, 1.0),  # grazes the edge x = y = 1 at one point
-        ((2, 0.5, 0), (-1, 1, 0), 0.0, INF, None),  # passes the edge by
-        ((2, 2, 2), (-1, -1, -1), 0.0, INF, 1.0),  # enters at the corner
-        ((3, 0, 3), (-1, 0, -1), 0.0, INF, 2.0),  # diagonally in through the x = z = 1 edge
-        ((-1, 3, -1), (1, -1, 1), 0.0, INF, 2.0),  # touches only the corner (1, 1, 1)
-        ((-1, 3.5, -1), (1, -1, 1), 0.0, INF, None),
-        ((-1, 3, 1), (1, -1, 0), 0.0, INF, 2.0),  # the same in the plane z = 1
+        ((0, 0, 5), (0, 0, -1), 0.0, INF, True),  # straight in through the +z face
+        ((0, 0, -5), (0, 0, 1), 0.0, INF, True),  # from the other side
+        ((0, 0, 5), (0, 0, -2), 0.0, 2.0, True),  # t is in units of the direction's length
+        ((0, 0, 5), (0, 0, -2), 0.0, 1.9, False),
+        ((0, 0, 5), (0, 0, 1), 0.0, INF, False),  # pointing away
+        ((0, 0, 5), (0, 0, -1), 0.0, 3.9, False),  # the box is beyond t_max
+        ((0, 0, 5), (0, 0, -1), 0.0, 4.0, True),  # entering exactly at t_max counts
+        ((0, 0, 5), (0, 0, -1), 6.0, INF, True),  # t_min inside the box
+        ((0, 0, 5), (0, 0, -1), 6.5, INF, False),  # t_min past the box
+        ((0, 0, 5), (0, 0, -1), -INF, INF, True),
+        ((0, 0, -5), (0, 0, -1), -INF, INF, True),  # behind the origin, when allowed
+        ((0, 0, -5), (0, 0, -1), -INF, -6.5, False),
+        ((0.5, 0.2, 0), (1, 2, 3), 0.0, INF, True),  # starts inside
+        ((0.5, 0.2, 0), (1, 2, 3), 0.25, INF, True),
+        ((1, 0, 0), (1, 0, 0), 0.0, INF, True),  # starts on a face, leaving
+        ((1, 0, 0), (1, 0, 0), 0.5, INF, False),
+        ((2, 0, 0), (-1, 1, 0), 0.0, INF, True),  # grazes the edge x = y = 1 at one point
+        ((2, 0.5, 0), (-1, 1, 0), 0.0, INF, False),  # passes the edge by
+        ((2, 2, 2), (-1, -1, -1), 0.0, INF, True),  # enters at the corner
+        ((3, 0, 3), (-1, 0, -1), 0.0, INF, True),  # diagonally in through the x = z = 1 edge
+        ((-1, 3, -1), (1, -1, 1), 0.0, INF, True),  # touches only the corner (1, 1, 1)
+        ((-1, 3.5, -1), (1, -1, 1), 0.0, INF, False),
+        ((-1, 3, 1), (1, -1, 0), 0.0, INF, True),  # the same in the plane z = 1
+        ((-1, 3, 1), (1, -1, 0), 0.0, 1.9, False),
     ],
 )
-def test_slab_entry_analytic(origin, direction, t_min, t_max, expected):
-    assert entry(UNIT_BOX, origin, direction, t_min, t_max) == expected
+def test_slab_test_analytic(origin, direction, t_min, t_max, expected):
+    assert enters(UNIT_BOX, origin, direction, t_min, t_max) == expected
 
 
 @pytest.mark.parametrize("zero", [0.0, -0.0])
 @pytest.mark.parametrize(
     "origin, expected",
     [
-        ((0.3, 5, 0.2), 4.0),  # inside the x and z slabs: only y decides
-        ((1, 5, -1), 4.0),  # on the x = 1 face's plane and the z = -1 plane: closed box
-        ((1.5, 5, 0), None),  # outside the x slab, moving parallel to it
-        ((0, 5, -1.0000001), None),
+        ((0.3, 5, 0.2), True),  # inside the x and z slabs: only y decides
+        ((1, 5, -1), True),  # on the x = 1 face's plane and the z = -1 plane: closed box
+        ((-1, 5, 1), True),
+        ((1.5, 5, 0), False),  # outside the x slab, moving parallel to it
+        ((-1.5, 5, 0), False),
+        ((0, 5, -1.0000001), False),
+        ((0, 5, 1.0000001), False),
     ],
 )
-def test_slab_entry_with_zero_direction_components(zero, origin, expected):
-    # No division by zero, and no 0 * inf = nan when the origin is on a slab's plane.
-    assert entry(UNIT_BOX, origin, (zero, -1.0, zero)) == expected
+def test_slab_test_with_zero_direction_components(zero, origin, expected):
+    # No division by zero, and 0 * inf = nan (the origin on a slab's plane) changes
+    # nothing.
+    assert enters(UNIT_BOX, origin, (zero, -1.0, zero)) == expected
+    assert enters(UNIT_BOX, origin, (zero, -1.0, zero), 0.0, 3.9) is False
 
 
-def test_slab_entry_on_a_flat_box():
+def test_slab_test_on_a_flat_box():
     flat = AABB(V(-1, -1, 0), V(1, 1, 0))  # zero thickness in z: still closed
-    assert entry(flat, (0, 0, 3), (0, 0, -1)) == 3.0
-    assert entry(flat, (0, 0, 3), (0.1, 0, -1)) == 3.0
-    assert entry(flat, (0, 0, 0), (1, 0, 0)) == 0.0  # in its plane
-    assert entry(flat, (0, 0, 1e-300), (1, 0, 0)) is None
+    assert enters(flat, (0, 0, 3), (0, 0, -1))
+    assert enters(flat, (0, 0, 3), (0.1, 0, -1))
+    assert enters(flat, (0, 0, 0), (1, 0, 0))  # in its plane
+    assert not enters(flat, (0, 0, 1e-300), (1, 0, 0))
 
 
-def test_hit_is_entry_not_none():
-    ray = Ray(V(0, 0, 5), V(0, 0, -1))
-    assert UNIT_BOX.hit(ray, 0.0, INF)
-    assert not UNIT_BOX.hit(ray, 0.0, 3.0)
+def test_slab_test_lets_every_ray_through_an_infinite_box():
+    everywhere = AABB(V(-INF, -INF, -INF), V(INF, INF, INF))
+    for direction in ((0, 0, 1), (0, 0, -1), (1, -2, 3), (-1, 0, 0)):
+        assert enters(everywhere, (5, -7, 1e300), direction)
 
 
 def exact_entry(lo, hi, o, d, t_min: Fraction, t_max: Fraction) -> Fraction | None:
@@ -126,7 +159,7 @@ def inside(lo, hi, p) -> bool:
 
 quarter = st.integers(-20, 20).map(lambda k: k / 4)
 # Powers of two (and both zeros): with these every float operation of the slab test
-# is exact, so the float answer must equal the rational one exactly.
+# (1 / d included) is exact, so the float answer must equal the rational one.
 power_of_two = st.sampled_from([0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.0, -2.0, 4.0, -4.0])
 
 
@@ -136,16 +169,16 @@ power_of_two = st.sampled_from([0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.0, -2.0, 4.0,
     d=st.tuples(power_of_two, power_of_two, power_of_two),
     t_range=st.tuples(quarter, quarter).map(sorted),
 )
-def test_slab_entry_equals_the_exact_answer(corners, o, d, t_range):
+def test_slab_test_equals_the_exact_answer(corners, o, d, t_range):
     assume(any(c != 0.0 for c in d))
     lo = tuple(min(pair) for pair in corners)
     hi = tuple(max(pair) for pair in corners)
     box = AABB(Vec3(*lo), Vec3(*hi))
     t_min, t_max = (Fraction(t) for t in t_range)
     expected = exact_entry(lo, hi, o, d, t_min, t_max)
-    got = box.entry(*o, *d, t_range[0], t_range[1])
-    assert got == expected  # None == None, or the same number
-    # And the meaning: the first point of the ray segment inside the closed box.
+    assert enters(box, o, d, t_range[0], t_range[1]) == (expected is not None)
+    # And the meaning of the exact answer: the first point of the ray segment
+    # inside the closed box.
     samples = [t_min + (t_max - t_min) * Fraction(k, 64) for k in range(65)]
     at = [tuple(Fraction(o[i]) + t * Fraction(d[i]) for i in range(3)) for t in samples]
     if expected is None:
@@ -442,9 +475,10 @@ def test_coincident_objects_resolve_to_the_earliest(monkeypatch):
 
 
 def test_equal_t_found_later_in_the_tree_still_wins_by_list_order(monkeypatch):
-    # A small quad (index 0) lies inside a big coplanar one (index 1). The big
-    # quad's box is padded more, so the ray enters it first and the BVH tests it
-    # first; the small quad, hit at the same t afterwards, must replace it.
+    # A small quad (index 0) lies inside a big coplanar one (index 1), each in a
+    # leaf; the split puts the big one on the right, the side a ray running toward
+    # -x meets first, so the BVH tests it first. The small quad, hit at the same t
+    # afterwards, must replace it.
     monkeypatch.setattr(rtpy.bvh, "LEAF_SIZE", 1)
     small = Quad(V(-0.5, -0.5, -2), V(1, 0, 0), V(0, 1, 0), MAT)
     big = Quad(V(-50, -50, -2), V(100, 0, 0), V(0, 100, 0), MAT)
@@ -458,7 +492,7 @@ def test_equal_t_found_later_in_the_tree_still_wins_by_list_order(monkeypatch):
             return original(ray, t_min, t_max)
 
         obj.hit_t = logged
-    ray = Ray(V(0.25, 0.125, 0), V(0, 0, -1))
+    ray = Ray(V(0.25, 0.125, 0), V(-0.01, 0, -1))
     hit = scene.find_intersection(ray, FORWARD)
     assert order == [big, small]
     assert hit.obj is small and hit.t == 2.0
