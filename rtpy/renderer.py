@@ -1,16 +1,17 @@
-"""Renderer: runs an integrator over every pixel, in tiles, on one or more processes.
+"""Renderer: runs an integrator over every pixel, unit by unit, on one or more processes.
 
 One loop (Renderer) serves both backends: a Backend plans the units of work and
 renders one unit (ScalarBackend here, ray by ray; the numpy backend's in
 rtpy/numpy_backend/renderer.py, a whole unit as arrays), and the loop runs the
 units on worker processes, shows progress, handles Ctrl-C and assembles the image.
 
-The image is cut into square tiles and the samples of each pixel into batches.
-One unit of work is (batch, tile); units run batch by batch, so an interrupted
-render already covers the whole image with fewer samples. Every unit draws from
-its own generator, seeded by (seed, tile, batch), and partial sums are combined
-in a fixed order, so the same seed gives the same image, bit for bit, with any
-number of worker processes.
+The image is cut into regions (square tiles for the scalar backend, bands of rows
+sized by the number of paths for the numpy backend) and the samples of each pixel
+into batches. One unit of work is (batch, region); units run batch by batch, so an
+interrupted render already covers the whole image with fewer samples. Every unit
+draws from its own generator, seeded by (seed, region, batch), and partial sums are
+combined in a fixed order, so the same seed gives the same image, bit for bit, with
+any number of worker processes.
 """
 
 from __future__ import annotations
@@ -41,7 +42,11 @@ MAX_BATCHES = 8  # samples per pixel are split into at most this many batches
 
 @dataclass(frozen=True)
 class Unit:
-    tile: int
+    """Samples batch `batch` (spp of them per pixel) of the pixels x0 <= i < x1,
+    y0 <= j < y1, which are region `region` of the plan; every batch of a plan has
+    the same regions."""
+
+    region: int
     batch: int
     x0: int
     y0: int
@@ -57,25 +62,61 @@ def plan_units(
     tiles, each tile's spp split into n_batches batches (default min(spp, MAX_BATCHES))
     that differ by at most 1."""
     n_batches = min(spp, MAX_BATCHES) if n_batches is None else n_batches
-    batch_spp = [spp // n_batches + (1 if b < spp % n_batches else 0) for b in range(n_batches)]
     tiles = [
         (x0, y0, min(x0 + tile, width), min(y0 + tile, height))
         for y0 in range(0, height, tile)
         for x0 in range(0, width, tile)
     ]
+    return _units(tiles, spp, n_batches)
+
+
+def plan_bands(width: int, height: int, spp: int, paths_per_unit: int) -> list[Unit]:
+    """All units of work, batch-major, each of at most about paths_per_unit camera
+    paths whatever the image size and spp: spp split into min(spp, MAX_BATCHES)
+    batches (more if a pixel's batch alone would exceed paths_per_unit), the image
+    into bands of whole rows of equal height holding that many paths per batch, or,
+    where one row holds more, each row into pieces of equal width."""
+    n_batches = max(min(spp, MAX_BATCHES), math.ceil(spp / paths_per_unit))
+    pixels = max(1, paths_per_unit // math.ceil(spp / n_batches))  # per unit
+    if pixels >= width:
+        rows = _even_step(height, pixels // width)
+        regions = [(0, y0, width, min(y0 + rows, height)) for y0 in range(0, height, rows)]
+    else:
+        cols = _even_step(width, pixels)
+        regions = [
+            (x0, y, min(x0 + cols, width), y + 1)
+            for y in range(height)
+            for x0 in range(0, width, cols)
+        ]
+    return _units(regions, spp, n_batches)
+
+
+def _even_step(length: int, at_most: int) -> int:
+    """The step that cuts `length` into the fewest pieces of at most `at_most`, with
+    sizes as equal as whole numbers allow (the last piece is the smallest)."""
+    pieces = math.ceil(length / at_most)
+    return math.ceil(length / pieces)
+
+
+def _units(regions: list[tuple[int, int, int, int]], spp: int, n_batches: int) -> list[Unit]:
+    """Batch-major units over regions (x0, y0, x1, y1): spp split into n_batches batches
+    that differ by at most 1."""
+    batch_spp = [spp // n_batches + (1 if b < spp % n_batches else 0) for b in range(n_batches)]
     return [
-        Unit(t, b, *tiles[t], batch_spp[b]) for b in range(n_batches) for t in range(len(tiles))
+        Unit(r, b, *regions[r], batch_spp[b])
+        for b in range(n_batches)
+        for r in range(len(regions))
     ]
 
 
 def render_unit(scene: Scene, camera: Camera, integrator, seed: int, unit: Unit) -> np.ndarray:
-    """Sum of `unit.spp` radiance samples for each pixel of the unit's tile:
-    an array (tile height, tile width, 3)."""
+    """Sum of `unit.spp` radiance samples for each pixel of the unit's region:
+    an array (region height, region width, 3)."""
     sums = []  # (r, g, b) per pixel, row by row: one array at the end, not one write per pixel
     radiance = integrator.compute_scattering
     get_ray = camera.get_center_ray if integrator.uses_center_ray else camera.get_ray
     samples = range(unit.spp)
-    with use_generator(make_generator(seed, unit.tile, unit.batch)):
+    with use_generator(make_generator(seed, unit.region, unit.batch)):
         for j in range(unit.y0, unit.y1):
             for i in range(unit.x0, unit.x1):
                 r = g = b = 0.0
@@ -91,25 +132,26 @@ def render_unit(scene: Scene, camera: Camera, integrator, seed: int, unit: Unit)
 class PixelSums:
     """The sums of finished units, added into one image as they arrive.
 
-    Each tile's batches are added in batch order (a unit that arrives before an
-    earlier batch of its tile waits), so every pixel's sum is the same for any
+    Each region's batches are added in batch order (a unit that arrives before an
+    earlier batch of its region waits), so every pixel's sum is the same for any
     order of arrival, that is for any number of workers, and memory holds one
-    image, not every unit of the render.
+    image, not every unit of the render. Every pixel of a region has had the same
+    samples, so the sample counts are kept per region.
     """
 
     def __init__(self, width: int, height: int) -> None:
         self.total = np.zeros((height, width, 3))
-        self.counts = np.zeros((height, width), dtype=np.int64)
-        self._next_batch: dict[int, int] = {}  # tile -> the batch to add next
+        self._samples: dict[int, tuple[Unit, int]] = {}  # region -> (a unit of it, spp)
+        self._next_batch: dict[int, int] = {}  # region -> the batch to add next
         self._waiting: dict[tuple[int, int], tuple[Unit, np.ndarray]] = {}
 
     def add(self, unit: Unit, sums: np.ndarray) -> None:
-        self._waiting[(unit.tile, unit.batch)] = (unit, sums)
-        batch = self._next_batch.get(unit.tile, 0)
-        while (unit.tile, batch) in self._waiting:
-            self._add(*self._waiting.pop((unit.tile, batch)))
+        self._waiting[(unit.region, unit.batch)] = (unit, sums)
+        batch = self._next_batch.get(unit.region, 0)
+        while (unit.region, batch) in self._waiting:
+            self._add(*self._waiting.pop((unit.region, batch)))
             batch += 1
-        self._next_batch[unit.tile] = batch
+        self._next_batch[unit.region] = batch
 
     def finish(self) -> None:
         """Add the units still waiting for an earlier batch (after Ctrl-C)."""
@@ -118,7 +160,37 @@ class PixelSums:
 
     def _add(self, unit: Unit, sums: np.ndarray) -> None:
         self.total[unit.y0 : unit.y1, unit.x0 : unit.x1] += sums
-        self.counts[unit.y0 : unit.y1, unit.x0 : unit.x1] += unit.spp
+        samples = self._samples.get(unit.region, (unit, 0))[1]
+        self._samples[unit.region] = (unit, samples + unit.spp)
+
+    @property
+    def counts(self) -> np.ndarray:
+        """Samples added per pixel, an array (height, width)."""
+        counts = np.zeros(self.total.shape[:2], dtype=np.int64)
+        for unit, samples in self._samples.values():
+            counts[unit.y0 : unit.y1, unit.x0 : unit.x1] = samples
+        return counts
+
+    @property
+    def paths(self) -> int:
+        """Samples added over all pixels."""
+        return sum(n * (u.x1 - u.x0) * (u.y1 - u.y0) for u, n in self._samples.values())
+
+    def samples_range(self) -> tuple[int, int]:
+        """The fewest and the most samples a pixel has."""
+        pixels = sum((u.x1 - u.x0) * (u.y1 - u.y0) for u, _ in self._samples.values())
+        samples = [n for _, n in self._samples.values()]
+        fewest = min(samples) if samples and pixels == self.total[..., 0].size else 0
+        return fewest, max(samples, default=0)
+
+    def mean(self) -> np.ndarray:
+        """The mean of each pixel's samples (black without one), an array (height,
+        width, 3), computed in place after finish(): `total` becomes it (call it once)."""
+        self.finish()
+        for unit, samples in self._samples.values():
+            self.total[unit.y0 : unit.y1, unit.x0 : unit.x1] /= samples
+        self._samples.clear()
+        return self.total
 
 
 # --- backends ---------------------------------------------------------------------
@@ -157,7 +229,7 @@ class Backend:
     def start(self) -> Callable[[Unit], np.ndarray]:
         """Prepare this process to render (called once in each process that renders)
         and return the function that renders one unit: the sum of unit.spp radiance
-        samples per pixel of its tile, an array (tile height, tile width, 3)."""
+        samples per pixel of its region, an array (height, width, 3)."""
         raise NotImplementedError
 
 
@@ -276,9 +348,8 @@ class Renderer:
 
     def _assemble(self, results: PixelSums, spp, interrupted, seconds) -> RenderedImage:
         results.finish()
-        counts = results.counts
-        linear = results.total / np.maximum(counts, 1)[..., None]
-        paths = int(counts.sum())
+        paths, (fewest, most) = results.paths, results.samples_range()
+        linear = results.mean()
         stats = {
             "seconds": seconds,
             "paths": paths,
@@ -292,8 +363,8 @@ class Renderer:
             linear,
             gamma=self.settings.gamma,
             spp=spp,
-            samples_min=int(counts.min()),
-            samples_max=int(counts.max()),
+            samples_min=fewest,
+            samples_max=most,
             interrupted=interrupted,
             stats=stats,
         )

@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 import rtpy
 from rtpy import Camera, Color, DiffuseLight, Lambertian, Metal, Scene, Sphere, Vec3
-from rtpy.renderer import Backend, PixelSums, Renderer, plan_units
+from rtpy.renderer import Backend, PixelSums, Renderer, plan_bands, plan_units
 
 
 @pytest.mark.parametrize("width,height,spp", [(1, 1, 1), (16, 16, 16), (37, 21, 5), (40, 3, 64)])
@@ -17,6 +19,22 @@ def test_units_cover_every_pixel_with_exactly_spp_samples(width, height, spp):
     for unit in plan_units(width, height, spp):
         counts[unit.y0 : unit.y1, unit.x0 : unit.x1] += unit.spp
     np.testing.assert_array_equal(counts, spp)
+
+
+@given(st.integers(1, 300), st.integers(1, 60), st.integers(1, 200), st.integers(1, 5000))
+def test_bands_cover_every_pixel_once_per_batch_within_the_path_budget(
+    width, height, spp, paths_per_unit
+):
+    units = plan_bands(width, height, spp, paths_per_unit)
+    counts = np.zeros((height, width), dtype=int)
+    regions: dict[int, set] = {}
+    for unit in units:
+        counts[unit.y0 : unit.y1, unit.x0 : unit.x1] += unit.spp
+        assert (unit.x1 - unit.x0) * (unit.y1 - unit.y0) * unit.spp <= paths_per_unit
+        regions.setdefault(unit.batch, set()).add((unit.region, unit.x0, unit.y0, unit.x1, unit.y1))
+    np.testing.assert_array_equal(counts, spp)
+    assert len({frozenset(r) for r in regions.values()}) == 1  # the same regions every batch
+    assert [u.batch for u in units] == sorted(u.batch for u in units)
 
 
 def test_units_run_batch_by_batch():
@@ -76,7 +94,9 @@ class Counting(Backend):
         return plan_units(width, height, spp, tile=8)
 
     def start(self):
-        return lambda unit: np.full((unit.y1 - unit.y0, unit.x1 - unit.x0, 3), unit.tile * unit.spp)
+        return lambda unit: np.full(
+            (unit.y1 - unit.y0, unit.x1 - unit.x0, 3), unit.region * unit.spp
+        )
 
 
 @pytest.mark.parametrize("workers", [1, 2])

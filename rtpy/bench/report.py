@@ -323,9 +323,12 @@ def format_doc_section(result: BenchResult, command: str, before: dict, after: d
     return "\n".join(parts)
 
 
-def replace_generated(text: str, section: str) -> str:
-    """text with its generated section (GENERATED_BEGIN to GENERATED_END) replaced."""
-    start, end = text.find(GENERATED_BEGIN), text.find(GENERATED_END)
-    if start < 0 or end < start:
+def replace_generated(
+    text: str, section: str, begin: str = GENERATED_BEGIN, end: str = GENERATED_END
+) -> str:
+    """text with its generated section (from the line `begin` to the line `end`,
+    which `section` starts and ends with) replaced."""
+    first, last = text.find(begin), text.find(end)
+    if first < 0 or last < first:
         raise ValueError("the document has no generated section to replace")
-    return text[:start] + section + text[end + len(GENERATED_END) :]
+    return text[:first] + section + text[last + len(end) :]

@@ -4,9 +4,11 @@ The loop (rtpy/renderer.py) is the scalar renderer's: units of work (batch, tile
 run batch by batch on one or more processes, each unit drawing from its own
 generator seeded by (seed, tile, batch), and sums combined in a fixed order, so the
 same seed gives the same image, bit for bit, with any number of worker processes.
-What differs is the unit: all samples of the batch for every pixel of a tile are
-traced together as one wavefront of at most MAX_RAYS paths, so memory is bounded
-by the unit size, not by image size times spp. (The scalar and numpy backends draw
+What differs is the unit: all samples of the batch for every pixel of a band of
+rows are traced together as one wavefront of about MAX_RAYS paths, whatever the
+image size and spp (numpy's cost per call is paid per segment of a wavefront, so
+small wavefronts are slow), and memory is bounded by the unit size, not by image
+size times spp. (The scalar and numpy backends draw
 different random numbers: their images agree up to Monte Carlo noise, not bit for
 bit.)
 """
@@ -14,21 +16,18 @@ bit.)
 from __future__ import annotations
 
 import ctypes
-import math
 import sys
 from collections.abc import Callable
 from functools import partial
 
 import numpy as np
 
-from ..renderer import Backend, Unit
-from ..renderer import plan_units as scalar_plan_units
+from ..renderer import Backend, Unit, plan_bands
 from .camera import CameraRays
 from .integrators import BatchIntegrator, make_integrator
 from .sampling import make_generator
 from .scene import BatchScene
 
-TILE_SIZE = 32
 # Camera samples per unit of work. Large, because after the first bounces few paths
 # live and each segment costs hundreds of numpy calls whatever their length; the
 # arrays of a unit's rays (a few MB each) bound the memory of a render.
@@ -36,17 +35,15 @@ MAX_RAYS = 65536
 
 
 def plan_units(width: int, height: int, spp: int) -> list[Unit]:
-    """All units of work, batch-major: each tile's spp split into the fewest batches
-    that keep a unit at or under MAX_RAYS samples."""
-    n_batches = max(1, math.ceil(spp * TILE_SIZE * TILE_SIZE / MAX_RAYS))
-    return scalar_plan_units(width, height, spp, min(n_batches, spp), TILE_SIZE)
+    """All units of work, batch-major, of at most about MAX_RAYS camera paths."""
+    return plan_bands(width, height, spp, MAX_RAYS)
 
 
 def render_unit(
     scene: BatchScene, rays: CameraRays, integrator: BatchIntegrator, seed: int, unit: Unit
 ) -> np.ndarray:
-    """Sum of unit.spp radiance samples per pixel of the unit's tile: (h, w, 3)."""
-    rng = make_generator(seed, unit.tile, unit.batch)
+    """Sum of unit.spp radiance samples per pixel of the unit's region: (h, w, 3)."""
+    rng = make_generator(seed, unit.region, unit.batch)
     h, w = unit.y1 - unit.y0, unit.x1 - unit.x0
     j, i = np.divmod(np.arange(h * w), w)
     i = np.repeat(i + unit.x0, unit.spp)

@@ -240,8 +240,9 @@ def _high_water_mark_mb() -> float | None:
     return None
 
 
-def _max_rss_mb(children: bool) -> float:
-    """getrusage's ru_maxrss in MB (kilobytes on Linux, bytes on macOS); NaN
+def max_rss_mb(children: bool) -> float:
+    """getrusage's ru_maxrss in MB (kilobytes on Linux, bytes on macOS): the peak of this
+    process since it started, or with children=True of its largest finished child; NaN
     without the `resource` module (Windows)."""
     try:
         import resource
@@ -259,8 +260,8 @@ def peak_memory_mb(children: bool = False) -> float:
     too. NaN where the platform reports neither."""
     own = _high_water_mark_mb()
     if own is None:
-        own = _max_rss_mb(children=False)
+        own = max_rss_mb(children=False)
     if not children:
         return own
-    known = [mb for mb in (own, _max_rss_mb(children=True)) if not math.isnan(mb)]
+    known = [mb for mb in (own, max_rss_mb(children=True)) if not math.isnan(mb)]
     return max(known, default=math.nan)

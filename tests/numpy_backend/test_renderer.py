@@ -53,15 +53,31 @@ def test_render_reports_samples_speed_and_memory():
     assert not image.interrupted and np.isfinite(image.linear).all()
 
 
-def test_ctrl_c_keeps_finished_tiles():
+def test_ctrl_c_keeps_finished_passes():
+    """Units are passes over the image: Ctrl-C during the second pass leaves the whole
+    first one, every pixel with a sample (noisier, not black in places)."""
     scene, camera = small_scene()
-    camera = camera.with_width(64)  # 64 x 36: tiles of 32 x 32, 32 x 32, 32 x 4, 32 x 4
-    scene.add_object(InterruptAfter(calls=32 * 32 * 2 + 100))  # during the second tile
+    camera = camera.with_width(64)  # 64 x 36: one unit holds a whole pass
+    scene.add_object(InterruptAfter(calls=64 * 36 + 100))  # during the second pass
     image = rtpy.render(scene, camera=camera, spp=2, seed=1, integrator="jittered", backend="numpy")
     assert image.interrupted
-    assert image.samples_min == 0 and image.samples_max == 2
-    assert image.stats["paths"] == 32 * 32 * 2  # the first tile, whole
-    assert (image.linear[:32, :32] > 0).all() and not image.linear[:, 32:].any()
+    assert image.samples_min == image.samples_max == 1
+    assert image.stats["paths"] == 64 * 36
+    assert (image.linear.sum(axis=2) > 0).all()
+
+
+@pytest.mark.parametrize(
+    "width,height,spp",
+    [(256, 144, 32), (1920, 1080, 1), (3840, 2160, 1), (100000, 2, 3), (4, 2, 1)],
+)
+def test_units_hold_about_max_rays_paths_whatever_the_spp(width, height, spp):
+    """A unit is as big as MAX_RAYS allows: every unit but the smallest of a batch holds
+    more than half of MAX_RAYS paths (or the whole batch, when it holds fewer)."""
+    units = plan_units(width, height, spp)
+    for batch in {u.batch for u in units}:
+        sizes = sorted((u.x1 - u.x0) * (u.y1 - u.y0) * u.spp for u in units if u.batch == batch)
+        assert sizes[-1] <= MAX_RAYS
+        assert all(size > MAX_RAYS // 2 for size in sizes[1:])
 
 
 class Velvet(Material):
