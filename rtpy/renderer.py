@@ -71,12 +71,15 @@ def plan_units(
 
 
 def plan_bands(width: int, height: int, spp: int, paths_per_unit: int) -> list[Unit]:
-    """All units of work, batch-major, each of at most about paths_per_unit camera
-    paths whatever the image size and spp: spp split into min(spp, MAX_BATCHES)
-    batches (more if a pixel's batch alone would exceed paths_per_unit), the image
-    into bands of whole rows of equal height holding that many paths per batch, or,
-    where one row holds more, each row into pieces of equal width."""
-    n_batches = max(min(spp, MAX_BATCHES), math.ceil(spp / paths_per_unit))
+    """All units of work, batch-major, each of at most paths_per_unit camera paths and
+    of about that many whatever the image size and spp. A batch is a pass over the
+    whole image with as few samples per pixel as fill one unit (one sample when the
+    image holds more pixels than a unit holds paths), so an interrupted render has
+    the same samples in every pixel, give or take a pass. A pass is cut into bands of
+    whole rows of equal height or, where one row holds more paths than a unit, each
+    row into pieces of equal width."""
+    spp_per_pass = max(1, min(spp, paths_per_unit // (width * height)))
+    n_batches = math.ceil(spp / spp_per_pass)
     pixels = max(1, paths_per_unit // math.ceil(spp / n_batches))  # per unit
     if pixels >= width:
         rows = _even_step(height, pixels // width)

@@ -11,6 +11,7 @@ import rtpy
 from rtpy.io.cli import main
 from rtpy.materials.material import Material
 from rtpy.numpy_backend.materials.fallback import ScalarFallback
+from rtpy.numpy_backend import renderer as numpy_renderer
 from rtpy.numpy_backend.renderer import MAX_RAYS, plan_units
 from rtpy.ray import spawn_ray
 from rtpy.scatter_info import ScatterInfo
@@ -53,11 +54,12 @@ def test_render_reports_samples_speed_and_memory():
     assert not image.interrupted and np.isfinite(image.linear).all()
 
 
-def test_ctrl_c_keeps_finished_passes():
-    """Units are passes over the image: Ctrl-C during the second pass leaves the whole
-    first one, every pixel with a sample (noisier, not black in places)."""
+def test_ctrl_c_keeps_finished_passes(monkeypatch):
+    """Batches are passes over the image: Ctrl-C during the second pass leaves the
+    whole first one, every pixel with a sample (noisier, not black in places)."""
     scene, camera = small_scene()
-    camera = camera.with_width(64)  # 64 x 36: one unit holds a whole pass
+    camera = camera.with_width(64)  # 64 x 36
+    monkeypatch.setattr(numpy_renderer, "MAX_RAYS", 64 * 36)  # a pass of 1 spp per unit
     scene.add_object(InterruptAfter(calls=64 * 36 + 100))  # during the second pass
     image = rtpy.render(scene, camera=camera, spp=2, seed=1, integrator="jittered", backend="numpy")
     assert image.interrupted
