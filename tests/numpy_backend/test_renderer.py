@@ -10,8 +10,8 @@ import pytest
 import rtpy
 from rtpy.io.cli import main
 from rtpy.materials.material import Material
-from rtpy.numpy_backend.materials.fallback import ScalarFallback
 from rtpy.numpy_backend import renderer as numpy_renderer
+from rtpy.numpy_backend.materials.fallback import ScalarFallback
 from rtpy.numpy_backend.renderer import MAX_RAYS, plan_units
 from rtpy.ray import spawn_ray
 from rtpy.scatter_info import ScatterInfo
