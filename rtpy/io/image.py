@@ -5,9 +5,13 @@ Conventions used throughout rtpy:
 * A rendered image is an ``(H, W, 3)`` float array of **linear** RGB radiance.
   Row 0 is the **top** of the image and column 0 is the **left**, so pixel
   ``(0, 0)`` is the top-left corner (the same as PIL and most image viewers).
-* Gamma encoding is applied **only** when producing 8-bit display output
-  (``.png``, ``.jpg``, ``.jpeg``). Linear output (``.npy``, ``.pfm``) is never
-  gamma-encoded: it stores the radiance values exactly as rendered, unclamped.
+* The display transform is applied **only** when producing 8-bit display output
+  (``.png``, ``.jpg``, ``.jpeg``): either a power law ``x ** (1 / gamma)`` (the
+  course's gamma 2.0 is the default) or ``gamma = "srgb"``, the sRGB curve. A PNG
+  records which: an ``sRGB`` chunk for "srgb", a ``gAMA`` chunk (1 / gamma)
+  otherwise. Linear output (``.npy``, ``.pfm``, ``.exr``) is never encoded: it
+  stores the radiance values exactly as rendered, unclamped.
+* ``.exr`` output needs the optional OpenEXR package (``pip install 'rtpy[exr]'``).
 * Every file is written atomically: the data goes to a temporary file in the
   destination directory which is then renamed over the target, so a crash or
   Ctrl-C never leaves a half-written output file behind.
@@ -22,13 +26,15 @@ import io
 import os
 import secrets
 import stat
+import struct
 from collections.abc import Callable, Collection
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
+from PIL import Image, PngImagePlugin
 
 __all__ = [
+    "EXR_INSTALL",
     "IMAGE_EXTENSIONS",
     "LINEAR_EXTENSIONS",
     "OUTPUT_EXTENSIONS",
@@ -38,8 +44,11 @@ __all__ = [
     "check_image_path",
     "check_linear_path",
     "check_writable",
+    "linear_to_srgb",
+    "png_info",
     "read_pfm",
     "to_8bit",
+    "write_exr",
     "write_linear",
     "write_npy",
     "write_pfm",
@@ -47,11 +56,15 @@ __all__ = [
 ]
 
 StrPath = str | os.PathLike[str]
+#: A display transform: a gamma > 0 (x ** (1 / gamma)) or "srgb".
+Gamma = float | str
 
 #: Extensions for 8-bit, gamma-encoded display output.
 IMAGE_EXTENSIONS: tuple[str, ...] = (".png", ".jpg", ".jpeg")
 #: Extensions for linear (never gamma-encoded) floating-point output.
-LINEAR_EXTENSIONS: tuple[str, ...] = (".npy", ".pfm")
+LINEAR_EXTENSIONS: tuple[str, ...] = (".npy", ".pfm", ".exr")
+#: How to get what .exr output needs.
+EXR_INSTALL = "pip install 'rtpy[exr]'"
 #: Every extension :meth:`RenderedImage.save` understands.
 OUTPUT_EXTENSIONS: tuple[str, ...] = IMAGE_EXTENSIONS + LINEAR_EXTENSIONS
 
@@ -151,8 +164,24 @@ def check_image_path(path: StrPath) -> Path:
 
 
 def check_linear_path(path: StrPath) -> Path:
-    """:func:`check_writable` for linear float output (``.npy``, ``.pfm``)."""
-    return check_writable(path, LINEAR_EXTENSIONS, "linear output")
+    """:func:`check_writable` for linear float output (``.npy``, ``.pfm``, ``.exr``);
+    for ``.exr`` also that the OpenEXR package is installed."""
+    p = check_writable(path, LINEAR_EXTENSIONS, "linear output")
+    if _ext(p) == ".exr":
+        _openexr(p)
+    return p
+
+
+def _openexr(path: Path):
+    """The OpenEXR module, or OutputError saying how to install it."""
+    try:
+        import OpenEXR
+    except ImportError:
+        raise OutputError(
+            f"cannot write '{os.fspath(path)}': .exr output needs the OpenEXR package "
+            f"({EXR_INSTALL})"
+        ) from None
+    return OpenEXR
 
 
 # --------------------------------------------------------------------------- conversion
@@ -167,27 +196,52 @@ def _as_rgb(linear: np.ndarray, name: str = "linear") -> np.ndarray:
     return arr
 
 
-def _check_gamma(gamma: float) -> float:
+def _check_gamma(gamma: Gamma) -> Gamma:
+    if gamma == "srgb":
+        return gamma
+    if isinstance(gamma, str | bool):
+        raise TypeError(f'gamma must be a positive number or "srgb", got {gamma!r}')
     gamma = float(gamma)
     if not (np.isfinite(gamma) and gamma > 0.0):
         raise ValueError(f"gamma must be a positive finite number, got {gamma!r}")
     return gamma
 
 
-def to_8bit(linear: np.ndarray, gamma: float) -> np.ndarray:
+def linear_to_srgb(x: np.ndarray) -> np.ndarray:
+    """The sRGB transfer curve (IEC 61966-2-1) for linear values in [0, 1]: linear
+    below 0.0031308, then 1.055 x^(1/2.4) - 0.055 (rtpy.texture.srgb_to_linear inverted)."""
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
+
+
+def to_8bit(linear: np.ndarray, gamma: Gamma) -> np.ndarray:
     """Convert an ``(H, W, 3)`` linear RGB image to ``uint8`` for display.
 
     Values are clamped to ``[0, 1]`` (NaN counts as 0, +inf as 1), encoded
-    with ``x ** (1 / gamma)`` (``gamma == 1`` means no encoding), scaled by
+    with ``x ** (1 / gamma)`` (``gamma == 1`` means no encoding) or, for
+    ``gamma == "srgb"``, the sRGB curve (:func:`linear_to_srgb`), scaled by
     255 and rounded to the nearest integer (halves round up).
     """
     gamma = _check_gamma(gamma)
     x = np.array(_as_rgb(linear), dtype=np.float64)  # a copy: the input is never modified
     x[np.isnan(x)] = 0.0
     np.clip(x, 0.0, 1.0, out=x)
-    if gamma != 1.0:
+    if gamma == "srgb":
+        x = linear_to_srgb(x)
+    elif gamma != 1.0:
         np.power(x, 1.0 / gamma, out=x)
     return np.floor(x * 255.0 + 0.5).astype(np.uint8)
+
+
+def png_info(gamma: Gamma) -> PngImagePlugin.PngInfo:
+    """The PNG chunks that record a display transform: sRGB (rendering intent 0,
+    perceptual) for "srgb", else gAMA, the file's gamma 1 / gamma times 100000."""
+    gamma = _check_gamma(gamma)
+    info = PngImagePlugin.PngInfo()
+    if gamma == "srgb":
+        info.add(b"sRGB", bytes([0]))
+    else:
+        info.add(b"gAMA", struct.pack(">I", round(100000.0 / gamma)))
+    return info
 
 
 # --------------------------------------------------------------------------- atomic writes
@@ -245,16 +299,20 @@ def remove_temporary_files() -> None:
 # --------------------------------------------------------------------------- writers
 
 
-def write_png(path: StrPath, linear: np.ndarray, gamma: float) -> Path:
-    """Write 8-bit display output, gamma-encoded with ``gamma`` (see :func:`to_8bit`).
+def write_png(path: StrPath, linear: np.ndarray, gamma: Gamma) -> Path:
+    """Write 8-bit display output, encoded with ``gamma`` (see :func:`to_8bit`).
 
-    The format follows the extension: ``.png`` is written as PNG, ``.jpg`` and
-    ``.jpeg`` as JPEG (quality 95).
+    The format follows the extension: ``.png`` is written as PNG with the chunk
+    that records the transform (:func:`png_info`), ``.jpg`` and ``.jpeg`` as
+    JPEG (quality 95).
     """
     p = check_image_path(path)
     pil = Image.fromarray(to_8bit(linear, gamma))
     fmt = _PIL_FORMATS[_ext(p)]
-    options = {"quality": _JPEG_QUALITY} if fmt == "JPEG" else {}
+    if fmt == "JPEG":
+        options = {"quality": _JPEG_QUALITY}
+    else:
+        options = {"pnginfo": png_info(gamma)}
 
     def write(tmp: Path) -> None:
         pil.save(tmp, format=fmt, **options)
@@ -296,11 +354,28 @@ def write_pfm(path: StrPath, linear: np.ndarray) -> Path:
     return atomic_write(p, lambda tmp: tmp.write_bytes(data))
 
 
+def write_exr(path: StrPath, linear: np.ndarray) -> Path:
+    """Write the linear image as OpenEXR: float32 R, G, B channels, ZIP compression,
+    not gamma-encoded. Needs the OpenEXR package (OutputError says how to install it)."""
+    p = check_writable(path, (".exr",), "OpenEXR output")
+    openexr = _openexr(p)
+    arr = np.ascontiguousarray(_as_rgb(linear), dtype=np.float32)
+    header = {"compression": openexr.ZIP_COMPRESSION, "type": openexr.scanlineimage}
+
+    def write(tmp: Path) -> None:
+        with openexr.File(header, {"RGB": arr}) as f:
+            f.write(str(tmp))
+
+    return atomic_write(p, write)
+
+
 def write_linear(path: StrPath, linear: np.ndarray) -> Path:
-    """Write linear output (never gamma-encoded), choosing ``.npy`` or ``.pfm`` by extension."""
+    """Write linear output (never gamma-encoded): ``.npy``, ``.pfm`` or ``.exr`` by extension."""
     p = check_linear_path(path)
     if _ext(p) == ".npy":
         return write_npy(p, linear)
+    if _ext(p) == ".exr":
+        return write_exr(p, linear)
     return write_pfm(p, linear)
 
 
@@ -364,8 +439,8 @@ class RenderedImage:
     Attributes:
         linear: ``(H, W, 3)`` float64 array of **linear** RGB; pixel ``(0, 0)``
             is the top-left corner (row index = y going down, column = x).
-        gamma: display gamma, used **only** for 8-bit output (:attr:`pil`,
-            ``.png``/``.jpg``); linear output is never gamma-encoded.
+        gamma: display transform, a gamma > 0 or "srgb", used **only** for 8-bit
+            output (:attr:`pil`, ``.png``/``.jpg``); linear output is never encoded.
         spp: requested samples per pixel.
         samples_min, samples_max: fewest and most samples any pixel actually
             holds (both default to ``spp``; smaller after an interrupted render).
@@ -376,7 +451,7 @@ class RenderedImage:
     def __init__(
         self,
         linear: np.ndarray,
-        gamma: float = 2.0,
+        gamma: Gamma = 2.0,
         spp: int = 0,
         samples_min: int | None = None,
         samples_max: int | None = None,
@@ -384,7 +459,7 @@ class RenderedImage:
         stats: dict | None = None,
     ) -> None:
         self.linear: np.ndarray = np.asarray(_as_rgb(linear), dtype=np.float64)
-        self.gamma: float = _check_gamma(gamma)
+        self.gamma: Gamma = _check_gamma(gamma)
         self.spp: int = int(spp)
         self.samples_min: int = self.spp if samples_min is None else int(samples_min)
         self.samples_max: int = self.spp if samples_max is None else int(samples_max)
@@ -413,8 +488,8 @@ class RenderedImage:
     def save(self, path: StrPath) -> Path:
         """Save by extension and return the path written.
 
-        ``.png``/``.jpg``/``.jpeg`` are 8-bit and gamma-encoded with :attr:`gamma`;
-        ``.npy``/``.pfm`` are linear and never gamma-encoded. Any other extension
+        ``.png``/``.jpg``/``.jpeg`` are 8-bit and encoded with :attr:`gamma`;
+        ``.npy``/``.pfm``/``.exr`` are linear and never encoded. Any other extension
         raises :class:`OutputError`.
         """
         ext = _ext(Path(path))
@@ -427,7 +502,7 @@ class RenderedImage:
     def _repr_png_(self) -> bytes:
         """PNG bytes of the 8-bit image, so Jupyter displays a RenderedImage inline."""
         buf = io.BytesIO()
-        self.pil.save(buf, format="PNG")
+        self.pil.save(buf, format="PNG", pnginfo=png_info(self.gamma))
         return buf.getvalue()
 
     def __repr__(self) -> str:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import os
 import stat
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,7 @@ from rtpy.io.image import (
     check_image_path,
     check_linear_path,
     check_writable,
+    linear_to_srgb,
     read_pfm,
     to_8bit,
     write_linear,
@@ -28,6 +30,7 @@ from rtpy.io.image import (
     write_pfm,
     write_png,
 )
+from rtpy.texture import srgb_to_linear
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -412,7 +415,7 @@ def test_check_writable_path_is_directory(tmp_path: Path) -> None:
         (check_image_path, "x.pfm"),
         (check_image_path, "x"),
         (check_linear_path, "x.png"),
-        (check_linear_path, "x.exr"),
+        (check_linear_path, "x.tiff"),
     ],
 )
 def test_check_writable_unsupported_extension(tmp_path: Path, check, name: str) -> None:
@@ -544,3 +547,73 @@ def test_rendered_image_save_unsupported(tmp_path: Path) -> None:
 def test_rendered_image_save_missing_directory(tmp_path: Path) -> None:
     with pytest.raises(OutputError, match="does not exist"):
         make_result().save(tmp_path / "missing" / "out.png")
+
+
+# --------------------------------------------------------------------------- sRGB and PNG chunks
+
+
+def test_srgb_curve_values_and_inverse() -> None:
+    # IEC 61966-2-1: linear toe below 0.0031308, 1.055 x^(1/2.4) - 0.055 above; the
+    # two pieces meet there, and the curve undoes the texture decoder's.
+    x = np.array([0.0, 0.001, 0.0031308, 0.18, 0.5, 1.0])
+    y = linear_to_srgb(x)
+    assert y[1] == pytest.approx(0.01292)
+    assert 12.92 * 0.0031308 == pytest.approx(1.055 * 0.0031308 ** (1 / 2.4) - 0.055, abs=1e-6)
+    assert y[-1] == pytest.approx(1.0)
+    np.testing.assert_allclose(srgb_to_linear(y), x, rtol=1e-12, atol=1e-15)
+
+
+def test_to_8bit_srgb() -> None:
+    # 0.5 -> 1.055 * 0.5^(1/2.4) - 0.055 = 0.7354 -> 188; gamma 2 gives 180 there.
+    assert to_8bit(rgb([0.0, 0.5, 1.0]), "srgb")[0, :, 0].tolist() == [0, 188, 255]
+    assert to_8bit(rgb([0.5]), 2.0)[0, 0, 0] == 180
+
+
+@pytest.mark.parametrize("gamma", ["linear", "SRGB", True])
+def test_to_8bit_refuses_other_transforms(gamma) -> None:
+    with pytest.raises((TypeError, ValueError), match="gamma"):
+        to_8bit(rgb([0.5]), gamma)
+
+
+@pytest.mark.parametrize("gamma, info", [(2.0, {"gamma": 0.5}), (2.2, {"gamma": 0.45455})])
+def test_png_records_its_gamma(tmp_path: Path, gamma: float, info: dict) -> None:
+    write_png(tmp_path / "a.png", rgb([0.5]), gamma)
+    with Image.open(tmp_path / "a.png") as pil:
+        assert {k: pil.info[k] for k in ("gamma", "srgb") if k in pil.info} == info
+
+
+def test_png_records_srgb(tmp_path: Path) -> None:
+    result = RenderedImage(rgb([0.25, 0.5]), gamma="srgb")
+    result.save(tmp_path / "a.png")
+    for source in (tmp_path / "a.png", io.BytesIO(result._repr_png_())):
+        with Image.open(source) as pil:
+            assert pil.info.get("srgb") == 0 and "gamma" not in pil.info
+            assert np.array_equal(np.asarray(pil), to_8bit(result.linear, "srgb"))
+
+
+# --------------------------------------------------------------------------- OpenEXR
+
+
+def test_exr_round_trip(tmp_path: Path) -> None:
+    openexr = pytest.importorskip("OpenEXR")
+    img = random_image(3, 5, seed=9)
+    assert RenderedImage(img).save(tmp_path / "a.exr") == tmp_path / "a.exr"
+    write_linear(tmp_path / "b.EXR", img)
+    for name in ("a.exr", "b.EXR"):
+        with openexr.File(str(tmp_path / name)) as f:
+            back = f.channels()["RGB"].pixels
+        np.testing.assert_array_equal(back, img.astype(np.float32))  # unclamped, no gamma
+    assert listing(tmp_path) == ["a.exr", "b.EXR"]
+
+
+def test_exr_without_openexr_says_how_to_install(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "OpenEXR", None)  # import OpenEXR fails
+    for attempt in (check_linear_path, lambda p: make_result().save(p)):
+        with pytest.raises(OutputError) as info:
+            attempt(tmp_path / "a.exr")
+        message = str(info.value)
+        assert "a.exr" in message and "pip install 'rtpy[exr]'" in message
+        assert "\n" not in message
+    assert listing(tmp_path) == []
