@@ -26,12 +26,13 @@ import io
 import os
 import secrets
 import stat
-import struct
 from collections.abc import Callable, Collection
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, PngImagePlugin
+from PIL import Image
+
+from .display import Gamma, as_rgb, check_gamma, linear_to_srgb, png_info, to_8bit
 
 __all__ = [
     "EXR_INSTALL",
@@ -56,8 +57,6 @@ __all__ = [
 ]
 
 StrPath = str | os.PathLike[str]
-#: A display transform: a gamma > 0 (x ** (1 / gamma)) or "srgb".
-Gamma = float | str
 
 #: Extensions for 8-bit, gamma-encoded display output.
 IMAGE_EXTENSIONS: tuple[str, ...] = (".png", ".jpg", ".jpeg")
@@ -184,66 +183,6 @@ def _openexr(path: Path):
     return OpenEXR
 
 
-# --------------------------------------------------------------------------- conversion
-
-
-def _as_rgb(linear: np.ndarray, name: str = "linear") -> np.ndarray:
-    arr = np.asarray(linear)
-    if arr.ndim != 3 or arr.shape[2] != 3:
-        raise ValueError(f"{name} must have shape (H, W, 3), got {arr.shape}")
-    if arr.shape[0] == 0 or arr.shape[1] == 0:
-        raise ValueError(f"{name} must not be empty, got shape {arr.shape}")
-    return arr
-
-
-def _check_gamma(gamma: Gamma) -> Gamma:
-    if gamma == "srgb":
-        return gamma
-    if isinstance(gamma, str | bool):
-        raise TypeError(f'gamma must be a positive number or "srgb", got {gamma!r}')
-    gamma = float(gamma)
-    if not (np.isfinite(gamma) and gamma > 0.0):
-        raise ValueError(f"gamma must be a positive finite number, got {gamma!r}")
-    return gamma
-
-
-def linear_to_srgb(x: np.ndarray) -> np.ndarray:
-    """The sRGB transfer curve (IEC 61966-2-1) for linear values in [0, 1]: linear
-    below 0.0031308, then 1.055 x^(1/2.4) - 0.055 (rtpy.texture.srgb_to_linear inverted)."""
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
-
-
-def to_8bit(linear: np.ndarray, gamma: Gamma) -> np.ndarray:
-    """Convert an ``(H, W, 3)`` linear RGB image to ``uint8`` for display.
-
-    Values are clamped to ``[0, 1]`` (NaN counts as 0, +inf as 1), encoded
-    with ``x ** (1 / gamma)`` (``gamma == 1`` means no encoding) or, for
-    ``gamma == "srgb"``, the sRGB curve (:func:`linear_to_srgb`), scaled by
-    255 and rounded to the nearest integer (halves round up).
-    """
-    gamma = _check_gamma(gamma)
-    x = np.array(_as_rgb(linear), dtype=np.float64)  # a copy: the input is never modified
-    x[np.isnan(x)] = 0.0
-    np.clip(x, 0.0, 1.0, out=x)
-    if gamma == "srgb":
-        x = linear_to_srgb(x)
-    elif gamma != 1.0:
-        np.power(x, 1.0 / gamma, out=x)
-    return np.floor(x * 255.0 + 0.5).astype(np.uint8)
-
-
-def png_info(gamma: Gamma) -> PngImagePlugin.PngInfo:
-    """The PNG chunks that record a display transform: sRGB (rendering intent 0,
-    perceptual) for "srgb", else gAMA, the file's gamma 1 / gamma times 100000."""
-    gamma = _check_gamma(gamma)
-    info = PngImagePlugin.PngInfo()
-    if gamma == "srgb":
-        info.add(b"sRGB", bytes([0]))
-    else:
-        info.add(b"gAMA", struct.pack(">I", round(100000.0 / gamma)))
-    return info
-
-
 # --------------------------------------------------------------------------- atomic writes
 
 
@@ -323,7 +262,7 @@ def write_png(path: StrPath, linear: np.ndarray, gamma: Gamma) -> Path:
 def write_npy(path: StrPath, linear: np.ndarray) -> Path:
     """Write the linear ``(H, W, 3)`` array as ``.npy``, keeping its dtype (not gamma-encoded)."""
     p = check_writable(path, (".npy",), "NumPy output")
-    arr = _as_rgb(linear)
+    arr = as_rgb(linear)
 
     def write(tmp: Path) -> None:
         # Save through a file object: np.save(path) would append ".npy" to the temp name.
@@ -334,7 +273,7 @@ def write_npy(path: StrPath, linear: np.ndarray) -> Path:
 
 
 def _pfm_bytes(linear: np.ndarray) -> bytes:
-    arr = _as_rgb(linear)
+    arr = as_rgb(linear)
     h, w, _ = arr.shape
     header = b"PF\n" + f"{w} {h}\n".encode("ascii") + b"-1.0\n"
     # PFM stores rows from the bottom of the image to the top; "-1.0" = little-endian.
@@ -359,7 +298,7 @@ def write_exr(path: StrPath, linear: np.ndarray) -> Path:
     not gamma-encoded. Needs the OpenEXR package (OutputError says how to install it)."""
     p = check_writable(path, (".exr",), "OpenEXR output")
     openexr = _openexr(p)
-    arr = np.ascontiguousarray(_as_rgb(linear), dtype=np.float32)
+    arr = np.ascontiguousarray(as_rgb(linear), dtype=np.float32)
     header = {"compression": openexr.ZIP_COMPRESSION, "type": openexr.scanlineimage}
 
     def write(tmp: Path) -> None:
@@ -458,8 +397,8 @@ class RenderedImage:
         interrupted: bool = False,
         stats: dict | None = None,
     ) -> None:
-        self.linear: np.ndarray = np.asarray(_as_rgb(linear), dtype=np.float64)
-        self.gamma: Gamma = _check_gamma(gamma)
+        self.linear: np.ndarray = np.asarray(as_rgb(linear), dtype=np.float64)
+        self.gamma: Gamma = check_gamma(gamma)
         self.spp: int = int(spp)
         self.samples_min: int = self.spp if samples_min is None else int(samples_min)
         self.samples_max: int = self.spp if samples_max is None else int(samples_max)
