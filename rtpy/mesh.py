@@ -24,9 +24,11 @@ class SmoothTriangle(Triangle):
     At a hit with barycentric weights (1 - u - v, u, v) of a, b, c the shading
     normal is normalize((1 - u - v) na + u nb + v nc), turned to the side of the
     geometric normal when it points away from it. HitInfo.normal is that shading
-    normal on the side the ray came from; front_face, the offsets of rays leaving
-    the surface (ray.spawn_ray) and the light-sampling densities keep using the
-    geometric normal `normal`, so the triangle stays flat for intersection.
+    normal on the side the ray came from. Intersection, front_face (which side
+    was hit, which side emits) and the light-sampling densities keep the geometric
+    normal `normal`. Rays leaving the surface are pushed off it along hit.normal
+    (ray.spawn_ray), as on every shape; a direction between the two planes may
+    then meet the triangle again from behind, the usual price of shading normals.
     """
 
     def __init__(self, a: Vec3, b: Vec3, c: Vec3, normals: Sequence[Vec3], material) -> None:
@@ -113,6 +115,9 @@ def _usable(n: Vec3) -> bool:
 class Mesh:
     """The triangles of a mesh, placed by a transform.
 
+        mesh = Mesh.from_obj("teapot.obj", Lambertian(), Transform(scale=Vec3(0.5, 0.5, 0.5)))
+        scene = Scene([*mesh.triangles, ...])
+
     positions  vertex positions; normals: vertex normals (may be empty)
     triangles  triples of corners (position index, normal index or None), as
                rtpy.io.obj.ObjMesh.triangles
@@ -146,3 +151,12 @@ class Mesh:
                 self.skipped += 1
                 continue
             self.triangles.append(tri)
+
+    @classmethod
+    def from_obj(cls, path, material, transform: Transform | None = None) -> Mesh:
+        """The mesh of a Wavefront OBJ file (rtpy.io.obj.read_obj, whose ObjError
+        names the line it cannot read)."""
+        from .io.obj import read_obj
+
+        obj = read_obj(path)
+        return cls(obj.positions, obj.normals, obj.triangles, material, transform)

@@ -561,17 +561,6 @@ def test_a_mesh_is_its_triangles_placed_by_scale_rotate_translate(tmp_path):
     assert uniform.objects[3].a == Vec3(3, 0, 0)  # face 2 3 4 starts at (1, 0, 0)
 
 
-def test_a_mesh_scene_renders_on_both_backends(tmp_path):
-    import rtpy
-
-    scene_text = mesh_scene(tmp_path, TETRA, "translate = [-0.3, -0.3, -2]\n")
-    path = tmp_path / "s.toml"
-    path.write_text("[render]\nsky = true\n\n" + scene_text)
-    for backend in ("scalar", "numpy"):
-        image = rtpy.render(rtpy.load_scene(path), width=16, spp=1, backend=backend)
-        assert image.linear[4, 8].sum() < image.linear[0, 0].sum()  # the mesh hides the sky
-
-
 @pytest.mark.parametrize(
     "obj_text, extra, key, words",
     [
