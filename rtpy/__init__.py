@@ -33,6 +33,7 @@ from .materials import (
     Ward,
     register_material,
 )
+from .mesh import Mesh, SmoothTriangle, Transform
 from .quad import Quad
 from .ray import Ray
 from .render_settings import SETTINGS, RenderSettings
@@ -115,6 +116,9 @@ __all__ = [
     "Sphere",
     "Quad",
     "Triangle",
+    "SmoothTriangle",
+    "Mesh",
+    "Transform",
     "PointLight",
     # materials and textures
     "Material",

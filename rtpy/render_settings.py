@@ -21,7 +21,9 @@ from .io.values import (
     Invalid,
     Range,
     boolean,
+    describe,
     integer,
+    is_number,
     number,
     string,
     suggest,
@@ -78,11 +80,12 @@ class SettingValueError(SettingError, ValueError):
 class Setting:
     """One render setting: its type and limits, its default and what it does.
 
-    kind: "int", "float", "bool", "choice" (one of choices) or "color" (three
-    numbers). table: the scene file table that holds it ("render", or "camera"
-    for width). field: it is a RenderSettings field (background and sky belong
-    to the scene, width to the camera). flag: the command line also has
-    --NAME for it (besides --set NAME=VALUE).
+    kind: "int", "float", "bool", "choice" (one of choices), "color" (three
+    numbers) or "gamma" (a number in range, or one of choices). table: the scene
+    file table that holds it ("render", or "camera" for width). field: it is a
+    RenderSettings field (background and sky belong to the scene, width to the
+    camera). flag: the command line also has --NAME for it (besides --set
+    NAME=VALUE).
     """
 
     name: str
@@ -107,6 +110,13 @@ class Setting:
                 return boolean(value)
             if self.kind == "choice":
                 return string(value, self.choices)
+            if self.kind == "gamma":
+                if isinstance(value, str):
+                    return string(value, self.choices)
+                if not is_number(value):
+                    what = f'a number {self.range.text()} or "srgb"'
+                    raise Invalid(f"expected {what}, found {describe(value)}", wrong_type=True)
+                return number(value, self.range)
             if isinstance(value, Color):
                 value = value.tolist()
             return Color(*triple(value, self.range))
@@ -177,7 +187,15 @@ SETTINGS: dict[str, Setting] = {
             "rays that leave the scene see a sky gradient instead of the background",
             field=False,
         ),
-        Setting("gamma", "float", 2.0, "display gamma for 8-bit output", POSITIVE),
+        Setting(
+            "gamma",
+            "gamma",
+            2.0,
+            "display transform of 8-bit output: a number > 0, x^(1/gamma) (the course's "
+            '2.0), or "srgb", the sRGB curve; a PNG records which (gAMA or sRGB chunk)',
+            POSITIVE,
+            choices=("srgb",),
+        ),
         Setting(
             "mis",
             "bool",
@@ -223,7 +241,7 @@ class RenderSettings:
     nee: bool = SETTINGS["nee"].default
     russian_roulette: int = SETTINGS["russian_roulette"].default
     seed: int = SETTINGS["seed"].default
-    gamma: float = SETTINGS["gamma"].default
+    gamma: float | str = SETTINGS["gamma"].default
     mis: bool = SETTINGS["mis"].default
 
     def __post_init__(self) -> None:

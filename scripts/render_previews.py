@@ -27,6 +27,7 @@ SETTINGS = {
     "week08_blinn": (320, 32),
     "week08_cook_torrance": (320, 32),
     "material_gallery": (400, 32),
+    "teapot": (320, 32),
 }
 
 

@@ -52,11 +52,18 @@ def test_wrong_types_are_type_errors_and_wrong_values_value_errors_naming_the_se
         RenderSettings(spp=0)
     with pytest.raises(ValueError, match=r"^integrator: .* — did you mean 'path'\?$"):
         RenderSettings(integrator="pth")
-    with pytest.raises(TypeError, match=r"^gamma: expected a number > 0, found true$"):
+    with pytest.raises(TypeError, match=r'^gamma: expected a number > 0 or "srgb", found true$'):
         RenderSettings(gamma=True)
+    with pytest.raises(ValueError, match=r'^gamma: expected one of "srgb", found .*"linear"$'):
+        RenderSettings(gamma="linear")
     with pytest.raises(TypeError, match=r"^spq: not a render setting .* did you mean 'spp'\?$"):
         RenderSettings().with_overrides(spq=4)
     assert RenderSettings().with_overrides(spp=None, seed=3) == RenderSettings(seed=3)
+
+
+def test_gamma_is_a_number_or_srgb():
+    assert RenderSettings(gamma="srgb").gamma == "srgb"
+    assert RenderSettings().gamma == 2.0  # the course's display gamma stays the default
 
 
 def test_numbers_are_stored_as_python_numbers():

@@ -69,8 +69,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--linear",
-        metavar="OUT.npy|OUT.pfm",
-        help="also write the linear float image (never gamma-encoded)",
+        metavar="OUT.npy|OUT.pfm|OUT.exr",
+        help="also write the linear float image: .npy, .pfm or .exr (never gamma-encoded)",
     )
     add_setting_options(r)
     r.add_argument(

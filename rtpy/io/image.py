@@ -5,9 +5,13 @@ Conventions used throughout rtpy:
 * A rendered image is an ``(H, W, 3)`` float array of **linear** RGB radiance.
   Row 0 is the **top** of the image and column 0 is the **left**, so pixel
   ``(0, 0)`` is the top-left corner (the same as PIL and most image viewers).
-* Gamma encoding is applied **only** when producing 8-bit display output
-  (``.png``, ``.jpg``, ``.jpeg``). Linear output (``.npy``, ``.pfm``) is never
-  gamma-encoded: it stores the radiance values exactly as rendered, unclamped.
+* The display transform is applied **only** when producing 8-bit display output
+  (``.png``, ``.jpg``, ``.jpeg``): either a power law ``x ** (1 / gamma)`` (the
+  course's gamma 2.0 is the default) or ``gamma = "srgb"``, the sRGB curve. A PNG
+  records which: an ``sRGB`` chunk for "srgb", a ``gAMA`` chunk (1 / gamma)
+  otherwise. Linear output (``.npy``, ``.pfm``, ``.exr``) is never encoded: it
+  stores the radiance values exactly as rendered, unclamped.
+* ``.exr`` output needs the optional OpenEXR package (``pip install 'rtpy[exr]'``).
 * Every file is written atomically: the data goes to a temporary file in the
   destination directory which is then renamed over the target, so a crash or
   Ctrl-C never leaves a half-written output file behind.
@@ -28,7 +32,10 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from .display import Gamma, as_rgb, check_gamma, linear_to_srgb, png_info, to_8bit
+
 __all__ = [
+    "EXR_INSTALL",
     "IMAGE_EXTENSIONS",
     "LINEAR_EXTENSIONS",
     "OUTPUT_EXTENSIONS",
@@ -38,8 +45,11 @@ __all__ = [
     "check_image_path",
     "check_linear_path",
     "check_writable",
+    "linear_to_srgb",
+    "png_info",
     "read_pfm",
     "to_8bit",
+    "write_exr",
     "write_linear",
     "write_npy",
     "write_pfm",
@@ -51,7 +61,9 @@ StrPath = str | os.PathLike[str]
 #: Extensions for 8-bit, gamma-encoded display output.
 IMAGE_EXTENSIONS: tuple[str, ...] = (".png", ".jpg", ".jpeg")
 #: Extensions for linear (never gamma-encoded) floating-point output.
-LINEAR_EXTENSIONS: tuple[str, ...] = (".npy", ".pfm")
+LINEAR_EXTENSIONS: tuple[str, ...] = (".npy", ".pfm", ".exr")
+#: How to get what .exr output needs.
+EXR_INSTALL = "pip install 'rtpy[exr]'"
 #: Every extension :meth:`RenderedImage.save` understands.
 OUTPUT_EXTENSIONS: tuple[str, ...] = IMAGE_EXTENSIONS + LINEAR_EXTENSIONS
 
@@ -151,43 +163,24 @@ def check_image_path(path: StrPath) -> Path:
 
 
 def check_linear_path(path: StrPath) -> Path:
-    """:func:`check_writable` for linear float output (``.npy``, ``.pfm``)."""
-    return check_writable(path, LINEAR_EXTENSIONS, "linear output")
+    """:func:`check_writable` for linear float output (``.npy``, ``.pfm``, ``.exr``);
+    for ``.exr`` also that the OpenEXR package is installed."""
+    p = check_writable(path, LINEAR_EXTENSIONS, "linear output")
+    if _ext(p) == ".exr":
+        _openexr(p)
+    return p
 
 
-# --------------------------------------------------------------------------- conversion
-
-
-def _as_rgb(linear: np.ndarray, name: str = "linear") -> np.ndarray:
-    arr = np.asarray(linear)
-    if arr.ndim != 3 or arr.shape[2] != 3:
-        raise ValueError(f"{name} must have shape (H, W, 3), got {arr.shape}")
-    if arr.shape[0] == 0 or arr.shape[1] == 0:
-        raise ValueError(f"{name} must not be empty, got shape {arr.shape}")
-    return arr
-
-
-def _check_gamma(gamma: float) -> float:
-    gamma = float(gamma)
-    if not (np.isfinite(gamma) and gamma > 0.0):
-        raise ValueError(f"gamma must be a positive finite number, got {gamma!r}")
-    return gamma
-
-
-def to_8bit(linear: np.ndarray, gamma: float) -> np.ndarray:
-    """Convert an ``(H, W, 3)`` linear RGB image to ``uint8`` for display.
-
-    Values are clamped to ``[0, 1]`` (NaN counts as 0, +inf as 1), encoded
-    with ``x ** (1 / gamma)`` (``gamma == 1`` means no encoding), scaled by
-    255 and rounded to the nearest integer (halves round up).
-    """
-    gamma = _check_gamma(gamma)
-    x = np.array(_as_rgb(linear), dtype=np.float64)  # a copy: the input is never modified
-    x[np.isnan(x)] = 0.0
-    np.clip(x, 0.0, 1.0, out=x)
-    if gamma != 1.0:
-        np.power(x, 1.0 / gamma, out=x)
-    return np.floor(x * 255.0 + 0.5).astype(np.uint8)
+def _openexr(path: Path):
+    """The OpenEXR module, or OutputError saying how to install it."""
+    try:
+        import OpenEXR
+    except ImportError:
+        raise OutputError(
+            f"cannot write '{os.fspath(path)}': .exr output needs the OpenEXR package "
+            f"({EXR_INSTALL})"
+        ) from None
+    return OpenEXR
 
 
 # --------------------------------------------------------------------------- atomic writes
@@ -245,16 +238,20 @@ def remove_temporary_files() -> None:
 # --------------------------------------------------------------------------- writers
 
 
-def write_png(path: StrPath, linear: np.ndarray, gamma: float) -> Path:
-    """Write 8-bit display output, gamma-encoded with ``gamma`` (see :func:`to_8bit`).
+def write_png(path: StrPath, linear: np.ndarray, gamma: Gamma) -> Path:
+    """Write 8-bit display output, encoded with ``gamma`` (see :func:`to_8bit`).
 
-    The format follows the extension: ``.png`` is written as PNG, ``.jpg`` and
-    ``.jpeg`` as JPEG (quality 95).
+    The format follows the extension: ``.png`` is written as PNG with the chunk
+    that records the transform (:func:`png_info`), ``.jpg`` and ``.jpeg`` as
+    JPEG (quality 95).
     """
     p = check_image_path(path)
     pil = Image.fromarray(to_8bit(linear, gamma))
     fmt = _PIL_FORMATS[_ext(p)]
-    options = {"quality": _JPEG_QUALITY} if fmt == "JPEG" else {}
+    if fmt == "JPEG":
+        options = {"quality": _JPEG_QUALITY}
+    else:
+        options = {"pnginfo": png_info(gamma)}
 
     def write(tmp: Path) -> None:
         pil.save(tmp, format=fmt, **options)
@@ -265,7 +262,7 @@ def write_png(path: StrPath, linear: np.ndarray, gamma: float) -> Path:
 def write_npy(path: StrPath, linear: np.ndarray) -> Path:
     """Write the linear ``(H, W, 3)`` array as ``.npy``, keeping its dtype (not gamma-encoded)."""
     p = check_writable(path, (".npy",), "NumPy output")
-    arr = _as_rgb(linear)
+    arr = as_rgb(linear)
 
     def write(tmp: Path) -> None:
         # Save through a file object: np.save(path) would append ".npy" to the temp name.
@@ -276,7 +273,7 @@ def write_npy(path: StrPath, linear: np.ndarray) -> Path:
 
 
 def _pfm_bytes(linear: np.ndarray) -> bytes:
-    arr = _as_rgb(linear)
+    arr = as_rgb(linear)
     h, w, _ = arr.shape
     header = b"PF\n" + f"{w} {h}\n".encode("ascii") + b"-1.0\n"
     # PFM stores rows from the bottom of the image to the top; "-1.0" = little-endian.
@@ -296,11 +293,28 @@ def write_pfm(path: StrPath, linear: np.ndarray) -> Path:
     return atomic_write(p, lambda tmp: tmp.write_bytes(data))
 
 
+def write_exr(path: StrPath, linear: np.ndarray) -> Path:
+    """Write the linear image as OpenEXR: float32 R, G, B channels, ZIP compression,
+    not gamma-encoded. Needs the OpenEXR package (OutputError says how to install it)."""
+    p = check_writable(path, (".exr",), "OpenEXR output")
+    openexr = _openexr(p)
+    arr = np.ascontiguousarray(as_rgb(linear), dtype=np.float32)
+    header = {"compression": openexr.ZIP_COMPRESSION, "type": openexr.scanlineimage}
+
+    def write(tmp: Path) -> None:
+        with openexr.File(header, {"RGB": arr}) as f:
+            f.write(str(tmp))
+
+    return atomic_write(p, write)
+
+
 def write_linear(path: StrPath, linear: np.ndarray) -> Path:
-    """Write linear output (never gamma-encoded), choosing ``.npy`` or ``.pfm`` by extension."""
+    """Write linear output (never gamma-encoded): ``.npy``, ``.pfm`` or ``.exr`` by extension."""
     p = check_linear_path(path)
     if _ext(p) == ".npy":
         return write_npy(p, linear)
+    if _ext(p) == ".exr":
+        return write_exr(p, linear)
     return write_pfm(p, linear)
 
 
@@ -364,8 +378,8 @@ class RenderedImage:
     Attributes:
         linear: ``(H, W, 3)`` float64 array of **linear** RGB; pixel ``(0, 0)``
             is the top-left corner (row index = y going down, column = x).
-        gamma: display gamma, used **only** for 8-bit output (:attr:`pil`,
-            ``.png``/``.jpg``); linear output is never gamma-encoded.
+        gamma: display transform, a gamma > 0 or "srgb", used **only** for 8-bit
+            output (:attr:`pil`, ``.png``/``.jpg``); linear output is never encoded.
         spp: requested samples per pixel.
         samples_min, samples_max: fewest and most samples any pixel actually
             holds (both default to ``spp``; smaller after an interrupted render).
@@ -376,15 +390,15 @@ class RenderedImage:
     def __init__(
         self,
         linear: np.ndarray,
-        gamma: float = 2.0,
+        gamma: Gamma = 2.0,
         spp: int = 0,
         samples_min: int | None = None,
         samples_max: int | None = None,
         interrupted: bool = False,
         stats: dict | None = None,
     ) -> None:
-        self.linear: np.ndarray = np.asarray(_as_rgb(linear), dtype=np.float64)
-        self.gamma: float = _check_gamma(gamma)
+        self.linear: np.ndarray = np.asarray(as_rgb(linear), dtype=np.float64)
+        self.gamma: Gamma = check_gamma(gamma)
         self.spp: int = int(spp)
         self.samples_min: int = self.spp if samples_min is None else int(samples_min)
         self.samples_max: int = self.spp if samples_max is None else int(samples_max)
@@ -413,8 +427,8 @@ class RenderedImage:
     def save(self, path: StrPath) -> Path:
         """Save by extension and return the path written.
 
-        ``.png``/``.jpg``/``.jpeg`` are 8-bit and gamma-encoded with :attr:`gamma`;
-        ``.npy``/``.pfm`` are linear and never gamma-encoded. Any other extension
+        ``.png``/``.jpg``/``.jpeg`` are 8-bit and encoded with :attr:`gamma`;
+        ``.npy``/``.pfm``/``.exr`` are linear and never encoded. Any other extension
         raises :class:`OutputError`.
         """
         ext = _ext(Path(path))
@@ -427,7 +441,7 @@ class RenderedImage:
     def _repr_png_(self) -> bytes:
         """PNG bytes of the 8-bit image, so Jupyter displays a RenderedImage inline."""
         buf = io.BytesIO()
-        self.pil.save(buf, format="PNG")
+        self.pil.save(buf, format="PNG", pnginfo=png_info(self.gamma))
         return buf.getvalue()
 
     def __repr__(self) -> str:

@@ -25,6 +25,7 @@ import json
 import math
 import re
 import tomllib
+import warnings
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -32,6 +33,7 @@ from typing import Any
 from ..camera import Camera
 from ..light import PointLight
 from ..materials import MATERIALS
+from ..mesh import Mesh, Transform
 from ..quad import Quad
 from ..render_settings import (
     MAX_MAX_DEPTH,
@@ -48,7 +50,8 @@ from ..triangle import Triangle
 from ..vec3 import Color, Vec3, cross
 from . import values
 from .material_params import MATERIAL_RANGES, Param, material_parameters
-from .scene_tables import SceneError, TableReader
+from .obj import ObjError, read_obj
+from .scene_tables import SceneError, SceneWarning, TableReader
 from .toml_lines import TomlLines, Where, quote_key
 from .values import ANY, MAX_RADIANCE, POSITIVE, RADIANCE, UNIT, Range, describe, suggest
 
@@ -60,6 +63,7 @@ __all__ = [
     "MAX_TEXTURE_PIXELS",
     "MAX_WIDTH",
     "SceneError",
+    "SceneWarning",
     "load_scene",
     "load_scene_text",
 ]
@@ -89,6 +93,7 @@ OBJECT_KEYS = {
     "sphere": ("type", "center", "radius", "material"),
     "quad": ("type", "q", "u", "v", "material"),
     "triangle": ("type", "a", "b", "c", "material"),
+    "mesh": ("type", "path", "material", "translate", "rotate", "scale"),
 }
 LIGHT_KEYS = {"point": ("type", "position", "intensity")}
 
@@ -121,10 +126,13 @@ class _Loader(TableReader):
             self.textures[name] = self.texture(Where.table("textures", name), t)
         for name, t in self.named_tables(data, "materials").items():
             self.materials[name] = self.material(Where.table("materials", name), t)
-        objects = [
-            self.object(Where.array("objects", i), t)
-            for i, t in enumerate(self.array_of_tables(data, "objects"))
-        ]
+        objects = []
+        for i, t in enumerate(self.array_of_tables(data, "objects")):
+            w = Where.array("objects", i)
+            if t.get("type") == "mesh":
+                objects.extend(self.mesh(w, t))
+            else:
+                objects.append(self.object(w, t))
         lights = [
             self.light(Where.array("lights", i), t)
             for i, t in enumerate(self.array_of_tables(data, "lights"))
@@ -338,6 +346,60 @@ class _Loader(TableReader):
         return self.build(
             w, blamed, lambda m: shape(*corners, m), self.reference(w, t), f" ({found})"
         )
+
+    def mesh(self, w: Where, t: dict) -> list:
+        """The triangles of a [[objects]] table of type "mesh" (an OBJ file)."""
+        self.check_keys(w, t, OBJECT_KEYS["mesh"], 'type "mesh"')
+        what = "the path of a Wavefront OBJ file"
+        rel = self.require(w, t, "path", what)
+        if not isinstance(rel, str) or not rel:
+            raise self.expected(w, "path", what, rel)
+        translate = self.vec3(w, "translate", t.get("translate", [0, 0, 0]))
+        rotate = self.vec3(w, "rotate", t.get("rotate", [0, 0, 0]))
+        scale = t.get("scale", 1)
+        if values.is_number(scale):
+            scale = [scale] * 3
+        elif not isinstance(scale, list):
+            raise self.expected(w, "scale", "a number or an array of 3 numbers, none 0", scale)
+        scale = self.vec3(w, "scale", scale)
+        if any(s == 0.0 for s in scale):
+            raise self.fail(
+                w, "scale", f"a scale of 0 flattens the mesh, found {describe(list(scale))}"
+            )
+        material = self.reference(w, t)
+        resolved = self.path.parent / rel
+        try:
+            obj = read_obj(resolved)
+        except FileNotFoundError:
+            raise self.fail(w, "path", f"OBJ file not found: {resolved}") from None
+        except IsADirectoryError:
+            raise self.fail(w, "path", f"{resolved} is a directory, not an OBJ file") from None
+        except OSError as e:
+            raise self.fail(w, "path", f"cannot read {resolved}: {e.strerror or e}") from None
+        except ObjError as e:
+            at = f" line {e.line}" if e.line is not None else ""
+            raise self.fail(w, "path", f"{resolved}{at}: {e.detail}") from None
+        mesh = self.build(
+            w,
+            "scale",
+            lambda m: Mesh(
+                obj.positions, obj.normals, obj.triangles, m, Transform(translate, rotate, scale)
+            ),
+            material,
+        )
+        if not mesh.triangles:
+            faces = len(obj.triangles)
+            detail = f"all {faces} faces are degenerate" if faces else "it has no faces"
+            raise self.fail(w, "path", f"empty mesh {resolved}: {detail}")
+        if mesh.skipped:
+            faces = "face" if mesh.skipped == 1 else "faces"
+            warnings.warn(
+                self.fail(
+                    w, "path", f"skipped {mesh.skipped} degenerate {faces} of {resolved}"
+                ).as_warning(),
+                stacklevel=2,
+            )
+        return mesh.triangles
 
     def build(
         self, w: Where, key: str, make: Callable[[Any], Any], material: Any, found: str = ""

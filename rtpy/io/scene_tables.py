@@ -20,7 +20,7 @@ from . import values
 from .toml_lines import TomlLines, Where, quote_key
 from .values import ANY, Invalid, Range, describe, suggest
 
-__all__ = ["SceneError", "TableReader"]
+__all__ = ["SceneError", "SceneWarning", "TableReader"]
 
 
 # --------------------------------------------------------------------------- errors
@@ -56,6 +56,15 @@ class SceneError(Exception):
         if self.suggestion is not None:
             text += f" — did you mean '{self.suggestion}'?"
         return text.translate(_ESCAPE_LINE_BREAKS)
+
+    def as_warning(self) -> SceneWarning:
+        """The same message as a warning: something the loader left out but could load."""
+        return SceneWarning(str(self))
+
+
+class SceneWarning(UserWarning):
+    """A scene file that loads but not entirely as written (a mesh's degenerate faces
+    left out); str(warning) is one line naming the file, the table and the key."""
 
 
 # A message is one line: names and strings quoted from the file keep no character

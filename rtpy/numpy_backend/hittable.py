@@ -131,6 +131,12 @@ class PrimitiveSet:
     def surface_uv(self, k, point) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
 
+    def shading_normal(self, k, point, geo) -> np.ndarray:
+        """The unit normals materials shade with at hits `point` on primitives k, on
+        the side of the geometric normals geo: geo itself, except on triangles with
+        vertex normals (rtpy.mesh.SmoothTriangle)."""
+        return geo
+
     def surface_tangent(self, k, point) -> tuple[np.ndarray, np.ndarray]:
         """(tangent (N, 3), valid (N,) bool): Hittable.surface_tangent; invalid where it
         returns None (then HitInfo falls back to ONB(normal).u)."""

@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from ..mesh import SmoothTriangle
 from ..quad import Quad
 from ..scene import Scene
 from ..sphere import Sphere
@@ -34,7 +35,7 @@ from .vec3 import row
 INF = math.inf
 SPHERE, QUAD, TRIANGLE, OTHER = 0, 1, 2, 3
 # Exact types: a subclass may override hit_t (tests do), so it goes to the ScalarSet.
-KINDS = {Sphere: SPHERE, Quad: QUAD, Triangle: TRIANGLE}
+KINDS = {Sphere: SPHERE, Quad: QUAD, Triangle: TRIANGLE, SmoothTriangle: TRIANGLE}
 SETS = (SphereSet, QuadSet, TriangleSet, ScalarSet)
 
 
@@ -45,7 +46,8 @@ class BatchScene:
     Object i (index into `objects`) is primitive local[i] of sets[kind[i]];
     material_id[i] is its material's index in materials.materials (the distinct
     materials in first-use order). need_uv and need_tangent say what the hits of a
-    batch must carry (else those fields are unused() zeros).
+    batch must carry (else those fields are unused() zeros); smooth, that some
+    triangles shade with interpolated vertex normals.
     """
 
     def __init__(self, scene: Scene) -> None:
@@ -75,6 +77,8 @@ class BatchScene:
             self.material_id[i] = ids[key]
         self.materials = MaterialTable(distinct)
         self.need_uv = self.materials.reads_uv
+        triangles = self.sets[TRIANGLE]
+        self.smooth = triangles is not None and bool(triangles.smooth.any())
         self.need_tangent = self.materials.reads_tangent
         self.lights = LightTable(self)
         self.background_color = row(scene.background)
@@ -189,7 +193,12 @@ class BatchScene:
         n = len(obj)
         local, groups = grouped if grouped is not None else self._groups(obj)
         front = dot(geo, d) < 0.0
-        normal = scale(geo, np.where(front, 1.0, -1.0))
+        shading = geo
+        if self.smooth:
+            shading = np.empty((n, 3))
+            for kd, i in groups:
+                shading[i] = self.sets[kd].shading_normal(local[i], point[i], geo[i])
+        normal = scale(shading, np.where(front, 1.0, -1.0))
         if self.need_uv:
             u, v = np.empty(n), np.empty(n)
             for kd, i in groups:

@@ -1,4 +1,5 @@
-"""TriangleSet: all triangles of a scene as arrays, the batched twin of rtpy/triangle.py.
+"""TriangleSet: all triangles of a scene as arrays, the batched twin of rtpy/triangle.py
+(and of rtpy/mesh.py's SmoothTriangle, whose vertex normals it interpolates).
 
 The all-pairs test is Moller-Trumbore in Plucker form, written as (N, 3) x (3, K)
 matrix products; its t agrees with Triangle.hit_t's to ~1e-15.
@@ -10,9 +11,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..mesh import SmoothTriangle
 from ..triangle import Triangle
 from .arrays import dot
-from .hittable import INF, PlanarSet
+from .hittable import INF, PlanarSet, area_direction_pdf
 from .vec3 import rows_of
 
 
@@ -40,6 +42,12 @@ class TriangleSet(PlanarSet):
         self.Mo = self.N.T.copy()
         self.Md = np.concatenate([self.N, self.e2xa, self.axe1], axis=0).T.copy()
         self.Mm = np.concatenate([self.e2, self.e1], axis=0).T.copy()
+        # Vertex normals (K, 3, 3) of the SmoothTriangles, rows where `smooth` is True.
+        self.smooth = np.array([isinstance(s, SmoothTriangle) for s in triangles], dtype=bool)
+        self.vertex_normals = np.zeros((len(triangles), 3, 3))
+        for i in np.flatnonzero(self.smooth):
+            s = triangles[i]
+            self.vertex_normals[i] = [[n.e0, n.e1, n.e2] for n in (s.na, s.nb, s.nc)]
         self.build_culling(cluster)
 
     def corners(self):
@@ -88,6 +96,26 @@ class TriangleSet(PlanarSet):
         u = (d11 * d20 - d01 * d21) / denom
         v = (d00 * d21 - d01 * d20) / denom
         return np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
+
+    def shading_normal(self, k, point, geo):
+        """SmoothTriangle.shading_normal at the hits `point` on triangles k (geometric
+        normals geo): the interpolated vertex normal on geo's side; geo for flat ones."""
+        smooth = self.smooth[k]
+        if not smooth.any():
+            return geo
+        u, v = self.surface_uv(k, point)
+        w = np.stack([1.0 - u - v, u, v], axis=1)
+        n = np.einsum("ij,ijk->ik", w, self.vertex_normals[k])
+        length = np.sqrt(dot(n, n))
+        smooth &= length > 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            n = n / length[:, None]
+        n *= np.where(dot(n, geo) < 0.0, -1.0, 1.0)[:, None]
+        return np.where(smooth[:, None], n, geo)
+
+    def direction_pdf(self, k, p, q, n):
+        # The density of sampling by area uses the geometric normal, not the shading one.
+        return area_direction_pdf(p, q, self.normal[k], self.area(k))
 
     def sample_point(self, k, r1, r2):
         s = np.sqrt(r1)

@@ -363,3 +363,35 @@ def test_render_with_a_student_plugin_material(tmp_path, material_registry):
     assert np.load(out)[2, 4].tolist() == [0.25, 0.25, 0.25]  # the ball's center pixel
     assert main([*args[:-1], str(tmp_path / "missing.py"), "-o", str(tmp_path / "p.png")]) == 2
     assert "half_grey" in material_registry
+
+
+def test_linear_exr_without_openexr_exits_2_before_rendering(tmp_path, capsys, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "OpenEXR", None)  # import OpenEXR fails
+
+    def no_render(*args, **kwargs):
+        raise AssertionError("rendered although the output cannot be written")
+
+    monkeypatch.setattr("rtpy.render", no_render)
+    out, png = tmp_path / "x.exr", tmp_path / "x.png"
+    status = main(["render", "cornell", *SMALL, "-o", str(png), "--linear", str(out)])
+    err = capsys.readouterr().err
+    assert status == 2 and err.startswith(f"rtpy: error: cannot write '{out}'")
+    assert "pip install 'rtpy[exr]'" in err and len(err.splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_mesh_scene_with_a_malformed_obj_exits_2_naming_file_table_key_and_line(tmp_path):
+    (tmp_path / "m.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1\nf 1 2 3\n")
+    scene = tmp_path / "m.toml"
+    scene.write_text(
+        '[materials.m]\ntype = "lambertian"\n\n'
+        '[[objects]]\ntype = "mesh"\npath = "m.obj"\nmaterial = "m"\n'
+    )
+    out = tmp_path / "out.png"
+    result = run_cli("render", str(scene), "-o", str(out), "--quiet")
+    assert result.returncode == 2 and not out.exists()
+    (line,) = result.stderr.splitlines()
+    assert line.startswith(f"rtpy: error: {scene}: [[objects]] #1 path: ")
+    assert "m.obj line 3: expected 3 to 4 numbers after 'v'" in line

@@ -5,12 +5,11 @@ from __future__ import annotations
 import io
 import os
 import stat
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given
-from hypothesis import strategies as st
 from PIL import Image
 
 from rtpy.io import image
@@ -46,84 +45,6 @@ def random_image(h: int, w: int, seed: int = 0) -> np.ndarray:
 
 def listing(directory: Path) -> list[str]:
     return sorted(p.name for p in directory.iterdir())
-
-
-# --------------------------------------------------------------------------- to_8bit
-
-
-# NaN -> uint8 casts are platform-dependent (and warn): NaN must be handled explicitly.
-@pytest.mark.filterwarnings("error")
-def test_to_8bit_endpoints_and_clamping() -> None:
-    out = to_8bit(rgb([0.0, 1.0, 1.5, 1e9, np.inf, -0.2, -np.inf, np.nan]), gamma=2.0)
-    assert out.dtype == np.uint8
-    assert out.shape == (1, 8, 3)
-    assert out[0, :, 0].tolist() == [0, 255, 255, 255, 255, 0, 0, 0]
-    # All three channels are treated the same.
-    assert np.array_equal(out[..., 0], out[..., 1])
-    assert np.array_equal(out[..., 0], out[..., 2])
-
-
-# NaN -> uint8 casts are platform-dependent (and warn): NaN must be handled explicitly.
-@pytest.mark.filterwarnings("error")
-def test_to_8bit_nan_is_zero_per_channel() -> None:
-    img = np.array([[[np.nan, 1.0, 0.25]]])
-    assert to_8bit(img, 1.0).tolist() == [[[0, 255, 64]]]
-
-
-def test_to_8bit_gamma_2() -> None:
-    # 0.25 ** (1/2) = 0.5 -> 127.5 -> rounds to 128 (round(255 * 0.5) == 128).
-    assert to_8bit(rgb([0.25]), 2.0)[0, 0, 0] == 128
-    # 0.5 ** (1/2) = 0.7071 -> 180.3 -> 180.
-    assert to_8bit(rgb([0.5]), 2.0)[0, 0, 0] == 180
-
-
-def test_to_8bit_gamma_2_2() -> None:
-    # 0.5 ** (1/2.2) = 0.7297 -> 186.08 -> 186; gamma encoding brightens mid-tones.
-    assert to_8bit(rgb([0.5]), 2.2)[0, 0, 0] == 186
-
-
-def test_to_8bit_gamma_1_is_linear() -> None:
-    values = [0.0, 0.1, 0.2, 0.5, 0.75, 1.0]
-    out = to_8bit(rgb(values), 1.0)[0, :, 0].tolist()
-    assert out == [0, 26, 51, 128, 191, 255]
-    # No encoding: output / 255 equals the input to within half a step.
-    assert np.all(np.abs(np.array(out) / 255.0 - np.array(values)) <= 0.5 / 255.0)
-
-
-def test_to_8bit_does_not_modify_input() -> None:
-    img = np.array([[[np.nan, 2.0, -1.0]]])
-    to_8bit(img, 2.0)
-    assert np.isnan(img[0, 0, 0]) and img[0, 0, 1] == 2.0 and img[0, 0, 2] == -1.0
-
-
-@pytest.mark.parametrize("gamma", [0.0, -1.0, float("nan"), float("inf")])
-def test_to_8bit_rejects_bad_gamma(gamma: float) -> None:
-    with pytest.raises(ValueError, match="gamma"):
-        to_8bit(rgb([0.5]), gamma)
-
-
-@pytest.mark.parametrize("shape", [(4, 4), (4, 4, 4), (4, 4, 1), (3,)])
-def test_to_8bit_rejects_bad_shape(shape: tuple[int, ...]) -> None:
-    with pytest.raises(ValueError, match="shape"):
-        to_8bit(np.zeros(shape), 2.0)
-
-
-finite_or_inf = st.floats(allow_nan=False, min_value=-1e300, max_value=1e300) | st.sampled_from(
-    [float("inf"), float("-inf")]
-)
-
-
-@given(a=finite_or_inf, b=finite_or_inf, gamma=st.floats(min_value=0.2, max_value=5.0))
-def test_to_8bit_monotone(a: float, b: float, gamma: float) -> None:
-    lo, hi = min(a, b), max(a, b)
-    out = to_8bit(rgb([lo, hi]), gamma)[0, :, 0]
-    assert int(out[0]) <= int(out[1])
-
-
-@given(x=st.floats(min_value=0.0, max_value=1.0), gamma=st.floats(min_value=0.2, max_value=5.0))
-def test_to_8bit_matches_formula(x: float, gamma: float) -> None:
-    expected = np.floor(255.0 * x ** (1.0 / gamma) + 0.5)
-    assert to_8bit(rgb([x]), gamma)[0, 0, 0] == expected
 
 
 # --------------------------------------------------------------------------- PFM
@@ -412,7 +333,7 @@ def test_check_writable_path_is_directory(tmp_path: Path) -> None:
         (check_image_path, "x.pfm"),
         (check_image_path, "x"),
         (check_linear_path, "x.png"),
-        (check_linear_path, "x.exr"),
+        (check_linear_path, "x.tiff"),
     ],
 )
 def test_check_writable_unsupported_extension(tmp_path: Path, check, name: str) -> None:
@@ -544,3 +465,50 @@ def test_rendered_image_save_unsupported(tmp_path: Path) -> None:
 def test_rendered_image_save_missing_directory(tmp_path: Path) -> None:
     with pytest.raises(OutputError, match="does not exist"):
         make_result().save(tmp_path / "missing" / "out.png")
+
+
+# --------------------------------------------------------------------------- sRGB and PNG chunks
+
+
+@pytest.mark.parametrize("gamma, info", [(2.0, {"gamma": 0.5}), (2.2, {"gamma": 0.45455})])
+def test_png_records_its_gamma(tmp_path: Path, gamma: float, info: dict) -> None:
+    write_png(tmp_path / "a.png", rgb([0.5]), gamma)
+    with Image.open(tmp_path / "a.png") as pil:
+        assert {k: pil.info[k] for k in ("gamma", "srgb") if k in pil.info} == info
+
+
+def test_png_records_srgb(tmp_path: Path) -> None:
+    result = RenderedImage(rgb([0.25, 0.5]), gamma="srgb")
+    result.save(tmp_path / "a.png")
+    for source in (tmp_path / "a.png", io.BytesIO(result._repr_png_())):
+        with Image.open(source) as pil:
+            assert pil.info.get("srgb") == 0 and "gamma" not in pil.info
+            assert np.array_equal(np.asarray(pil), to_8bit(result.linear, "srgb"))
+
+
+# --------------------------------------------------------------------------- OpenEXR
+
+
+def test_exr_round_trip(tmp_path: Path) -> None:
+    openexr = pytest.importorskip("OpenEXR")
+    img = random_image(3, 5, seed=9)
+    assert RenderedImage(img).save(tmp_path / "a.exr") == tmp_path / "a.exr"
+    write_linear(tmp_path / "b.EXR", img)
+    for name in ("a.exr", "b.EXR"):
+        with openexr.File(str(tmp_path / name)) as f:
+            back = f.channels()["RGB"].pixels
+        np.testing.assert_array_equal(back, img.astype(np.float32))  # unclamped, no gamma
+    assert listing(tmp_path) == ["a.exr", "b.EXR"]
+
+
+def test_exr_without_openexr_says_how_to_install(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "OpenEXR", None)  # import OpenEXR fails
+    for attempt in (check_linear_path, lambda p: make_result().save(p)):
+        with pytest.raises(OutputError) as info:
+            attempt(tmp_path / "a.exr")
+        message = str(info.value)
+        assert "a.exr" in message and "pip install 'rtpy[exr]'" in message
+        assert "\n" not in message
+    assert listing(tmp_path) == []

@@ -508,3 +508,95 @@ def test_mis_key_is_a_boolean_defaulting_to_true():
     assert "true or false" in str(err)
     err = error_of("[render]\nmiss = false\n")
     assert_names(err, "[render]", "miss", "mis")
+
+
+# --------------------------------------------------------------------------- meshes
+
+TETRA = """\
+v 0 0 0
+v 1 0 0
+v 0 1 0
+v 0 0 1
+vn -1 -1 -1
+vn 1 0 0
+vn 0 1 0
+vn 0 0 1
+f 1//1 3//3 2//2
+f 1 2 4
+f 1 4 3
+f 2 3 4
+"""
+
+
+def mesh_scene(tmp_path, obj_text: str | None, extra: str = "", name: str = "m.obj") -> str:
+    """A scene with one mesh object; writes the OBJ file (if given) next to FILE's name."""
+    if obj_text is not None:
+        (tmp_path / name).write_text(obj_text)
+    return (
+        '[materials.m]\ntype = "lambertian"\n\n'
+        f'[[objects]]\ntype = "mesh"\npath = "{name}"\nmaterial = "m"\n{extra}'
+    )
+
+
+def load_mesh(tmp_path, obj_text, extra="", name="m.obj"):
+    return load(mesh_scene(tmp_path, obj_text, extra, name), tmp_path / "s.toml")
+
+
+def mesh_error(tmp_path, obj_text, extra="", name="m.obj") -> SceneError:
+    return error_of(mesh_scene(tmp_path, obj_text, extra, name), tmp_path / "s.toml")
+
+
+def test_a_mesh_is_its_triangles_placed_by_scale_rotate_translate(tmp_path):
+    from rtpy.mesh import SmoothTriangle
+
+    extra = "scale = [2, 1, 1]\nrotate = [0, 0, 90]\ntranslate = [0, 0, -5]\n"
+    scene = load_mesh(tmp_path, TETRA, extra)
+    assert len(scene.objects) == 4
+    assert [type(t) for t in scene.objects] == [SmoothTriangle, Triangle, Triangle, Triangle]
+    first = scene.objects[0]
+    # b = (1, 0, 0) scaled to (2, 0, 0), turned about z to (0, 2, 0), moved to z = -5
+    assert (first.c - Vec3(0, 2, -5)).length() < 1e-12
+    assert all(t.material is scene.objects[0].material for t in scene.objects)
+    uniform = load_mesh(tmp_path, TETRA, "scale = 3\n")
+    assert uniform.objects[3].a == Vec3(3, 0, 0)  # face 2 3 4 starts at (1, 0, 0)
+
+
+@pytest.mark.parametrize(
+    "obj_text, extra, key, words",
+    [
+        (None, "", "path", "OBJ file not found"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 x\n", "", "path", "m.obj line 4: expected an integer"),
+        ("v 0 0 0\n", "", "path", "empty mesh"),
+        ("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "", "path", "all 1 faces are degenerate"),
+        (TETRA, "scale = 0\n", "scale", "a scale of 0 flattens the mesh"),
+        (TETRA, "scale = [1, 0, 1]\n", "scale", "a scale of 0"),
+        (TETRA, 'scale = "big"\n', "scale", "expected a number or an array of 3 numbers"),
+        (TETRA, "rotate = [0, 90]\n", "rotate", "expected"),
+        (TETRA, "translate = 1\n", "translate", "expected"),
+        (TETRA, "rotation = [0, 0, 0]\n", "rotation", "unknown key"),
+    ],
+)
+def test_mesh_errors_name_the_file_table_and_key(tmp_path, obj_text, extra, key, words):
+    err = mesh_error(tmp_path, obj_text, extra)
+    msg = str(err)
+    assert err.file == str(tmp_path / "s.toml") and err.table == "[[objects]] #1"
+    assert err.key == key and f"[[objects]] #1 {key}:" in msg
+    assert words in msg and len(msg.splitlines()) == 1
+
+
+def test_a_mesh_path_must_be_a_file(tmp_path):
+    (tmp_path / "d.obj").mkdir()
+    assert "is a directory" in str(mesh_error(tmp_path, None, name="d.obj"))
+    err = error_of(mesh_scene(tmp_path, None).replace('path = "m.obj"\n', ""), tmp_path / "s.toml")
+    assert err.key == "path" and "missing required key" in str(err)
+
+
+def test_degenerate_faces_are_skipped_and_counted_in_one_warning(tmp_path):
+    from rtpy.io.scene_file import SceneWarning
+
+    text = TETRA + "v 2 0 0\nf 1 2 5\nf 2 5 1\n"  # two faces on one line
+    with pytest.warns(SceneWarning) as record:
+        scene = load_mesh(tmp_path, text)
+    assert len(scene.objects) == 4 and len(record) == 1
+    (message,) = str(record[0].message).splitlines()
+    assert message.startswith(f"{tmp_path / 's.toml'}: [[objects]] #1 path: skipped 2 degenerate")

@@ -1,13 +1,21 @@
-"""TriangleSet against rtpy/triangle.py: the scalar hit_t, to rounding."""
+"""TriangleSet against rtpy/triangle.py and rtpy/mesh.py: the scalar hit_t, to rounding,
+and the shading normals and light densities of smooth triangles."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import assume, given, settings
 
 from rtpy import Triangle
+from rtpy.io.bundled import bundled_dir
+from rtpy.io.obj import read_obj
+from rtpy.mesh import Mesh, SmoothTriangle, Transform
+from rtpy.numpy_backend.scene import BatchScene
 from rtpy.numpy_backend.triangle import TriangleSet
 from rtpy.ray import Ray
+from rtpy.scene import Scene
+from rtpy.sphere import Sphere
 
 from .geometry_checks import MAT, V, arr, check_planar, planar_shape, unit_pair, vec
 
@@ -31,3 +39,41 @@ def test_triangle_t_matches_scalar(a, b, c, origin, uv):
 
     target = np.array(a) + uv[0] * e1 + uv[1] * e2 * 0.5
     check_planar(tri, TriangleSet([tri]), origin, target, edge_distance)
+
+
+def teapot_scene():
+    """The bundled teapot (smooth triangles), a flat triangle and a sphere."""
+    obj = read_obj(bundled_dir() / "teapot.obj")
+    mesh = Mesh(obj.positions, obj.normals, obj.triangles, MAT, Transform(rotate=V((-90, 20, 0))))
+    flat = Triangle(V((-4, -1, -4)), V((4, -1, -4)), V((0, -1, 4)), MAT)
+    return Scene([*mesh.triangles, flat, Sphere(V((0, 4, 0)), 0.5, MAT)])
+
+
+def test_smooth_triangle_hits_match_the_scalar_shading_normals():
+    scene = teapot_scene()
+    geo = BatchScene(scene)
+    assert geo.smooth and geo.sets[2].bvh is not None  # through the triangles' BVH
+    rng = np.random.default_rng(5)
+    o = rng.normal(size=(600, 3))
+    o *= 8.0 / np.linalg.norm(o, axis=1)[:, None]
+    d = rng.uniform(-2.0, 2.0, (600, 3)) + [0.0, 1.0, 0.0] - o
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    obj, t = geo.find_intersection(o, d)
+    h = obj >= 0
+    hits = geo.hit_batch(obj[h], o[h], d[h], t[h])
+    kinds = {type(scene.objects[k]) for k in obj[h]}
+    assert kinds >= {SmoothTriangle, Triangle} and hits.front_face.any()
+    for n, i in enumerate(np.flatnonzero(h)):
+        ref = scene.objects[obj[i]].hit_info(Ray(V(o[i]), V(d[i])), float(t[i]))
+        np.testing.assert_allclose(hits.normal[n], arr(ref.normal), rtol=1e-9, atol=1e-9)
+        assert hits.front_face[n] == ref.front_face
+    # light densities use the geometric normal, as SmoothTriangle.direction_pdf
+    k = geo.local[obj[h]]
+    p = o[h] + 0.5 * (hits.point - o[h])
+    pdf = geo.sets[2].direction_pdf(k, p, hits.point, hits.normal)
+    for n, i in enumerate(np.flatnonzero(h)):
+        ref_obj = scene.objects[obj[i]]
+        if not isinstance(ref_obj, Triangle):
+            continue
+        ref = ref_obj.hit_info(Ray(V(o[i]), V(d[i])), float(t[i]))
+        assert pdf[n] == pytest.approx(ref_obj.direction_pdf(V(p[n]), ref), rel=1e-9)

@@ -1,0 +1,146 @@
+"""Reading Wavefront OBJ files: the positions, normals and faces of a triangle mesh.
+
+    obj = read_obj("teapot.obj")
+    obj.positions[obj.triangles[0][0][0]]   # the first corner of the first triangle
+
+The statements read are `v x y z [w]`, `vn x y z`, `vt u [v [w]]` (counted, so
+face indices that name texture coordinates are checked) and `f` with corners
+written `v`, `v/vt`, `v//vn` or `v/vt/vn`. Indices start at 1; a negative index
+counts back from the last element defined before the face (-1 is the last). A
+polygon of n corners becomes n - 2 triangles fanned from its first corner.
+Grouping, smoothing-group and material statements (o, g, s, usemtl, mtllib) and
+the other OBJ statements that do not define faces (l, p, vp, ...) are ignored.
+Anything else, or a statement that cannot be read, raises ObjError with the line.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+__all__ = ["ObjError", "ObjMesh", "parse_obj", "read_obj"]
+
+# Statements that define nothing this reader uses; they are skipped.
+IGNORED = frozenset(
+    ("o", "g", "s", "usemtl", "mtllib", "l", "p", "vp", "cstype", "deg", "bmat", "step")
+    + ("curv", "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con")
+    + ("mg", "bevel", "c_interp", "d_interp", "lod", "maplib", "usemap", "shadow_obj")
+    + ("trace_obj", "ctech", "stech", "call", "csh")
+)
+
+# A corner: (position index, normal index or None), both 0-based.
+Corner = tuple[int, int | None]
+
+
+class ObjError(ValueError):
+    """An OBJ file that cannot be read: detail says what is wrong, line (1-based)
+    where, when it is about one line. str(error) is "detail (line N)"."""
+
+    def __init__(self, detail: str, line: int | None = None) -> None:
+        self.detail, self.line = detail, line
+        super().__init__(detail if line is None else f"{detail} (line {line})")
+
+
+@dataclass
+class ObjMesh:
+    """The geometry of an OBJ file.
+
+    positions  the vertex positions (x, y, z), in file order
+    normals    the vertex normals (x, y, z) as written (not normalized)
+    triangles  each a triple of corners (position index, normal index or None),
+               0-based, in the winding order of the file
+    """
+
+    positions: list[tuple[float, float, float]] = field(default_factory=list)
+    normals: list[tuple[float, float, float]] = field(default_factory=list)
+    triangles: list[tuple[Corner, Corner, Corner]] = field(default_factory=list)
+
+
+def _numbers(words: list[str], least: int, most: int, what: str, line: int) -> list[float]:
+    if not least <= len(words) <= most:
+        count = str(least) if least == most else f"{least} to {most}"
+        found = " ".join(words) or "nothing"
+        raise ObjError(f"expected {count} numbers after '{what}', found {found!r}", line)
+    try:
+        values = [float(w) for w in words]
+    except ValueError:
+        raise ObjError(
+            f"expected numbers after '{what}', found {' '.join(words)!r}", line
+        ) from None
+    if not all(math.isfinite(x) for x in values):
+        raise ObjError(f"expected finite numbers after '{what}', found {' '.join(words)!r}", line)
+    return values
+
+
+def _index(word: str, count: int, what: str, line: int) -> int:
+    """The 0-based index an OBJ index (1-based, or negative from the end) names."""
+    try:
+        i = int(word)
+    except ValueError:
+        raise ObjError(f"expected an integer {what} index, found {word!r}", line) from None
+    k = i - 1 if i > 0 else count + i
+    if i == 0 or not 0 <= k < count:
+        raise ObjError(f"{what} index {i} is out of range ({count} {what}s defined so far)", line)
+    return k
+
+
+def _face(words: list[str], obj: ObjMesh, n_texcoords: int, line: int) -> list[Corner]:
+    if len(words) < 3:
+        raise ObjError(f"a face needs at least 3 corners, found {len(words)}", line)
+    corners: list[Corner] = []
+    for word in words:
+        parts = word.split("/")
+        if len(parts) > 3 or parts[0] == "":
+            raise ObjError(f"expected a corner v, v/vt, v//vn or v/vt/vn, found {word!r}", line)
+        p = _index(parts[0], len(obj.positions), "vertex", line)
+        if len(parts) > 1 and parts[1] != "":
+            _index(parts[1], n_texcoords, "texture coordinate", line)
+        n = None
+        if len(parts) == 3 and parts[2] != "":
+            n = _index(parts[2], len(obj.normals), "normal", line)
+        corners.append((p, n))
+    return corners
+
+
+def parse_obj(text: str) -> ObjMesh:
+    """The mesh in the text of an OBJ file; ObjError on a line it cannot read."""
+    obj = ObjMesh()
+    n_texcoords = 0
+    for number, raw in enumerate(text.splitlines(), start=1):
+        words = raw.split("#", 1)[0].split()
+        if not words:
+            continue
+        head, rest = words[0], words[1:]
+        if head == "v":
+            x, y, z, *w = _numbers(rest, 3, 4, "v", number)
+            if w and w[0] == 0.0:
+                raise ObjError("a vertex with weight w = 0 has no position", number)
+            scale = 1.0 / w[0] if w else 1.0
+            obj.positions.append((x * scale, y * scale, z * scale))
+        elif head == "vn":
+            x, y, z = _numbers(rest, 3, 3, "vn", number)
+            obj.normals.append((x, y, z))
+        elif head == "vt":
+            _numbers(rest, 1, 3, "vt", number)
+            n_texcoords += 1
+        elif head == "f":
+            corners = _face(rest, obj, n_texcoords, number)
+            first = corners[0]
+            for b, c in zip(corners[1:-1], corners[2:], strict=True):
+                obj.triangles.append((first, b, c))
+        elif head not in IGNORED:
+            raise ObjError(f"unknown statement {head!r}", number)
+    return obj
+
+
+def read_obj(path: str | Path) -> ObjMesh:
+    """The mesh in an OBJ file (UTF-8 or ASCII). OSError when it cannot be read,
+    ObjError when its text cannot."""
+    raw = Path(path).read_bytes()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = raw[: e.start].count(b"\n") + 1
+        raise ObjError(f"not UTF-8 text (byte {e.start})", line) from None
+    return parse_obj(text)
