@@ -383,6 +383,40 @@ def weight_without_1_over_pdf(cls):
     return mistake
 
 
+# Mistakes inside a function: (owner, name, the solution's text, the mistake's).
+LIGHT_SAMPLE = (direct_lighting, "light_sample_estimate")
+DIRECT = (direct.DirectIntegrator, "compute_scattering")
+SOURCE_MISTAKES = {
+    "triangle_as_parallelogram": (Triangle, "_barycentric", "u + v > 1.0", "v > 1.0"),
+    "lambertian_pdf_uniform": (Lambertian, "pdf", ") * INV_PI", ") * 0.0 + 0.5 * INV_PI"),
+    "estimate_without_1_over_pdf": (*LIGHT_SAMPLE, "(cos_i / sample.pdf)", "cos_i"),
+    "shadow_ray_blocked_by_its_light": (*LIGHT_SAMPLE, "ignore=light_shape", "ignore=None"),
+    "direct_without_emission": (*DIRECT, "emitted + direct_lighting(", "direct_lighting("),
+    "quad_uv_swapped": (Quad, "surface_uv", "a, b = self._coords", "b, a = self._coords"),
+    "phong_albedo_as_brdf": (Phong, "BRDF", "* (self.kd * INV_PI)", "* self.kd"),
+    "phong_wrong_normalisation": (Phong, "BRDF", "(n + 2.0) * INV_TWO", "(n + 1.0) * INV_TWO"),
+    "phong_pdf_around_the_normal": (Phong, "pdf", "dot(mirror, wi)", "dot(normal, wi)"),
+    "phong_pdf_without_diffuse": (Phong, "pdf", "(diffuse_probability(self, hit),", "(0.0,"),
+    "phong_highlight_around_the_normal": (Phong, "scattering", "ONB(mirror)", "ONB(hit.normal)"),
+    "course_halfvector": (BlinnPhong, "BRDF", "halfvector(wo, wi)", "(wo + wi) * 0.5"),
+    "blinn_without_jacobian": (
+        BlinnPhong,
+        "pdf",
+        "reflected_density(density_h, wo, h)",
+        "density_h",
+    ),
+    "blinn_half_vector_as_wi": (BlinnPhong, "scattering", "reflect(ray_in.direction, h)", "h"),
+    "cook_torrance_pdf_without_cos_theta_h": (CookTorrance, "pdf", " * dot(normal, h)  #", "  #"),
+    "cook_torrance_without_masking": (CookTorrance, "BRDF", "self.G1(normal, wi)", "1.0"),
+    "ward_without_jacobian": (Ward, "pdf", "reflected_density(density_h, wo, h)", "density_h"),
+}
+
+
+def source(label):
+    """The mistake `label` of SOURCE_MISTAKES."""
+    return in_source(label, *SOURCE_MISTAKES[label])
+
+
 # (task, mistake, grader tests that must fail; one of them the task's own)
 PLANTED = [
     ("03.1", cross_left_handed, ["test_cross_and_unit_vector"]),
@@ -395,24 +429,14 @@ PLANTED = [
     ("04.1", sphere_ignores_t_min, ["test_sphere_hit_t"]),
     ("04.1", normal_not_flipped, ["test_sphere_hit_info"]),
     ("04.2", quad_no_interior_test, ["test_quad_hit", "test_center_render_matches_reference"]),
-    (
-        "04.3",
-        in_source("triangle_as_parallelogram", Triangle, "_barycentric", "u + v > 1.0", "v > 1.0"),
-        ["test_triangle_hit"],
-    ),
+    ("04.3", source("triangle_as_parallelogram"), ["test_triangle_hit"]),
     ("04.4", first_hit_not_closest, ["test_closest_hit", "test_center_render_matches_reference"]),
     ("05.1", no_falloff, ["test_point_light_sample", "test_direct_light_on_a_plane_is_exact"]),
     ("05.1", unnormalised_light_vector, ["test_point_light_sample"]),
     ("05.2", two_blockers_needed, ["test_shadow_rays", "test_direct_light_on_a_plane_is_exact"]),
     ("05.3", albedo_as_brdf, ["test_lambertian_brdf_and_sampling"]),
     ("05.3", lambertian_no_pdf, ["test_lambertian_brdf_and_sampling"]),
-    (
-        "05.3",
-        in_source(
-            "lambertian_pdf_uniform", Lambertian, "pdf", ") * INV_PI", ") * 0.0 + 0.5 * INV_PI"
-        ),
-        ["test_lambertian_brdf_and_sampling"],
-    ),
+    ("05.3", source("lambertian_pdf_uniform"), ["test_lambertian_brdf_and_sampling"]),
     (
         "05.4",
         cosine_with_unnormalised_vector,
@@ -420,35 +444,13 @@ PLANTED = [
     ),
     (
         "05.4",
-        in_source(
-            "estimate_without_1_over_pdf",
-            direct_lighting,
-            "light_sample_estimate",
-            "(cos_i / sample.pdf)",
-            "cos_i",
-        ),
+        source("estimate_without_1_over_pdf"),
         ["test_light_sample_estimate", "test_direct_render_matches_reference"],
     ),
+    ("05.4", source("shadow_ray_blocked_by_its_light"), ["test_light_sample_estimate"]),
     (
         "05.4",
-        in_source(
-            "shadow_ray_blocked_by_its_light",
-            direct_lighting,
-            "light_sample_estimate",
-            "ignore=light_shape",
-            "ignore=None",
-        ),
-        ["test_light_sample_estimate"],
-    ),
-    (
-        "05.4",
-        in_source(
-            "direct_without_emission",
-            direct.DirectIntegrator,
-            "compute_scattering",
-            "return emitted + direct_lighting(",
-            "return direct_lighting(",
-        ),
+        source("direct_without_emission"),
         ["test_direct_sees_emitters_and_background", "test_direct_render_matches_reference"],
     ),
     ("05.4", light_counted_twice, ["test_direct_render_matches_reference"]),
@@ -459,108 +461,42 @@ PLANTED = [
     ("06.3", no_total_internal_reflection, ["test_total_internal_reflection"]),
     ("06.3", glass_never_refracts, ["test_dielectric_reflects_with_probability_schlick"]),
     ("07.1", sphere_uv_from_plus_x, ["test_sphere_uv"]),
-    (
-        "07.1",
-        in_source(
-            "quad_uv_swapped", Quad, "surface_uv", "a, b = self._coords", "b, a = self._coords"
-        ),
-        ["test_quad_uv"],
-    ),
+    ("07.1", source("quad_uv_swapped"), ["test_quad_uv"]),
     ("07.2", checker_with_int, ["test_checker_texture"]),
     ("07.2", image_v_not_flipped, ["test_image_texture"]),
     ("07.3", fuzz_not_absorbed, ["test_metal_fuzz"]),
     ("07.3", fuzz_ignored, ["test_metal_fuzz"]),
     # Week 8, each a change to the solution's source, the course's own first: Phong's
     # albedo as the BRDF (fr = kd + ks (R.V)^n) and the half vector (v + l) * 0.5.
+    ("08.1", source("phong_albedo_as_brdf"), ["test_phong_brdf"]),
+    ("08.1", source("phong_wrong_normalisation"), ["test_phong_brdf"]),
     (
         "08.1",
-        in_source("phong_albedo_as_brdf", Phong, "BRDF", "* (self.kd * INV_PI)", "* self.kd"),
-        ["test_phong_brdf"],
-    ),
-    (
-        "08.1",
-        in_source(
-            "phong_wrong_normalisation", Phong, "BRDF", "(n + 2.0) * INV_TWO", "(n + 1.0) * INV_TWO"
-        ),
-        ["test_phong_brdf"],
-    ),
-    (
-        "08.1",
-        in_source(
-            "phong_pdf_around_the_normal", Phong, "pdf", "dot(mirror, wi)", "dot(normal, wi)"
-        ),
+        source("phong_pdf_around_the_normal"),
         ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
     ),
     (
         "08.1",
-        in_source(
-            "phong_pdf_without_the_diffuse_lobe",
-            Phong,
-            "pdf",
-            "mixture_pdf(diffuse_probability(self, hit),",
-            "mixture_pdf(0.0,",
-        ),
+        source("phong_pdf_without_diffuse"),
         ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
     ),
-    (
-        "08.1",
-        in_source(
-            "phong_highlight_around_the_normal",
-            Phong,
-            "scattering",
-            "ONB(mirror).to_world",
-            "ONB(hit.normal).to_world",
-        ),
-        ["test_sampling_follows_pdf[phong]"],
-    ),
+    ("08.1", source("phong_highlight_around_the_normal"), ["test_sampling_follows_pdf[phong]"]),
     ("08.1", weight_without_1_over_pdf(Phong), ["test_weight_is_brdf_cos_over_pdf[phong]"]),
+    ("08.2", source("course_halfvector"), ["test_blinn_phong_brdf"]),
     (
         "08.2",
-        in_source("course_halfvector", BlinnPhong, "BRDF", "halfvector(wo, wi)", "(wo + wi) * 0.5"),
-        ["test_blinn_phong_brdf"],
-    ),
-    (
-        "08.2",
-        in_source(
-            "blinn_pdf_without_jacobian",
-            BlinnPhong,
-            "pdf",
-            "reflected_density(density_h, wo, h)",
-            "density_h",
-        ),
+        source("blinn_without_jacobian"),
         ["test_pdf[blinn_phong]", "test_sampling_follows_pdf[blinn_phong]"],
     ),
-    (
-        "08.2",
-        in_source(
-            "blinn_half_vector_as_direction",
-            BlinnPhong,
-            "scattering",
-            "wi = reflect(ray_in.direction, h)",
-            "wi = h",
-        ),
-        ["test_sampling_follows_pdf[blinn_phong]"],
-    ),
+    ("08.2", source("blinn_half_vector_as_wi"), ["test_sampling_follows_pdf[blinn_phong]"]),
     (
         "08.3",
-        in_source(
-            "cook_torrance_pdf_without_cos_theta_h",
-            CookTorrance,
-            "pdf",
-            " * dot(normal, h)  #",
-            "  #",
-        ),
+        source("cook_torrance_pdf_without_cos_theta_h"),
         ["test_pdf[cook_torrance_ggx]", "test_sampling_follows_pdf[cook_torrance_ggx]"],
     ),
     (
         "08.3",
-        in_source(
-            "cook_torrance_without_masking",
-            CookTorrance,
-            "BRDF",
-            "(self.G1(normal, wi) / cos_i) * (self.G1(normal, wo) / cos_o)",
-            "(1.0 / cos_i) * (1.0 / cos_o)",
-        ),
+        source("cook_torrance_without_masking"),
         ["test_cook_torrance_brdf[cook_torrance_ggx]"],
     ),
     (
@@ -573,13 +509,7 @@ PLANTED = [
     ("08.4", roulette_not_divided, ["test_path_furnace"]),
     (
         "08.5",
-        in_source(
-            "ward_pdf_without_jacobian",
-            Ward,
-            "pdf",
-            "reflected_density(density_h, wo, h)",
-            "density_h",
-        ),
+        source("ward_without_jacobian"),
         ["test_pdf[ward]", "test_sampling_follows_pdf[ward]"],
     ),
 ]
