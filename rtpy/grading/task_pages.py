@@ -214,7 +214,7 @@ def task_map_page(weeks: list[Week], graders: Callable[[str], list], root: Path 
             + "".join(paragraph(g, "- ") + "\n" for g in w.goals)
             + "\n| task | methods | points | time | graders |\n|---|---|---|---|---|\n"
             + "".join(
-                f"| {t.number} {t.title}{' (extension)' if t.extension else ''} | "
+                f"| {t.number} {t.title} | "
                 f"{methods_text(t, root)} | {t.points:g} | {duration(t.minutes)} | "
                 f"{', '.join(by_task.get(t.id, ['none']))} |\n"
                 for t in w.tasks
