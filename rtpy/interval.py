@@ -29,6 +29,7 @@ class Interval:
         # END SOLUTION
 
     def clamp(self, x: float) -> float:
+        """x moved into [min, max]: min below it, max above it."""
         # BEGIN SOLUTION week03: x clamped into [min, max]
         if x < self.min:
             return self.min

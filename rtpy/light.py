@@ -57,6 +57,10 @@ class PointLight(Light):
         self.intensity = intensity
 
     def sample(self, p: Vec3) -> LightSample | None:
+        """The light seen from p: the unit direction from p toward the light, the
+        distance d, the radiance I / d^2 arriving at p, pdf 1 and is_delta True (one
+        direction only), and the light's position as the sampled point; None when p
+        is the light's position."""
         # BEGIN SOLUTION week05: direction, distance and radiance I / d^2 seen from p
         to_light = self.position - p
         dist2 = to_light.length_squared()

@@ -110,6 +110,8 @@ class Scene:
                 return None
             obj, t = found
             return obj.hit_info(ray, t)
+        if not self.objects:
+            return None  # the sky alone (week 3's scenes, before this method is written)
         # BEGIN SOLUTION week04: the closest hit over all objects (earliest object wins ties)
         # Every object in list order. An object replaces the closest so far only
         # when it is strictly closer, so on equal t the earlier one stays.

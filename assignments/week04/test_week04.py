@@ -48,7 +48,7 @@ def check_t(got, expected, where):
         )
 
 
-@points(3)
+@points(3, task="04.1")
 def test_sphere_hit_t():
     """Sphere.hit_t: nearest root inside (t_min, t_max), from outside and inside"""
     rng = np.random.default_rng(4)
@@ -62,7 +62,7 @@ def test_sphere_hit_t():
         check_t(got, sphere_t(o, d, c, r, t_min, t_max), f"Sphere.hit_t (rtpy/sphere.py), case {k}")
 
 
-@points(2)
+@points(2, task="04.1")
 def test_sphere_hit_info():
     """Sphere.hit_info: point on the sphere, unit normal facing the ray, front_face"""
     rng = np.random.default_rng(44)
@@ -100,7 +100,7 @@ def plane_t(o, d, corner, e1, e2, inside):
     return t if t > 0 and inside(a, b) else None
 
 
-@points(3)
+@points(3, task="04.2")
 def test_quad_hit():
     """Quad.hit_t: the plane, then 0 <= alpha, beta <= 1"""
     rng = np.random.default_rng(5)
@@ -112,7 +112,7 @@ def test_quad_hit():
         check_t(got, expected, f"Quad.hit_t (rtpy/quad.py), case {k}")
 
 
-@points(3)
+@points(3, task="04.3")
 def test_triangle_hit():
     """Triangle hit: inside the triangle only (u, v >= 0, u + v <= 1)"""
     rng = np.random.default_rng(6)
@@ -126,7 +126,7 @@ def test_triangle_hit():
         check_t(got, expected, f"Triangle._barycentric (rtpy/triangle.py), case {k}")
 
 
-@points(2)
+@points(2, task="04.4")
 def test_closest_hit():
     """Scene.find_intersection: the closest of all objects"""
     rng = np.random.default_rng(7)
@@ -171,7 +171,7 @@ def make_reference_image():
     return deterministic_image(shapes_scene(), integrator="center")
 
 
-@points(2)
+@points(2, task="04.4")
 def test_center_render_matches_reference():
     """center integrator render of spheres, a quad and a triangle matches the reference"""
     image = deterministic_image(shapes_scene(), integrator="center")

@@ -1,5 +1,6 @@
 # ruff: noqa: E501  (the assertion messages are prose for students)
-"""Week 05 graders: point lights with 1/r^2, shadow rays, the direct integrator.
+"""Week 05 graders: point lights with 1/r^2, shadow rays, Lambertian, the light-sampling
+estimate and the direct integrator; each names its task of assignments/week05/tasks.toml.
 
 Each test names the method it checks and says what is wrong when it fails.
 Run them with `python -m rtpy grade 05`.
@@ -10,12 +11,15 @@ from pathlib import Path
 
 import numpy as np
 
+import rtpy.integrators.direct_lighting as direct_lighting
 import rtpy.testing as rt
-from rtpy import Color, Interval, Lambertian, PointLight, Quad, Ray, Scene, Sphere, Vec3
+from rtpy import Color, HitInfo, Interval, Lambertian, PointLight, Quad, Ray, Scene, Sphere, Vec3
 from rtpy.grading import assert_renders_match, points, reference_summary
 from rtpy.integrators import DirectIntegrator
+from rtpy.light import LightSample
 from rtpy.materials import DiffuseLight
 from rtpy.render_settings import RenderSettings
+from rtpy.vec3 import BLACK, dot
 
 HERE = Path(__file__).parent
 RNG_SEED = 2005
@@ -25,7 +29,7 @@ def unit(v):
     return v / np.linalg.norm(v)
 
 
-@points(3)
+@points(3, task="05.1")
 def test_point_light_sample():
     """PointLight.sample: unit direction, distance, radiance I / d^2"""
     rng = np.random.default_rng(RNG_SEED)
@@ -55,9 +59,9 @@ def test_point_light_sample():
         )
 
 
-@points(3)
+@points(3, task="05.3")
 def test_lambertian_brdf_and_sampling():
-    """Lambertian: BRDF = albedo / pi, cosine sampling, weight = BRDF * cos / pdf"""
+    """BRDF = albedo / pi, pdf = cos / pi, cosine sampling, weight = BRDF * cos / pdf"""
     albedo = Color(0.8, 0.5, 0.2)
     material = Lambertian(albedo)
     hit = rt.local_hit(material)
@@ -69,6 +73,15 @@ def test_lambertian_brdf_and_sampling():
         )
     below = material.BRDF(rt.incident_ray(30.0), rt.light_ray(rt.local_direction(120.0)), hit)
     assert below.is_black(), "Lambertian.BRDF: light from below the surface must give 0"
+    for theta in (0.0, 40.0, 80.0, 120.0):
+        got = material.pdf(
+            rt.incident_ray(30.0), rt.light_ray(rt.local_direction(theta, 70.0)), hit
+        )
+        expected = max(0.0, math.cos(math.radians(theta))) / math.pi
+        assert math.isclose(got, expected, rel_tol=1e-9, abs_tol=1e-15), (
+            f"Lambertian.pdf (rtpy/materials/lambertian.py) at {theta} degrees from the normal "
+            f"= {got:.6g}, expected cos(theta) / pi = {expected:.6g} (0 below the surface)"
+        )
     for theta in (10.0, 60.0):
         weights = rt.check_weights(material, theta, n=300, seed=5)
         assert weights.passed, (
@@ -81,7 +94,7 @@ def test_lambertian_brdf_and_sampling():
         )
 
 
-@points(2)
+@points(2, task="05.2")
 def test_shadow_rays():
     """Scene.find_occlusion: blockers between the point and the light only"""
     m = Lambertian()
@@ -121,7 +134,73 @@ def lit_plane_scene(occluder: bool):
     return Scene(objects, [light]), albedo, light
 
 
-@points(4)
+class FlatBRDF:
+    """A stand-in material with f_r = f above the surface, so that the estimate's grader
+    does not depend on Lambertian."""
+
+    is_specular = False
+
+    def __init__(self, f: Color) -> None:
+        self.f = f
+
+    def BRDF(self, ray_view, ray_light, hit):
+        return self.f if dot(hit.normal, ray_light.direction) > 0.0 else BLACK
+
+
+@points(3, task="05.4")
+def test_light_sample_estimate():
+    """light_sample_estimate: f_r L cos / pdf, black behind the surface or in shadow"""
+    rng = np.random.default_rng(RNG_SEED + 2)
+    f = Color(0.2, 0.1, 0.3)
+    where = "light_sample_estimate (rtpy/integrators/direct_lighting.py)"
+    for k in range(40):
+        p = np.array([rng.uniform(-2, 2), 0.0, rng.uniform(-2, 2)])
+        light = p + rng.uniform(0.5, 3) * unit(
+            np.array([rng.uniform(-1, 1), 1.0, rng.uniform(-1, 1)])
+        )
+        if k % 5 == 4:
+            light[1] = -light[1]  # the light below the surface
+        to_light = light - p
+        dist = float(np.linalg.norm(to_light))
+        radiance, pdf = rng.uniform(0.5, 4, 3), rng.uniform(0.05, 5.0)
+        sample = LightSample(
+            Vec3(*(to_light / dist)), dist, Color(*radiance), pdf, False, Vec3(*light)
+        )
+        hit = HitInfo(Vec3(*p), Vec3(0, 1, 0), 1.0, True, FlatBRDF(f))
+        eye = p + unit(np.array([0.3, 1.0, -0.2]))
+        ray_in = Ray(Vec3(*eye), Vec3(*unit(p - eye)))
+        mid, r = p + 0.5 * to_light, 0.1 * dist
+        cases = [  # (objects, the light's own shape, blocked?, what)
+            ([], None, False, "nothing in the way"),
+            ([Sphere(Vec3(*mid), r, Lambertian())], None, True, "a sphere halfway to the light"),
+            ([Sphere(Vec3(*(light + 0.5 * to_light)), r, Lambertian())], None, False,
+             "a sphere beyond the light"),
+        ]  # fmt: skip
+        own = Sphere(Vec3(*mid), r, DiffuseLight(Color(1, 1, 1)))
+        cases.append(([own], own, False, "the light's own shape (light_shape), not tested"))
+        cos = to_light[1] / dist
+        for objects, shape, blocked, what in cases:
+            got = np.array(
+                list(
+                    direct_lighting.light_sample_estimate(
+                        Scene(objects), ray_in, hit, sample, shape
+                    )
+                )
+            )
+            expected = np.zeros(3)
+            if cos > 0 and not blocked:
+                expected = np.array(list(f)) * radiance * cos / pdf
+            assert np.allclose(got, expected, rtol=1e-9, atol=1e-12), (
+                f"{where} with the light {'below' if cos <= 0 else 'above'} the surface, "
+                f"{what}: {got.round(6)}, expected {expected.round(6)} = f_r * L * cos(theta) "
+                f"/ pdf with cos(theta) = {cos:.4f} of the UNIT direction to the light and "
+                f"pdf = sample.pdf = {pdf:.4f}; 0 when the light is behind the surface or the "
+                "shadow ray (scene.find_occlusion over shadow_interval, ignoring light_shape) "
+                "is blocked"
+            )
+
+
+@points(3, task="05.4")
 def test_direct_light_on_a_plane_is_exact():
     """direct integrator: albedo/pi * I cos / d^2 on a plane, 0 in the shadow"""
     rng = np.random.default_rng(RNG_SEED + 1)
@@ -161,7 +240,7 @@ def test_direct_light_on_a_plane_is_exact():
             f"direct integrator at floor point {target.round(3)}{' (in shadow)' if blocked else ''}: "
             f"radiance {got.round(6)}, expected albedo/pi * I cos(theta) / d^2 = {expected.round(6)}. "
             "Check PointLight.sample (1/d^2), the cosine with the UNIT direction to the light, "
-            "the shadow ray (rtpy/integrators/direct_lighting.py: sample_one_light)"
+            "the shadow ray (rtpy/integrators/direct_lighting.py: light_sample_estimate)"
         )
 
 
@@ -194,22 +273,24 @@ def make_reference_summary():
     return reference_summary(area_light_scene(), RENDER, REFERENCE)
 
 
-@points(4)
+@points(4, task="05.4")
 def test_direct_render_matches_reference():
-    """direct integrator: area and point light render matches the reference (light counted once)"""
+    """render with an area and a point light matches the reference (light counted once)"""
     assert_renders_match(
         area_light_scene(),
         SEEDS,
         RENDER,
         HERE / "reference" / f"{REFERENCE['name']}.npz",
-        "direct integrator (rtpy/integrators/direct_lighting.py) differs from the reference "
-        "beyond its noise. Too bright near the light: light counted twice (the emission a "
-        "BRDF-sampled ray finds must carry the MIS weight); too dark: a missing 1/pdf or "
-        "a shadow ray that hits the light itself",
+        "direct integrator (rtpy/integrators/direct.py, direct_lighting.py) differs from the "
+        "reference beyond its noise. Too bright: emission added twice in "
+        "DirectIntegrator.compute_scattering (direct_lighting already weighs the light a "
+        "scattered ray finds); too dark near the area light: light_sample_estimate without "
+        "its 1/pdf, or a shadow ray blocked by the light itself (pass light_shape as "
+        "ignore and use shadow_interval)",
     )
 
 
-@points(1)
+@points(1, task="05.4")
 def test_direct_sees_emitters_and_background():
     """direct integrator: emission seen directly, background on a miss"""
     emit = Color(2.0, 3.0, 4.0)

@@ -36,7 +36,7 @@ def random_incidence(rng):
     return n, d
 
 
-@points(2)
+@points(2, task="06.1")
 def test_reflect():
     """vec3.reflect: v - 2 (v . n) n"""
     rng = np.random.default_rng(6)
@@ -50,7 +50,7 @@ def test_reflect():
         )
 
 
-@points(3)
+@points(3, task="06.2")
 def test_refract_obeys_snell():
     """vec3.refract: Snell's law, in the plane of incidence, unit length"""
     rng = np.random.default_rng(66)
@@ -75,7 +75,7 @@ def test_refract_obeys_snell():
         )
 
 
-@points(2)
+@points(2, task="06.3")
 def test_schlick():
     """dielectric.schlick: r0 + (1 - r0)(1 - cos)^5"""
     rng = np.random.default_rng(7)
@@ -99,7 +99,7 @@ def incoming(theta_deg):
     return Ray(Vec3(math.sin(t), 0, math.cos(t)), Vec3(-math.sin(t), 0, -math.cos(t)))
 
 
-@points(2)
+@points(2, task="06.3")
 def test_total_internal_reflection():
     """Dielectric: from inside beyond the critical angle every ray reflects"""
     glass = Dielectric(1.5)
@@ -123,7 +123,7 @@ def test_total_internal_reflection():
         )
 
 
-@points(2)
+@points(2, task="06.3")
 def test_dielectric_reflects_with_probability_schlick():
     """Dielectric.scattering: reflect with probability R, refract otherwise, weight albedo"""
     glass = Dielectric(1.5, Color(0.9, 0.95, 1.0))
@@ -148,7 +148,7 @@ def test_dielectric_reflects_with_probability_schlick():
             )
 
 
-@points(2)
+@points(2, task="06.1")
 def test_mirror():
     """Mirror.scattering: the reflected ray, weight albedo (no cosine)"""
     m = Mirror(Color(0.9, 0.8, 0.7))
@@ -183,7 +183,7 @@ def make_reference_image():
     return deterministic_image(optics_scene(), integrator="whitted", max_depth=8)
 
 
-@points(3)
+@points(3, task="06.3")
 def test_whitted_render_matches_reference():
     """whitted render of a glass and a mirror ball matches the reference"""
     # Whitted with a point light and a pinhole is deterministic; spp 1 shows

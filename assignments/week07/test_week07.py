@@ -34,7 +34,7 @@ def arr(x):
     return np.array(list(x))
 
 
-@points(2)
+@points(2, task="07.1")
 def test_sphere_uv():
     """Sphere.surface_uv: u = phi / 2 pi from -x around +y, v = theta / pi from -y"""
     rng = np.random.default_rng(7)
@@ -55,7 +55,7 @@ def test_sphere_uv():
         )
 
 
-@points(2)
+@points(2, task="07.1")
 def test_quad_uv():
     """Quad.surface_uv: p = q + u * U + v * V"""
     rng = np.random.default_rng(77)
@@ -72,7 +72,7 @@ def test_quad_uv():
         )
 
 
-@points(2)
+@points(2, task="07.2")
 def test_checker_texture():
     """CheckerTexture.value: 3-D cells of edge `scale`"""
     rng = np.random.default_rng(8)
@@ -91,7 +91,7 @@ def test_checker_texture():
         )
 
 
-@points(2)
+@points(2, task="07.2")
 def test_image_texture():
     """ImageTexture.value: nearest texel, u from the left, v from the bottom row"""
     h, w = 5, 7
@@ -109,7 +109,7 @@ def test_image_texture():
         )
 
 
-@points(3)
+@points(3, task="07.3")
 def test_metal_fuzz():
     """Metal.scattering: reflection + fuzz * random unit vector, absorbed below the surface"""
     n = np.array([0.0, 0.0, 1.0])
@@ -191,7 +191,7 @@ def make_reference_image():
     return deterministic_image(texture_scene(), integrator="center")
 
 
-@points(2)
+@points(2, task="07.2")
 def test_texture_render_matches_reference():
     """center render of checker and image textures matches the reference"""
     image = deterministic_image(texture_scene(), integrator="center")

@@ -17,9 +17,10 @@ week and of every later week replaced by
         raise NotImplementedError("week05 task: PointLight.sample ...")
 
 (a later week's region is withheld too: it would hand out that week's answer, and
-several of them contain this week's, such as Cook-Torrance's Schlick factor or the
-path integrator's light sampling), the bundled scenes, docs/, `assignments/weekNN/`
-(README, graders, scenes, reference data) and the tests of rtpy that can pass there.
+several of them contain this week's, such as the diffuse part of the week-8 models,
+which is Lambertian's BRDF, or the path loop, which contains the direct integrator),
+the bundled scenes, docs/, `assignments/weekNN/` (README, task map, graders, scenes,
+reference data) and the tests of rtpy that can pass there.
 
 Which tests ship is decided by `assignments/test_weeks.toml`: for each test file,
 the weeks whose solution regions it executes, as recorded by running the suite on
@@ -57,12 +58,15 @@ END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
 COPIED = ("pyproject.toml", ".gitignore", "scenes", "docs")
 TEST_WEEKS_FILE = "assignments/test_weeks.toml"
 # Tests that belong to rtpy's own repository only (and are not mapped): the assignment
-# machinery's, which grade every week and generate repositories, the checks of rtpy's
+# machinery's, which grade every week, generate repositories and check the task maps
+# against the solution regions and the pages made from them, the checks of rtpy's
 # README (a student repository's README.md is the week's) and of its layout (which
 # counts the numpy backend's modules and tests).
 MACHINERY_TESTS = (
     "tests/grading/test_graders.py",
     "tests/grading/test_assignment.py",
+    "tests/grading/test_tasks.py",
+    "tests/grading/test_task_pages.py",
     "tests/docs/test_pages.py",
     "tests/test_layout.py",
 )

@@ -1,21 +1,26 @@
-"""Grading the weekly assignments: points, a score table, Gradescope JSON, and a
-noise-aware comparison of renders with a reference.
+"""Grading the weekly assignments: points per task, a score table, Gradescope JSON, and
+a noise-aware comparison of renders with a reference.
 
-A grader is a pytest test in `assignments/weekNN/` marked with its points:
+A grader is a pytest test in `assignments/weekNN/` marked with its points and the task
+of the week's task map (`assignments/weekNN/tasks.toml`, rtpy.grading.tasks) it grades:
 
     from rtpy.grading import points
 
-    @points(3)
-    def test_point_light_falls_off_with_distance_squared():
-        \"\"\"Point light: 1/r^2 falloff\"\"\"        # the name shown in the score table
+    @points(3, task="05.1")
+    def test_point_light_sample():
+        \"\"\"unit direction, distance, radiance I / d^2\"\"\"   # shown after the task's title
         ...
         assert ok, "PointLight.sample (rtpy/light.py): ... what is wrong, what to do"
 
-A test scores all its points when it passes and none when it fails; its output is
-the assertion's message (or the exception, such as the NotImplementedError of a
-stub). `python -m rtpy grade WEEK [--json results.json]` runs them in-process
-(`grade()`), prints a table and writes the results in Gradescope's autograder
-format: {"score": ..., "tests": [{"name", "score", "max_score", "output"}, ...]}.
+A parametrized grader whose cases grade different tasks marks each case instead:
+`pytest.param("phong", marks=points(2, task="08.1"))`. A test scores all its points
+when it passes and none when it fails; its output is the assertion's message (or the
+exception, such as the NotImplementedError of a stub). `python -m rtpy grade WEEK
+[--json results.json]` runs them in-process (`grade()`), prints a table grouped by
+task with subtotals and writes the results in Gradescope's autograder format: each
+test is numbered task.test ("5.1.1", which Gradescope orders and groups by) and named
+"<task title>: <first docstring line>". Extension tasks are worth 0 points: their
+tests report passed or failed in their own group and do not change the score.
 
 Renders are compared by `assert_render_matches`: R renders with different seeds are
 cut into 8 x 8 pixel blocks and each block mean is compared with a stored reference
@@ -28,6 +33,8 @@ light counted twice or a missing 1/r^2 shifts whole regions by many sigmas.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import time
 from dataclasses import dataclass, field
@@ -41,11 +48,12 @@ ALPHA = 1e-3
 DEFAULT_POINTS = 1
 
 
-def points(n: float):
-    """Decorator: the test is worth n points."""
+def points(n: float, task: str | None = None):
+    """Mark: the test (or a parametrized case) is worth n points toward `task`, the id
+    of a task in the week's task map ("05.1")."""
     import pytest
 
-    return pytest.mark.points(n)
+    return pytest.mark.points(n, task=task)
 
 
 # --- render comparison ----------------------------------------------------------------
@@ -136,16 +144,18 @@ def assert_image_matches(
 # --- running graders ------------------------------------------------------------------
 @dataclass
 class GraderResult:
-    name: str
+    name: str  # the first line of the test's docstring, with a parametrized case's id
     nodeid: str
     max_score: float
+    task: str | None = None  # the id of the task it grades ("05.1")
     score: float = 0.0
     output: str = ""
+    passed: bool = False
 
 
 @dataclass(eq=False)
 class PointsPlugin:
-    """pytest plugin: every collected test's points, and whether it passed."""
+    """pytest plugin: every collected test's points and task, and whether it passed."""
 
     results: dict[str, GraderResult] = field(default_factory=dict)
     errors: list[str] = field(default_factory=list)  # graders that could not be loaded
@@ -155,27 +165,28 @@ class PointsPlugin:
             self.errors.append(f"{report.nodeid}: {failure_message(report)}")
 
     def pytest_configure(self, config) -> None:
-        config.addinivalue_line("markers", "points(n): points a grader test is worth")
+        config.addinivalue_line("markers", "points(n, task): points a grader test is worth")
 
     def pytest_collection_modifyitems(self, items) -> None:
         for item in items:
             mark = item.get_closest_marker("points")
             value = float(mark.args[0]) if mark else DEFAULT_POINTS
+            task = mark.kwargs.get("task") if mark else None
             doc = (getattr(item.function, "__doc__", None) or "").strip().splitlines()
             name = doc[0] if doc else item.name
             if "[" in item.name:
                 name += item.name[item.name.index("[") :]
-            self.results[item.nodeid] = GraderResult(name, item.nodeid, value)
+            self.results[item.nodeid] = GraderResult(name, item.nodeid, value, task)
 
     def pytest_runtest_logreport(self, report) -> None:
         result = self.results.get(report.nodeid)
         if result is None:
             return
         if report.failed:
-            result.score = 0.0
+            result.score, result.passed = 0.0, False
             result.output = failure_message(report)
         elif report.when == "call" and report.passed and not result.output:
-            result.score = result.max_score
+            result.score, result.passed = result.max_score, True
 
 
 def failure_message(report) -> str:
@@ -194,23 +205,62 @@ def grader_dir(week: str, root: Path | None = None) -> Path:
     raise FileNotFoundError(f"assignments/week{week}: not found in {Path.cwd()} or beside rtpy")
 
 
-def grade(week: str, extra_args: tuple[str, ...] = (), root: Path | None = None) -> dict:
-    """Run week's graders in this process; the Gradescope results dictionary."""
+def run_graders(folder: Path, extra_args: tuple[str, ...] = ()) -> PointsPlugin:
+    """Run (or with "--collect-only", collect) the graders of a week's folder in this
+    process; the plugin holds their results."""
     import pytest
 
-    folder = grader_dir(week, root)
     plugin = PointsPlugin()
-    start = time.perf_counter()
     pytest.main(
         # quiet: the score table shows each failure's message (pytest on the folder
         # shows the tracebacks)
         [str(folder), "-qq", "-p", "no:cacheprovider", "--tb=no", "-o", "addopts=", *extra_args],
         plugins=[plugin],
     )
-    tests = [
-        {"name": r.name, "score": r.score, "max_score": r.max_score, "output": r.output}
-        for r in plugin.results.values()
-    ]
+    return plugin
+
+
+def collect_graders(week: str, root: Path | None = None) -> list[GraderResult]:
+    """The week's graders with their points and tasks, collected without running them
+    (pytest's list of them is not printed)."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        plugin = run_graders(grader_dir(week, root), ("--collect-only",))
+    return list(plugin.results.values())
+
+
+def gradescope_tests(graders: list[GraderResult], week_map) -> list[dict]:
+    """Gradescope's test entries, in the order of the week's tasks: numbered task.test
+    ("5.1.1") and named "<task title>: <test>". Graders of a task the map does not
+    have (or without a map) come last, named and numbered by themselves."""
+    tasks = {t.id: t for t in week_map.tasks} if week_map is not None else {}
+    order = list(tasks)
+    graders = sorted(graders, key=lambda g: order.index(g.task) if g.task in tasks else len(order))
+    tests, counts = [], {}
+    for g in graders:
+        test = {"name": g.name}
+        task = tasks.get(g.task)
+        if task is not None:
+            counts[task.id] = counts.get(task.id, 0) + 1
+            test = {"name": f"{task.title}: {g.name}", "number": f"{task.number}.{counts[task.id]}"}
+        test.update(
+            score=g.score,
+            max_score=g.max_score,
+            status="passed" if g.passed else "failed",
+            output=g.output,
+        )
+        tests.append(test)
+    return tests
+
+
+def grade(week: str, extra_args: tuple[str, ...] = (), root: Path | None = None) -> dict:
+    """Run week's graders in this process; the Gradescope results dictionary."""
+    from .tasks import TASKS_FILE, load_week
+
+    folder = grader_dir(week, root)
+    start = time.perf_counter()
+    plugin = run_graders(folder, extra_args)
+    week_map = load_week(folder) if (folder / TASKS_FILE).is_file() else None
+    tests = gradescope_tests(list(plugin.results.values()), week_map)
     results = {
         "score": sum(t["score"] for t in tests),
         "max_score": sum(t["max_score"] for t in tests),
@@ -227,15 +277,28 @@ def grade(week: str, extra_args: tuple[str, ...] = (), root: Path | None = None)
 
 
 def score_table(results: dict) -> str:
+    """The results as a table: each task's line with its subtotal, then its tests with
+    the output of those that failed (a 0-point extension test shows passed/failed)."""
     if "output" in results:
         return results["output"]
-    rows = [(t["name"], f"{t['score']:g}/{t['max_score']:g}") for t in results["tests"]]
-    width = max([len(r[0]) for r in rows] + [4])
-    lines = [f"{'test':<{width}}  points", "-" * (width + 8)]
-    for (name, pts), t in zip(rows, results["tests"], strict=True):
-        lines.append(f"{name:<{width}}  {pts}")
-        if t["output"]:
-            lines.extend(f"    {line}" for line in t["output"].splitlines()[:6])
+    groups: dict[str, list[dict]] = {}
+    for t in results["tests"]:
+        groups.setdefault(t.get("number", "").rpartition(".")[0], []).append(t)
+    rows = []  # (indent, label, points, output)
+    for number, tests in groups.items():
+        if number:
+            title = tests[0]["name"].partition(": ")[0]
+            got, most = sum(t["score"] for t in tests), sum(t["max_score"] for t in tests)
+            rows.append((0, f"{number} {title}", f"{got:g}/{most:g}", ""))
+        for t in tests:
+            label = f"{t['number']} {t['name'].partition(': ')[2]}" if number else t["name"]
+            pts = f"{t['score']:g}/{t['max_score']:g}" if t["max_score"] else t["status"]
+            rows.append((4 if number else 0, label, pts, t["output"]))
+    width = max([indent + len(label) for indent, label, _, _ in rows] + [4])
+    lines = [f"{'task / test':<{width}}  points", "-" * (width + 8)]
+    for indent, label, pts, output in rows:
+        lines.append(f"{' ' * indent}{label:<{width - indent}}  {pts}")
+        lines.extend(f"{' ' * (indent + 4)}{line}" for line in output.splitlines()[:6])
     lines.append("-" * (width + 8))
     lines.append(f"{'total':<{width}}  {results['score']:g}/{results['max_score']:g}")
     return "\n".join(lines)

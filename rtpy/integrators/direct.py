@@ -18,6 +18,9 @@ class DirectIntegrator(Integrator):
     name = "direct"
 
     def compute_scattering(self, ray: Ray, scene: Scene) -> Color:
+        """Radiance arriving along the camera ray: the background when it hits
+        nothing, else the emission of the surface hit (seen directly) plus
+        direct_lighting there (with the settings' mis)."""
         # BEGIN SOLUTION week05: emission plus direct lighting at the first hit
         hit = scene.find_intersection(ray, FORWARD)
         if hit is None:

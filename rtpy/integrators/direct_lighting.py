@@ -14,8 +14,9 @@ Point lights can only be reached by light sampling (weight 1).
 from __future__ import annotations
 
 from ..hit_info import HitInfo
+from ..hittable import Hittable
 from ..interval import Interval
-from ..light import Light
+from ..light import Light, LightSample
 from ..ray import Ray, offset_scale, spawn_ray
 from ..sampling import power_heuristic, random_double
 from ..scene import Scene
@@ -23,19 +24,21 @@ from ..vec3 import BLACK, Color, dot
 from .integrator import FORWARD
 
 
-def sample_one_light(
-    scene: Scene, ray_in: Ray, hit: HitInfo, lights: list[Light], mis: bool = True
+def light_sample_estimate(
+    scene: Scene, ray_in: Ray, hit: HitInfo, sample: LightSample, light_shape: Hittable | None
 ) -> Color:
-    """Light-sampling estimate of the radiance reflected toward -ray_in.direction
-    by light arriving directly from `lights`: one light picked uniformly, one
-    direction toward it, weight f_r * L * cos(theta_i) / pdf (times the MIS weight
-    for area lights; with mis = False the weight is 1: light sampling alone)."""
-    # BEGIN SOLUTION week05: one light, one shadow ray, f_r * L * cos / pdf
-    n_lights = len(lights)
-    light = lights[min(int(random_double() * n_lights), n_lights - 1)]
-    sample = light.sample(hit.point)
-    if sample is None or sample.radiance.is_black():
-        return BLACK
+    """The light-sampling estimate of one sample of one light: the radiance reflected
+    toward -ray_in.direction by light from that light arriving along sample.direction,
+
+        f_r(wi, wo) * L * cos(theta_i) / pdf
+
+    with L = sample.radiance, pdf = sample.pdf (the density with which the light
+    chose the direction; 1 for a point light) and cos(theta_i) = hit.normal .
+    sample.direction (a unit vector). Black when the light is behind the surface or
+    something blocks the shadow ray: a ray that leaves the surface (spawn_ray) toward
+    the light, tested by scene.find_occlusion over shadow_interval(hit, sample), not
+    testing light_shape, the light's own shape (None for a point light)."""
+    # BEGIN SOLUTION week05: shadow ray toward the light, f_r * L * cos / pdf
     normal, wi = hit.normal, sample.direction
     cos_i = dot(normal, wi)
     if cos_i <= 0.0:
@@ -44,20 +47,45 @@ def sample_one_light(
     f = hit.material.BRDF(ray_in, shadow_ray, hit)
     if f.is_black():
         return BLACK
-    # The light itself is not tested: its shapes (spheres sampled on the cap facing
-    # the point, flat quads and triangles) cannot hide the sampled point from it,
-    # while rounding near the sampled point could make it seem to, most where the
-    # light is seen at a slant. Other objects count up to just short of the light.
-    t_max = sample.distance - offset_scale(sample.point) - offset_scale(hit.point)
-    light_shape = getattr(light, "shape", None)
-    if scene.find_occlusion(shadow_ray, Interval(0.0, t_max), ignore=light_shape):
+    if scene.find_occlusion(shadow_ray, shadow_interval(hit, sample), ignore=light_shape):
         return BLACK
-    pdf = sample.pdf / n_lights  # choosing this light, then this direction
-    if sample.is_delta or not mis:
-        return f * sample.radiance * (cos_i / pdf)
-    weight = power_heuristic(pdf, hit.material.pdf(ray_in, shadow_ray, hit))
-    return f * sample.radiance * (cos_i * weight / pdf)
+    return f * sample.radiance * (cos_i / sample.pdf)
     # END SOLUTION
+
+
+def shadow_interval(hit: HitInfo, sample: LightSample) -> Interval:
+    """Where on a shadow ray from hit.point toward sample.point a blocker casts a
+    shadow: from its start to just short of the light. The margins are the offsets
+    of the spawned origin and of the sampled point (offset_scale): an object that
+    touches the light there (a ceiling around a quad lamp) does not block it."""
+    return Interval(0.0, sample.distance - offset_scale(sample.point) - offset_scale(hit.point))
+
+
+def sample_one_light(
+    scene: Scene, ray_in: Ray, hit: HitInfo, lights: list[Light], mis: bool = True
+) -> Color:
+    """Light-sampling estimate of the radiance reflected toward -ray_in.direction
+    by light arriving directly from `lights`: one light picked uniformly, one
+    direction toward it (light.sample), its light_sample_estimate divided by the
+    probability 1 / len(lights) of picking that light, times the MIS weight for
+    area lights (with mis = False the weight is 1: light sampling alone)."""
+    n_lights = len(lights)
+    light = lights[min(int(random_double() * n_lights), n_lights - 1)]
+    sample = light.sample(hit.point)
+    if sample is None or sample.radiance.is_black():
+        return BLACK
+    # An area light's own shape is not tested by the shadow ray: a sphere sampled on
+    # the cap facing the point, a flat quad or triangle cannot hide the sampled point
+    # from it, while rounding near that point could make it seem to, most where the
+    # light is seen at a slant.
+    estimate = light_sample_estimate(scene, ray_in, hit, sample, getattr(light, "shape", None))
+    if sample.is_delta or not mis or estimate.is_black():
+        return estimate * n_lights
+    # The power heuristic against the density with which BRDF sampling picks the same
+    # direction: emission_weight gives that strategy the complementary weight.
+    pdf = sample.pdf / n_lights  # choosing this light, then this direction
+    weight = power_heuristic(pdf, hit.material.pdf(ray_in, Ray(hit.point, sample.direction), hit))
+    return estimate * (n_lights * weight)
 
 
 def emission_weight(
@@ -87,7 +115,6 @@ def direct_lighting(scene: Scene, ray_in: Ray, hit: HitInfo, mis: bool = True) -
     bounce: light sampling plus BRDF sampling, combined by MIS (mis = False: the
     lights by light sampling alone). A BRDF-sampled ray that escapes sees the
     background. At specular materials only the sampled ray is followed."""
-    # BEGIN SOLUTION week05: light sampling plus the BRDF-sampled bounce, light counted once
     material = hit.material
     lights = scene.lights
     result = BLACK
@@ -109,4 +136,3 @@ def direct_lighting(scene: Scene, ray_in: Ray, hit: HitInfo, mis: bool = True) -
             )
             result = result + scatter.attenuation * emitted * w
     return result
-    # END SOLUTION

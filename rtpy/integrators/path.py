@@ -32,6 +32,10 @@ class PathIntegrator(Integrator):
     name = "path"
 
     def compute_scattering(self, ray: Ray, scene: Scene) -> Color:
+        """Radiance arriving along the camera ray, estimated along one random path
+        (the class docstring): emission times emission_weight, sample_one_light at
+        non-specular hits, the throughput times each scattering() weight, Russian
+        roulette."""
         # BEGIN SOLUTION week08: path loop: emission (MIS), light sampling, throughput, roulette
         settings = self.settings
         max_depth, rr_start = settings.max_depth, settings.russian_roulette

@@ -70,11 +70,10 @@ MIN_ALPHA = 1e-4
 
 
 def schlick_fresnel(f0: Color, cosine: float) -> Color:
-    """Schlick's Fresnel reflectance F0 + (1 - F0) (1 - cos)^5, per colour channel."""
-    # BEGIN SOLUTION week08: Schlick's F per colour channel
+    """Schlick's Fresnel reflectance F0 + (1 - F0) (1 - cos)^5, per colour channel
+    (Schlick 1994, "An Inexpensive BRDF Model for Physically-based Rendering")."""
     m = (1.0 - min(1.0, max(0.0, cosine))) ** 5
     return f0 + (WHITE - f0) * m
-    # END SOLUTION
 
 
 def f0_from_ior(ior: float) -> float:
@@ -147,8 +146,9 @@ class CookTorrance(Material):
     # angles (where tan is infinite) and for tiny widths.
 
     def D(self, normal: Vec3, h: Vec3) -> float:
-        """Microfacet density along the unit half vector h (0 below the surface)."""
-        # BEGIN SOLUTION week08: GGX and Beckmann normal distributions
+        """Microfacet density along the unit half vector h (0 below the surface): the
+        GGX or Beckmann D of the module docstring (Walter et al. 2007, "Microfacet
+        Models for Refraction through Rough Surfaces", section 5)."""
         cos = dot(normal, h)
         cos2 = cos * cos
         if cos <= 0.0 or cos2 == 0.0:
@@ -166,11 +166,11 @@ class CookTorrance(Material):
         if exponent > 700.0:  # exp underflows; the cos^4 below would lose to it anyway
             return 0.0
         return math.exp(-exponent) / (math.pi * a2 * cos2 * cos2)
-        # END SOLUTION
 
     def G1(self, normal: Vec3, v: Vec3) -> float:
-        """Smith's masking of the unit direction v (1 at the normal, 0 at grazing)."""
-        # BEGIN SOLUTION week08: Smith masking G1 for GGX and Beckmann
+        """Smith's masking of the unit direction v (1 at the normal, 0 at grazing), the
+        G1 that matches D (Walter et al. 2007, section 5; the module docstring has
+        both forms)."""
         cos = dot(normal, v)
         if cos <= 0.0:
             return 0.0
@@ -187,7 +187,6 @@ class CookTorrance(Material):
         # erf(a) - 1 = -erfc(a), without the cancellation for large a.
         lam = 0.5 * (INV_SQRT_PI * math.exp(-a * a) / a - math.erfc(a))
         return 1.0 / (1.0 + max(0.0, lam))
-        # END SOLUTION
 
     def F(self, cosine: float) -> Color:
         """Fresnel reflectance of a facet seen at incidence cosine wo . h."""
@@ -200,9 +199,9 @@ class CookTorrance(Material):
         Inverting the cumulative distribution of theta_h gives
             GGX:      tan^2(theta_h) = alpha^2 r1 / (1 - r1)
             Beckmann: tan^2(theta_h) = -alpha^2 ln(1 - r1)
-        and phi_h = 2 pi r2 (D is the same in every direction around the normal).
+        and phi_h = 2 pi r2 (D is the same in every direction around the normal):
+        the sampling formulas of Walter et al. 2007, section 5.
         """
-        # BEGIN SOLUTION week08: a half vector with density D(h) cos(theta_h)
         a2 = self.alpha * self.alpha
         if self.distribution == "ggx":
             tan2 = a2 * r1 / (1.0 - r1)
@@ -212,7 +211,6 @@ class CookTorrance(Material):
         sin = math.sqrt(tan2) * cos
         phi = 2.0 * math.pi * r2
         return Vec3(sin * math.cos(phi), sin * math.sin(phi), cos)
-        # END SOLUTION
 
     # --- BRDF, density and sampling -------------------------------------------------
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:

@@ -27,6 +27,9 @@ class Lambertian(Material):
         self.albedo = as_texture(albedo)
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
+        """A cosine-weighted direction around hit.normal (pdf = cos(theta) / pi), the
+        ray leaving the surface toward it (spawn_ray), its weight BRDF * cos / pdf and
+        its pdf."""
         # BEGIN SOLUTION week05: cosine-weighted direction, weight = BRDF * cos / pdf
         local = random_cosine_direction()  # z = cos(theta) from the normal
         direction = ONB(hit.normal).to_world(local)
@@ -37,6 +40,8 @@ class Lambertian(Material):
         # END SOLUTION
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
+        """f_r = albedo / pi for light arriving from above the surface (ray_light's
+        direction, toward the light, on the side of hit.normal), black from below."""
         # BEGIN SOLUTION week05: f_r = albedo / pi above the surface
         if dot(hit.normal, ray_light.direction) <= 0.0:
             return BLACK  # light below the surface
@@ -44,4 +49,8 @@ class Lambertian(Material):
         # END SOLUTION
 
     def pdf(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> float:
+        """The density cos(theta) / pi with which scattering() picks ray_light's
+        direction (0 below the surface)."""
+        # BEGIN SOLUTION week05: cos(theta) / pi above the surface, 0 below
         return max(0.0, dot(hit.normal, ray_light.direction)) * INV_PI
+        # END SOLUTION

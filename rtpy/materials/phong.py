@@ -42,24 +42,23 @@ def sample_cosine_power(exponent: float, r1: float, r2: float) -> Vec3:
     (ONB(axis).to_world turns it around an axis).
 
     Inverting the cumulative distribution of cos(theta), 1 - cos^(n+1), gives
-    cos(theta) = r1^(1 / (n + 1)); the azimuth is uniform.
+    cos(theta) = r1^(1 / (n + 1)); the azimuth is uniform (Lafortune and Willems
+    1994, "Using the Modified Phong Reflectance Model for Physically Based
+    Rendering", KU Leuven report CW 197).
     """
-    # BEGIN SOLUTION week08: a direction with density (n + 1) / (2 pi) cos^n
     cos_theta = r1 ** (1.0 / (exponent + 1.0))
     sin_theta = math.sqrt(max(0.0, 1.0 - cos_theta * cos_theta))
     phi = 2.0 * math.pi * r2
     return Vec3(sin_theta * math.cos(phi), sin_theta * math.sin(phi), cos_theta)
-    # END SOLUTION
 
 
 def cosine_power_pdf(exponent: float, cos_theta: float) -> float:
-    """Density of sample_cosine_power at a direction cos_theta from the axis
-    (0 outside the hemisphere around the axis)."""
-    # BEGIN SOLUTION week08: the density (n + 1) / (2 pi) cos^n
+    """Density (n + 1) / (2 pi) * cos^n(theta) of sample_cosine_power at a direction
+    cos_theta from the axis, 0 outside the hemisphere around the axis (Lafortune and
+    Willems 1994)."""
     if cos_theta <= 0.0:
         return 0.0
     return (exponent + 1.0) * INV_TWO_PI * cos_theta**exponent
-    # END SOLUTION
 
 
 class Phong(Material):

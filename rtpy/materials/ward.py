@@ -165,7 +165,7 @@ class Ward(Material):
         """Density of scattering() choosing ray_light's direction: the mixture of
         cos(theta_i) / pi and p_h(h) / (4 (wo . h)), the half vector's density times
         the Jacobian d(w_h) / d(w_i) = 1 / (4 (wo . h)) of the reflection."""
-        # BEGIN SOLUTION week08: (not graded) the mixture's density, as Blinn-Phong's
+        # BEGIN SOLUTION week08: extension: the mixture's density; p_h(h) over 4 (wo . h)
         normal, wo, wi = hit.normal, -ray_view.direction, ray_light.direction
         cos_i = dot(normal, wi)
         if dot(normal, wo) <= 0.0 or cos_i <= 0.0:
@@ -179,7 +179,7 @@ class Ward(Material):
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
         """The diffuse lobe with probability p_d, else wo reflected about a half
         vector drawn with density p_h in the shading frame; weight BRDF * cos / pdf."""
-        # BEGIN SOLUTION week08: (not graded) wo reflected about a half vector, as Blinn-Phong's
+        # BEGIN SOLUTION week08: extension: pick a lobe; wo reflected about a half vector from p_h
         r = generator().random
         if r() < diffuse_probability(self, hit):
             wi = ONB(hit.normal).to_world(random_cosine_direction())

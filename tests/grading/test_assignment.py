@@ -6,6 +6,10 @@ repository's own rtpy first on the path):
 
 - every grader of that week fails (score 0), each with the NotImplementedError of a
   stub that names the week's task — proof that the graders can fail;
+- with that week's solutions put back (what a student who did every task has), the
+  graders give full marks with the code the repository ships as given (for week 05:
+  light counted once by the given MIS around the student's light sampling), and every
+  scene of the week's render list renders;
 - the rtpy tests shipped there pass: each test file runs in the first week it ships
   in (where the most code around it is stubbed; later weeks stub less, and a file
   ships only when it executes no stubbed region), so every shipped file is run once;
@@ -36,6 +40,7 @@ from rtpy.grading.assignment import (
     make_assignment,
     map_tests,
     regions_in,
+    rewrite,
     shipped_tests,
     student_pytest_options,
     weeks_of_tests,
@@ -146,27 +151,64 @@ def test_student_repository(tmp_path, week):
         folder = setup["package-dir"].get(package, package.replace(".", "/"))
         assert (repo / folder).is_dir() and any((repo / folder).iterdir()), package
     assert (repo / "assignments" / f"week{week}" / "README.md").exists()
+    assert (repo / "assignments" / f"week{week}" / "tasks.toml").exists()  # grade() reads it
     kept, left = shipped_tests(ROOT, week)
     assert sorted(str(p.relative_to(repo)) for p in (repo / "tests").rglob("*.py")) == kept
     assert left and all(not (repo / p).exists() for p in left)
 
-    first = first_shipped(week)
-    env = dict(os.environ, PYTHONPATH=str(repo))
-    proc = subprocess.run(
-        [sys.executable, "-c", DRIVER, week, *first],
-        cwd=repo,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    report = json.loads(proc.stdout.strip().splitlines()[-1])
+    report, proc = run_driver(repo, DRIVER, week, *first_shipped(week))
     tests = report["grade"]["tests"]
     assert len(tests) >= 5
     for t in tests:
         assert t["score"] == 0, f"week {week}: {t['name']} passes on the stubs"
         assert "NotImplementedError" in t["output"] and f"week{week} task" in t["output"], t
     assert report["shipped"] == 0, f"week {week}: shipped tests failed:\n{proc.stdout[-3000:]}"
+
+    solve(repo, week)
+    scenes = [
+        str(p.relative_to(repo))
+        for p in (repo / "assignments" / f"week{week}").glob("scenes/*.toml")
+    ]
+    report, proc = run_driver(repo, SOLVED_DRIVER, week, str(tmp_path / "render.png"), *scenes)
+    graded = report["grade"]
+    assert graded["score"] == graded["max_score"] > 0, f"week {week} solved: {graded}"
+    assert all(t["status"] == "passed" for t in graded["tests"]), graded
+    assert scenes and report["renders"] == [0] * len(scenes), (scenes, proc.stderr[-3000:])
+
+
+def run_driver(repo: Path, driver: str, *args: str) -> tuple[dict, subprocess.CompletedProcess]:
+    """Run a driver script in the repository with its own rtpy first on the path: the
+    JSON report it prints last, and the process."""
+    proc = subprocess.run(
+        [sys.executable, "-c", driver, *args],
+        cwd=repo,
+        env=dict(os.environ, PYTHONPATH=str(repo)),
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    return json.loads(proc.stdout.strip().splitlines()[-1]), proc
+
+
+SOLVED_DRIVER = """
+import json, sys
+from rtpy.grading import grade
+from rtpy.io.cli import main
+results = grade(sys.argv[1])
+out = sys.argv[2]
+renders = [main(["render", s, "--width", "16", "--spp", "1", "--max-depth", "3", "-o", out])
+           for s in sys.argv[3:]]
+print(json.dumps({"grade": results, "renders": renders}))
+"""
+
+
+def solve(repo: Path, week: str) -> None:
+    """Put week's solution regions back into its repository (later weeks stay stubs)."""
+    for path in sorted((ROOT / "rtpy").rglob("*.py")):
+        rel = path.relative_to(ROOT)
+        if rel.parts[1] != "numpy_backend" and any(r.week == week for r in regions_in(path, ROOT)):
+            text = rewrite(path, ROOT, lambda r: r.stub() if int(r.week) > int(week) else None)
+            (repo / rel).write_text(text)
 
 
 def test_map_tests_of_some_files_records_their_weeks_and_keeps_the_rest(tmp_path):

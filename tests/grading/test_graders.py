@@ -3,10 +3,12 @@
 Each planted mistake patches rtpy's solution with a buggy version (the course code's
 own mistakes first: no 1/r^2, a cosine with the unnormalised vector to the light, a
 shadow test that needs two blockers, no 1/pdf, albedo as the BRDF, light counted twice,
-glass that never refracts, an unnormalised half vector) and shows that the graders
-named with it fail, with a message. `python -m rtpy grade` is run on the reference for
-every week in test_graders_pass_on_the_reference, which also checks the points table
-and the Gradescope JSON.
+glass that never refracts, an unnormalised half vector), names the task of the week's
+task map it belongs to, and shows that the graders named with it fail, with a message;
+every task of every week has one, and the graders named include one of that task's.
+`python -m rtpy grade` is run on the reference for every week in
+test_graders_pass_on_the_reference, which also checks the table and the Gradescope
+JSON (numbered task.test, named by the task's title).
 """
 
 from __future__ import annotations
@@ -24,18 +26,30 @@ from pathlib import Path
 import pytest
 
 import rtpy.integrators.center as center
+import rtpy.integrators.direct as direct
 import rtpy.integrators.direct_lighting as direct_lighting
 import rtpy.integrators.path as path_module
 import rtpy.materials.dielectric as dielectric
-import rtpy.materials.glossy as glossy
 import rtpy.materials.mirror as mirror
-import rtpy.materials.phong as phong
 import rtpy.vec3 as vec3
-from rtpy import Camera, CheckerTexture, ImageTexture, PointLight, Quad, Ray, Scene, Sphere
+from rtpy import (
+    Camera,
+    CheckerTexture,
+    ImageTexture,
+    Interval,
+    PointLight,
+    Quad,
+    Ray,
+    Scene,
+    Sphere,
+    Triangle,
+)
 from rtpy.grading import compare, render_stack, summarize
 from rtpy.grading.assignment import WEEKS
+from rtpy.grading.graders import collect_graders
+from rtpy.grading.tasks import load_weeks
 from rtpy.io.cli import main
-from rtpy.materials import CookTorrance, Lambertian, Metal, Phong
+from rtpy.materials import BlinnPhong, CookTorrance, Lambertian, Metal, Phong, Ward
 from rtpy.vec3 import Vec3
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -119,7 +133,7 @@ def cosine_with_unnormalised_vector(mp):
     plant(
         mp,
         direct_lighting,
-        "sample_one_light",
+        "light_sample_estimate",
         "cos_i = dot(normal, wi)",
         "d = sample.point - hit.point; cos_i = dot(normal, d)",
     )
@@ -345,74 +359,159 @@ def in_source(label, owner, name, old, new):
     return mistake
 
 
-# Week 8's mistakes, each one change to the solution's source, the course's own first:
-# Phong's albedo as the BRDF (fr = kd + ks (R.V)^n) and the half vector (v + l) * 0.5.
-WEEK08_MISTAKES = {
+def interval_contains_open(mp):
+    mp.setattr(Interval, "contains", lambda self, x: self.min < x < self.max)
+
+
+def refract_inverted_ratio(mp):
+    original = vec3.refract
+    mp.setattr(vec3, "refract", lambda uv, n, eta: original(uv, n, 1.0 / eta))
+
+
+def weight_without_1_over_pdf(cls):
+    """scattering() of cls with the weight BRDF * cos (times pdf / pdf forgotten)."""
+
+    def mistake(mp):
+        def change(self, s, ray_in, hit):
+            if s is not None:
+                s.attenuation = s.attenuation * s.pdf
+            return s
+
+        mp.setattr(cls, "scattering", wrap(cls, "scattering", change))
+
+    mistake.__name__ = f"{cls.__name__.lower()}_weight_without_1_over_pdf"
+    return mistake
+
+
+# Mistakes inside a function: (owner, name, the solution's text, the mistake's).
+LIGHT_SAMPLE = (direct_lighting, "light_sample_estimate")
+DIRECT = (direct.DirectIntegrator, "compute_scattering")
+SOURCE_MISTAKES = {
+    "triangle_as_parallelogram": (Triangle, "_barycentric", "u + v > 1.0", "v > 1.0"),
+    "lambertian_pdf_uniform": (Lambertian, "pdf", ") * INV_PI", ") * 0.0 + 0.5 * INV_PI"),
+    "estimate_without_1_over_pdf": (*LIGHT_SAMPLE, "(cos_i / sample.pdf)", "cos_i"),
+    "shadow_ray_blocked_by_its_light": (*LIGHT_SAMPLE, "ignore=light_shape", "ignore=None"),
+    "direct_without_emission": (*DIRECT, "emitted + direct_lighting(", "direct_lighting("),
+    "quad_uv_swapped": (Quad, "surface_uv", "a, b = self._coords", "b, a = self._coords"),
     "phong_albedo_as_brdf": (Phong, "BRDF", "* (self.kd * INV_PI)", "* self.kd"),
-    "course_halfvector": (vec3, "halfvector", "unit_vector(view + light)", "(view + light) * 0.5"),
     "phong_wrong_normalisation": (Phong, "BRDF", "(n + 2.0) * INV_TWO", "(n + 1.0) * INV_TWO"),
     "phong_pdf_around_the_normal": (Phong, "pdf", "dot(mirror, wi)", "dot(normal, wi)"),
-    "pdf_without_jacobian": (glossy, "reflected_density", " / (4.0 * wo_h)", ""),
-    "pdf_without_cos_theta_h": (CookTorrance, "pdf", " * dot(normal, h)  #", "  #"),
-    "mixture_pdf_unweighted": (glossy, "mixture_pdf", "(1.0 - p_diffuse) * ", ""),
-    "cosine_power_wrong_inverse": (phong, "sample_cosine_power", "(exponent + 1", "(exponent + 2"),
-    "ggx_without_pi": (CookTorrance, "D", "a2 / (math.pi * k * k)", "a2 / (k * k)"),
-    "weight_without_1_over_pdf": (glossy, "weighted_sample", "* (cos_i / pdf)", "* cos_i"),
-}
-# the grader tests each must fail
-WEEK08_FAILS = {
-    "phong_albedo_as_brdf": ["test_phong_brdf"],
-    "course_halfvector": ["test_blinn_phong_brdf"],
-    "phong_wrong_normalisation": ["test_phong_brdf"],
-    "phong_pdf_around_the_normal": ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
-    "pdf_without_jacobian": ["test_pdf[blinn_phong]", "test_sampling_follows_pdf[blinn_phong]"],
-    "pdf_without_cos_theta_h": [
-        "test_pdf[cook_torrance_ggx]",
-        "test_sampling_follows_pdf[cook_torrance_ggx]",
-    ],
-    "mixture_pdf_unweighted": ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
-    "cosine_power_wrong_inverse": ["test_cosine_power_sampler"],
-    "ggx_without_pi": [
-        "test_cook_torrance_factors[ggx]",
-        "test_cook_torrance_brdf[cook_torrance_ggx]",
-    ],
-    "weight_without_1_over_pdf": ["test_weight_is_brdf_cos_over_pdf[cook_torrance_ggx]"],
+    "phong_pdf_without_diffuse": (Phong, "pdf", "(diffuse_probability(self, hit),", "(0.0,"),
+    "phong_highlight_around_the_normal": (Phong, "scattering", "ONB(mirror)", "ONB(hit.normal)"),
+    "course_halfvector": (BlinnPhong, "BRDF", "halfvector(wo, wi)", "(wo + wi) * 0.5"),
+    "blinn_without_jacobian": (
+        BlinnPhong,
+        "pdf",
+        "reflected_density(density_h, wo, h)",
+        "density_h",
+    ),
+    "blinn_half_vector_as_wi": (BlinnPhong, "scattering", "reflect(ray_in.direction, h)", "h"),
+    "cook_torrance_pdf_without_cos_theta_h": (CookTorrance, "pdf", " * dot(normal, h)  #", "  #"),
+    "cook_torrance_without_masking": (CookTorrance, "BRDF", "self.G1(normal, wi)", "1.0"),
+    "ward_without_jacobian": (Ward, "pdf", "reflected_density(density_h, wo, h)", "density_h"),
 }
 
 
-# (week, mistake, grader tests that must fail)
+def source(label):
+    """The mistake `label` of SOURCE_MISTAKES."""
+    return in_source(label, *SOURCE_MISTAKES[label])
+
+
+# (task, mistake, grader tests that must fail; one of them the task's own)
 PLANTED = [
-    ("03", cross_left_handed, ["test_cross_and_unit_vector"]),
-    ("03", center_ray_through_corner, ["test_center_ray"]),
-    ("03", jitter_outside_pixel, ["test_jittered_ray", "test_sky_render_matches_reference"]),
-    ("03", unnormalised_camera_ray, ["test_center_ray", "test_jittered_ray"]),
-    ("03", emitter_shows_albedo, ["test_flat_color"]),
-    ("04", sphere_far_root, ["test_sphere_hit_t"]),
-    ("04", sphere_ignores_t_min, ["test_sphere_hit_t"]),
-    ("04", normal_not_flipped, ["test_sphere_hit_info"]),
-    ("04", quad_no_interior_test, ["test_quad_hit", "test_center_render_matches_reference"]),
-    ("04", first_hit_not_closest, ["test_closest_hit", "test_center_render_matches_reference"]),
-    ("05", no_falloff, ["test_point_light_sample", "test_direct_light_on_a_plane_is_exact"]),
-    ("05", unnormalised_light_vector, ["test_point_light_sample"]),
-    ("05", cosine_with_unnormalised_vector, ["test_direct_light_on_a_plane_is_exact"]),
-    ("05", two_blockers_needed, ["test_shadow_rays", "test_direct_light_on_a_plane_is_exact"]),
-    ("05", albedo_as_brdf, ["test_lambertian_brdf_and_sampling"]),
-    ("05", lambertian_no_pdf, ["test_lambertian_brdf_and_sampling"]),
-    ("05", light_counted_twice, ["test_direct_render_matches_reference"]),
-    ("06", reflect_wrong_sign, ["test_reflect", "test_mirror"]),
-    ("06", schlick_power_four, ["test_schlick"]),
-    ("06", no_total_internal_reflection, ["test_total_internal_reflection"]),
-    ("06", glass_never_refracts, ["test_dielectric_reflects_with_probability_schlick"]),
-    ("06", mirror_with_cosine, ["test_mirror"]),
-    ("07", sphere_uv_from_plus_x, ["test_sphere_uv"]),
-    ("07", checker_with_int, ["test_checker_texture"]),
-    ("07", image_v_not_flipped, ["test_image_texture"]),
-    ("07", fuzz_not_absorbed, ["test_metal_fuzz"]),
-    ("07", fuzz_ignored, ["test_metal_fuzz"]),
-    *[("08", in_source(k, *WEEK08_MISTAKES[k]), WEEK08_FAILS[k]) for k in WEEK08_MISTAKES],
-    ("08", light_counted_twice, ["test_path_render_matches_reference"]),
-    ("08", path_counts_light_twice, ["test_path_render_matches_reference", "test_path_furnace"]),
-    ("08", roulette_not_divided, ["test_path_furnace"]),
+    ("03.1", cross_left_handed, ["test_cross_and_unit_vector"]),
+    ("03.2", interval_contains_open, ["test_interval"]),
+    ("03.3", center_ray_through_corner, ["test_center_ray"]),
+    ("03.3", unnormalised_camera_ray, ["test_center_ray", "test_jittered_ray"]),
+    ("03.4", emitter_shows_albedo, ["test_flat_color"]),
+    ("03.5", jitter_outside_pixel, ["test_jittered_ray", "test_sky_render_matches_reference"]),
+    ("04.1", sphere_far_root, ["test_sphere_hit_t"]),
+    ("04.1", sphere_ignores_t_min, ["test_sphere_hit_t"]),
+    ("04.1", normal_not_flipped, ["test_sphere_hit_info"]),
+    ("04.2", quad_no_interior_test, ["test_quad_hit", "test_center_render_matches_reference"]),
+    ("04.3", source("triangle_as_parallelogram"), ["test_triangle_hit"]),
+    ("04.4", first_hit_not_closest, ["test_closest_hit", "test_center_render_matches_reference"]),
+    ("05.1", no_falloff, ["test_point_light_sample", "test_direct_light_on_a_plane_is_exact"]),
+    ("05.1", unnormalised_light_vector, ["test_point_light_sample"]),
+    ("05.2", two_blockers_needed, ["test_shadow_rays", "test_direct_light_on_a_plane_is_exact"]),
+    ("05.3", albedo_as_brdf, ["test_lambertian_brdf_and_sampling"]),
+    ("05.3", lambertian_no_pdf, ["test_lambertian_brdf_and_sampling"]),
+    ("05.3", source("lambertian_pdf_uniform"), ["test_lambertian_brdf_and_sampling"]),
+    (
+        "05.4",
+        cosine_with_unnormalised_vector,
+        ["test_light_sample_estimate", "test_direct_light_on_a_plane_is_exact"],
+    ),
+    (
+        "05.4",
+        source("estimate_without_1_over_pdf"),
+        ["test_light_sample_estimate", "test_direct_render_matches_reference"],
+    ),
+    ("05.4", source("shadow_ray_blocked_by_its_light"), ["test_light_sample_estimate"]),
+    (
+        "05.4",
+        source("direct_without_emission"),
+        ["test_direct_sees_emitters_and_background", "test_direct_render_matches_reference"],
+    ),
+    ("05.4", light_counted_twice, ["test_direct_render_matches_reference"]),
+    ("06.1", reflect_wrong_sign, ["test_reflect", "test_mirror"]),
+    ("06.1", mirror_with_cosine, ["test_mirror"]),
+    ("06.2", refract_inverted_ratio, ["test_refract_obeys_snell"]),
+    ("06.3", schlick_power_four, ["test_schlick"]),
+    ("06.3", no_total_internal_reflection, ["test_total_internal_reflection"]),
+    ("06.3", glass_never_refracts, ["test_dielectric_reflects_with_probability_schlick"]),
+    ("07.1", sphere_uv_from_plus_x, ["test_sphere_uv"]),
+    ("07.1", source("quad_uv_swapped"), ["test_quad_uv"]),
+    ("07.2", checker_with_int, ["test_checker_texture"]),
+    ("07.2", image_v_not_flipped, ["test_image_texture"]),
+    ("07.3", fuzz_not_absorbed, ["test_metal_fuzz"]),
+    ("07.3", fuzz_ignored, ["test_metal_fuzz"]),
+    # Week 8, each a change to the solution's source, the course's own first: Phong's
+    # albedo as the BRDF (fr = kd + ks (R.V)^n) and the half vector (v + l) * 0.5.
+    ("08.1", source("phong_albedo_as_brdf"), ["test_phong_brdf"]),
+    ("08.1", source("phong_wrong_normalisation"), ["test_phong_brdf"]),
+    (
+        "08.1",
+        source("phong_pdf_around_the_normal"),
+        ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
+    ),
+    (
+        "08.1",
+        source("phong_pdf_without_diffuse"),
+        ["test_pdf[phong]", "test_sampling_follows_pdf[phong]"],
+    ),
+    ("08.1", source("phong_highlight_around_the_normal"), ["test_sampling_follows_pdf[phong]"]),
+    ("08.1", weight_without_1_over_pdf(Phong), ["test_weight_is_brdf_cos_over_pdf[phong]"]),
+    ("08.2", source("course_halfvector"), ["test_blinn_phong_brdf"]),
+    (
+        "08.2",
+        source("blinn_without_jacobian"),
+        ["test_pdf[blinn_phong]", "test_sampling_follows_pdf[blinn_phong]"],
+    ),
+    ("08.2", source("blinn_half_vector_as_wi"), ["test_sampling_follows_pdf[blinn_phong]"]),
+    (
+        "08.3",
+        source("cook_torrance_pdf_without_cos_theta_h"),
+        ["test_pdf[cook_torrance_ggx]", "test_sampling_follows_pdf[cook_torrance_ggx]"],
+    ),
+    (
+        "08.3",
+        source("cook_torrance_without_masking"),
+        ["test_cook_torrance_brdf[cook_torrance_ggx]"],
+    ),
+    (
+        "08.3",
+        weight_without_1_over_pdf(CookTorrance),
+        ["test_weight_is_brdf_cos_over_pdf[cook_torrance_ggx]"],
+    ),
+    ("08.4", light_counted_twice, ["test_path_render_matches_reference"]),
+    ("08.4", path_counts_light_twice, ["test_path_render_matches_reference", "test_path_furnace"]),
+    ("08.4", roulette_not_divided, ["test_path_furnace"]),
+    (
+        "08.5",
+        source("ward_without_jacobian"),
+        ["test_pdf[ward]", "test_sampling_follows_pdf[ward]"],
+    ),
 ]
 
 
@@ -427,13 +526,13 @@ def run_grader_test(week: str, name: str) -> None:
 
 
 @pytest.mark.parametrize(
-    "week,mistake,graders", PLANTED, ids=[f"{w}-{m.__name__}" for w, m, _ in PLANTED]
+    "task,mistake,graders", PLANTED, ids=[f"{t}-{m.__name__}" for t, m, _ in PLANTED]
 )
-def test_a_planted_mistake_fails_its_graders(monkeypatch, week, mistake, graders):
+def test_a_planted_mistake_fails_its_graders(monkeypatch, task, mistake, graders):
     mistake(monkeypatch)
     for name in graders:
         with pytest.raises(AssertionError) as info:
-            run_grader_test(week, name)
+            run_grader_test(task[:2], name)
         message = str(info.value)
         # where to look: a file, a Class.method or a function of rtpy, or the integrator
         assert re.search(r"rtpy/|[A-Z]\w*\.\w+|\w+ \(rtpy|integrator", message), (
@@ -441,28 +540,75 @@ def test_a_planted_mistake_fails_its_graders(monkeypatch, week, mistake, graders
         )
 
 
-def test_every_week_has_planted_mistakes():
-    assert {w for w, _, _ in PLANTED} == set(WEEKS)
+@cache
+def graders_by_name(week: str) -> dict[str, str | None]:
+    """Grader test name (with its case) -> the task it grades, collected by pytest."""
+    return {g.nodeid.split("::")[-1]: g.task for g in collect_graders(week)}
+
+
+def plant_problems(planted, weeks, graders_of) -> list[str]:
+    """What is wrong with the planted mistakes against the task maps: a task without a
+    mistake, a mistake naming no grader of its task or a grader that does not exist."""
+    problems = []
+    tasks = {t.id for w in weeks for t in w.tasks}
+    for task, mistake, names in planted:
+        graders = graders_of(task[:2])
+        missing = [n for n in names if n not in graders]
+        if task not in tasks or missing:
+            problems.append(f"{task} {mistake.__name__}: no such task or graders {missing}")
+        elif not any(graders[n] == task for n in names):
+            problems.append(f"{task} {mistake.__name__}: names no grader of task {task}")
+    planted_tasks = {t for t, _, _ in planted}
+    problems += [f"{t}: no planted mistake" for t in sorted(tasks - planted_tasks)]
+    return problems
+
+
+def test_every_task_has_a_planted_mistake_that_its_graders_catch():
+    """Every task of every week's map (extensions too) has a planted mistake above,
+    and each mistake names a grader of its own task among those that must fail."""
+    weeks = load_weeks(ROOT)
+    assert {w.week for w in weeks} == set(WEEKS)
+    assert plant_problems(PLANTED, weeks, graders_by_name) == []
+    # the check can fail: a task without a mistake, and a mistake on another task's grader
+    cut = [p for p in PLANTED if p[0] != "05.2"]
+    moved = [("05.1", two_blockers_needed, ["test_shadow_rays"])]
+    assert plant_problems(cut + moved, weeks, graders_by_name) == [
+        "05.1 two_blockers_needed: names no grader of task 05.1",
+        "05.2: no planted mistake",
+    ]
 
 
 @pytest.mark.slow
 def test_graders_pass_on_the_reference(tmp_path, capsys):
-    """`python -m rtpy grade WEEK --json` on rtpy's solution: full score, Gradescope format."""
-    for week in WEEKS:
+    """`python -m rtpy grade WEEK --json` on rtpy's solution: full score, every test
+    passed (the extensions' too), numbered task.test and named by its task's title in
+    the task map's order, the points per task those of the map, a subtotal per task."""
+    for week_map in load_weeks(ROOT):
+        week = week_map.week
         out = tmp_path / f"results{week}.json"
         status = main(["grade", week, "--json", str(out)])
         table = capsys.readouterr().out
         results = json.loads(out.read_text())
-        failed = [t for t in results["tests"] if t["score"] < t["max_score"]]
+        failed = [t for t in results["tests"] if t["status"] != "passed"]
         assert status == 0 and not failed, f"week {week}: {failed}"
         assert (
             results["score"]
             == results["max_score"]
             == sum(t["max_score"] for t in results["tests"])
+            == sum(t.points for t in week_map.graded)
         )
-        assert len(results["tests"]) >= 5
-        for t in results["tests"]:
-            assert set(t) == {"name", "score", "max_score", "output"} and t["max_score"] > 0
+        keys = {"name", "number", "score", "max_score", "status", "output"}
+        numbers = [t["number"] for t in results["tests"]]
+        for task in week_map.tasks:
+            tests = [t for t in results["tests"] if t["number"].startswith(f"{task.number}.")]
+            assert [t["number"] for t in tests] == [
+                f"{task.number}.{k + 1}" for k in range(len(tests))
+            ]
+            assert tests and sum(t["max_score"] for t in tests) == task.points, task.id
+            assert all(set(t) == keys and t["name"].startswith(f"{task.title}: ") for t in tests)
+            got = f"{task.number} {task.title}"
+            assert any(line.startswith(got) for line in table.splitlines()), (got, table)
+        assert len(numbers) == len(set(numbers)) == len(results["tests"]) >= 5
         assert "total" in table and f"{results['score']:g}/{results['max_score']:g}" in table
 
 
