@@ -18,19 +18,24 @@ from __future__ import annotations
 
 import math
 import multiprocessing
+import os
+import pickle
 import signal
 import sys
 import time
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
-from tqdm import tqdm
+from tqdm.auto import tqdm  # a notebook widget in Jupyter, else text
 
 from .camera import Camera
 from .integrators import make_integrator
 from .io.image import RenderedImage
+from .plugins import PLUGINS, load_listed_plugins
 from .render_settings import BACKENDS, RenderSettings
 from .sampling import make_generator, use_generator
 from .scene import Scene
@@ -259,17 +264,100 @@ def make_backend(name: str, scene: Scene, camera: Camera, settings: RenderSettin
 
 
 # --- worker processes -------------------------------------------------------
+# A worker process receives the backend (the scene, camera and settings) once, when
+# it starts. Under the `fork` start method it inherits the object; under `spawn` and
+# `forkserver` (the defaults on Windows and macOS, and on Linux from Python 3.14) it
+# receives the pickled bytes and rebuilds the backend after loading the plugins the
+# parent loaded (rtpy.plugins), since the scene's material classes may live in them.
+# A worker that cannot rebuild it reports why with every unit it is given, so the
+# render stops at once with one message rather than a pool restarting workers forever.
+
 _render_one: Callable[[Unit], np.ndarray] | None = None
+_start_error = ""
 
 
-def _init_worker(backend: Backend) -> None:
-    global _render_one
+def available_cpus() -> int:
+    """The number of CPUs this process may run on (its affinity mask or, on Python
+    3.13+, also its -X cpu_count limit), the machine's count where the system does
+    not say, and 1 where nothing does."""
+    count = getattr(os, "process_cpu_count", None)  # Python 3.13+
+    if count is not None:
+        return count() or 1
+    if hasattr(os, "sched_getaffinity"):  # Linux and some other Unix systems
+        return len(os.sched_getaffinity(0)) or 1
+    return os.cpu_count() or 1
+
+
+class WorkerStartError(RuntimeError):
+    """The worker processes cannot rebuild the render (a class the scene uses cannot
+    be imported by a process started by spawn or forkserver), or one died starting."""
+
+
+def worker_start_error(reason: str, method: str) -> WorkerStartError:
+    """The error saying why the workers (started by `method`) failed and what to do."""
+    return WorkerStartError(
+        f"the worker processes (start method {method!r}) cannot rebuild the scene: "
+        f"{reason}. Every class a scene uses must be importable by its module's name: "
+        "define it in a .py file and import it (or load the file with rtpy.load_plugin, "
+        "--plugin FILE.py on the command line), keep a script's rendering under "
+        '`if __name__ == "__main__":`, or render with one worker.'
+    )
+
+
+def _init_worker(plugins: dict[str, str], backend: Backend | bytes) -> None:
+    global _render_one, _start_error
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
-    _render_one = backend.start()
+    try:
+        load_listed_plugins(plugins)
+        if isinstance(backend, bytes):
+            backend = pickle.loads(backend)
+        _render_one = backend.start()
+    except Exception as err:
+        _start_error = f"{type(err).__name__}: {err}"
 
 
 def _run_unit(unit: Unit) -> tuple[Unit, np.ndarray]:
+    if _render_one is None:
+        raise WorkerStartError(_start_error)
     return unit, _render_one(unit)
+
+
+def _stop_workers(executor: ProcessPoolExecutor) -> None:
+    """End the executor's worker processes now, in the middle of their units."""
+    terminate = getattr(executor, "terminate_workers", None)  # Python 3.14+
+    if terminate is not None:
+        terminate()
+        return
+    for process in list(executor._processes.values()):
+        process.terminate()
+
+
+def run_on_workers(backend: Backend, units: list[Unit], workers: int):
+    """Yield (unit, sums) for every unit as worker processes finish them, in the order
+    they finish; the processes start by the default start method
+    (multiprocessing.get_context()). Raises WorkerStartError if they cannot start."""
+    context = multiprocessing.get_context()
+    method = context.get_start_method()
+    try:
+        payload = backend if method == "fork" else pickle.dumps(backend)
+    except (pickle.PicklingError, AttributeError, TypeError) as err:  # a local class
+        raise worker_start_error(f"{type(err).__name__}: {err}", method) from None
+    executor = ProcessPoolExecutor(
+        workers, mp_context=context, initializer=_init_worker, initargs=(dict(PLUGINS), payload)
+    )
+    try:
+        for future in as_completed([executor.submit(_run_unit, unit) for unit in units]):
+            yield future.result()
+    except WorkerStartError as err:
+        _stop_workers(executor)
+        raise worker_start_error(str(err), method) from None
+    except BrokenProcessPool:
+        raise worker_start_error("a worker process ended while it started", method) from None
+    except BaseException:
+        _stop_workers(executor)  # at once on Ctrl-C or an error
+        raise
+    finally:
+        executor.shutdown(wait=True, cancel_futures=True)
 
 
 class Renderer:
@@ -331,20 +419,13 @@ class Renderer:
         return self._assemble(results, spp, interrupted, seconds)
 
     def _run(self, units: list[Unit]):
-        if self.workers == 1:
-            render_one = self.backend.start()
-            for unit in units:
-                yield unit, render_one(unit)
+        workers = min(self.workers, len(units))
+        if workers > 1:
+            yield from run_on_workers(self.backend, units, workers)
             return
-        pool = multiprocessing.get_context().Pool(self.workers, _init_worker, (self.backend,))
-        try:
-            yield from pool.imap_unordered(_run_unit, units, chunksize=1)
-            pool.close()
-        except BaseException:
-            pool.terminate()  # stop the workers at once on Ctrl-C or an error
-            raise
-        finally:
-            pool.join()
+        render_one = self.backend.start()
+        for unit in units:
+            yield unit, render_one(unit)
 
     def _assemble(self, results: PixelSums, spp, interrupted, seconds) -> RenderedImage:
         results.finish()
