@@ -4,6 +4,7 @@ one loop that drives any backend."""
 from __future__ import annotations
 
 import multiprocessing
+import re
 import subprocess
 import sys
 
@@ -269,3 +270,37 @@ def test_a_scene_the_workers_cannot_rebuild_stops_with_one_message(tmp_path, met
 def test_under_fork_workers_inherit_the_classes_of_main(tmp_path):
     result = run_worker_program(tmp_path, "fork", "main")
     assert result.returncode == 0 and result.stdout.strip() == "rendered", result.stderr
+
+
+# --- progress bar ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "options,shown",
+    [({}, False), ({"progress": True}, True), ({"quiet": False}, True), ({"quiet": True}, False)],
+)
+def test_progress_bar_only_when_asked_for(capsys, options, shown):
+    scene, camera = small_scene()
+    rtpy.render(scene, camera=camera.with_width(8), integrator="center", **options)
+    err = capsys.readouterr().err
+    assert ("path" in err) == shown, err
+
+
+def test_the_bar_is_tqdms_notebook_aware_one():
+    import tqdm.auto
+
+    assert rtpy.renderer.tqdm is tqdm.auto.tqdm
+
+
+@pytest.mark.parametrize(
+    "options,error,message",
+    [
+        ({"progress": "yes"}, TypeError, "progress must be True or False, got 'yes'"),
+        ({"quiet": 0}, TypeError, "quiet must be True or False, got 0"),
+        ({"progress": True, "quiet": True}, ValueError, "progress=True contradicts quiet=True"),
+    ],
+)
+def test_bad_progress_options_are_refused(options, error, message):
+    scene, camera = small_scene()
+    with pytest.raises(error, match=re.escape(message)):
+        rtpy.render(scene, camera=camera, **options)
