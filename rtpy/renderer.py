@@ -274,6 +274,9 @@ def make_backend(name: str, scene: Scene, camera: Camera, settings: RenderSettin
 
 _render_one: Callable[[Unit], np.ndarray] | None = None
 _start_error = ""
+# Windows waits on at most 63 handles at once; ProcessPoolExecutor refuses more than
+# 61 workers there.
+WINDOWS_MAX_WORKERS = 61
 
 
 def available_cpus() -> int:
@@ -288,19 +291,24 @@ def available_cpus() -> int:
     return os.cpu_count() or 1
 
 
-class WorkerStartError(RuntimeError):
+class WorkerError(RuntimeError):
     """The worker processes cannot rebuild the render (a class the scene uses cannot
-    be imported by a process started by spawn or forkserver), or one died starting."""
+    be imported by a process started by spawn or forkserver), or one ended abruptly."""
 
 
-def worker_start_error(reason: str, method: str) -> WorkerStartError:
-    """The error saying why the workers (started by `method`) failed and what to do."""
-    return WorkerStartError(
+START_ADVICE = (
+    "Every class a scene uses must be importable by its module's name: define it in a "
+    ".py file and import it (or load the file with rtpy.load_plugin, --plugin FILE.py "
+    'on the command line), keep a script\'s rendering under `if __name__ == "__main__":`, '
+    "or render with one worker."
+)
+
+
+def cannot_rebuild(reason: str, method: str) -> WorkerError:
+    """The error saying why workers started by `method` cannot rebuild the scene."""
+    return WorkerError(
         f"the worker processes (start method {method!r}) cannot rebuild the scene: "
-        f"{reason}. Every class a scene uses must be importable by its module's name: "
-        "define it in a .py file and import it (or load the file with rtpy.load_plugin, "
-        "--plugin FILE.py on the command line), keep a script's rendering under "
-        '`if __name__ == "__main__":`, or render with one worker.'
+        f"{reason}. {START_ADVICE}"
     )
 
 
@@ -318,7 +326,7 @@ def _init_worker(plugins: dict[str, str], backend: Backend | bytes) -> None:
 
 def _run_unit(unit: Unit) -> tuple[Unit, np.ndarray]:
     if _render_one is None:
-        raise WorkerStartError(_start_error)
+        raise WorkerError(_start_error)
     return unit, _render_one(unit)
 
 
@@ -328,6 +336,7 @@ def _stop_workers(executor: ProcessPoolExecutor) -> None:
     if terminate is not None:
         terminate()
         return
+    # Python 3.11-3.13 have no public way: the executor's own table of its processes
     for process in list(executor._processes.values()):
         process.terminate()
 
@@ -335,24 +344,30 @@ def _stop_workers(executor: ProcessPoolExecutor) -> None:
 def run_on_workers(backend: Backend, units: list[Unit], workers: int):
     """Yield (unit, sums) for every unit as worker processes finish them, in the order
     they finish; the processes start by the default start method
-    (multiprocessing.get_context()). Raises WorkerStartError if they cannot start."""
+    (multiprocessing.get_context()). Raises WorkerError if they cannot start or one
+    ends abruptly."""
     context = multiprocessing.get_context()
     method = context.get_start_method()
     try:
         payload = backend if method == "fork" else pickle.dumps(backend)
     except (pickle.PicklingError, AttributeError, TypeError) as err:  # a local class
-        raise worker_start_error(f"{type(err).__name__}: {err}", method) from None
+        raise cannot_rebuild(f"{type(err).__name__}: {err}", method) from None
+    if sys.platform == "win32":
+        workers = min(workers, WINDOWS_MAX_WORKERS)
     executor = ProcessPoolExecutor(
         workers, mp_context=context, initializer=_init_worker, initargs=(dict(PLUGINS), payload)
     )
     try:
         for future in as_completed([executor.submit(_run_unit, unit) for unit in units]):
             yield future.result()
-    except WorkerStartError as err:
+    except WorkerError as err:
         _stop_workers(executor)
-        raise worker_start_error(str(err), method) from None
+        raise cannot_rebuild(str(err), method) from None
     except BrokenProcessPool:
-        raise worker_start_error("a worker process ended while it started", method) from None
+        raise WorkerError(
+            f"a worker process (start method {method!r}) ended abruptly: it was killed, "
+            f"ran out of memory or failed while starting (its error is above). {START_ADVICE}"
+        ) from None
     except BaseException:
         _stop_workers(executor)  # at once on Ctrl-C or an error
         raise

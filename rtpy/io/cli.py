@@ -1,7 +1,8 @@
 """Command line: `python -m rtpy render SCENE ...` and `python -m rtpy scenes`.
 
-Exit status: 0 done, 2 bad input (scene file, option or output path; nothing is
-written), 130 interrupted by Ctrl-C (what was finished is written first).
+Exit status: 0 done, 1 the worker processes failed (nothing is written), 2 bad input
+(scene file, option or output path; nothing is written), 130 interrupted by Ctrl-C
+(what was finished is written first).
 """
 
 from __future__ import annotations
@@ -13,9 +14,10 @@ import tomllib
 from pathlib import Path
 
 from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
-from ..renderer import available_cpus
+from ..renderer import WorkerError, available_cpus
 from .image import OutputError, check_image_path, check_linear_path
 
+EXIT_WORKERS_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
 
@@ -286,7 +288,13 @@ def _render(args: argparse.Namespace) -> int:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
 
-    image = render(scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides)
+    try:
+        image = render(
+            scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides
+        )
+    except WorkerError as err:
+        print(f"rtpy: error: {err}", file=sys.stderr)
+        return EXIT_WORKERS_FAILED
     if image.interrupted:
         print(
             "rtpy: interrupted: writing the samples finished so far "

@@ -449,3 +449,24 @@ def test_short_options_and_the_default_worker_count(monkeypatch):
     assert args.workers == 2 and args.quiet
     monkeypatch.setattr("rtpy.io.cli.available_cpus", lambda: 10_000)
     assert build_parser().parse_args(["render", "cornell"]).workers == MAX_WORKERS
+
+
+def test_workers_that_cannot_start_stop_the_render_with_one_error(tmp_path):
+    """A plugin that refuses to run in a worker process: under spawn the render stops
+    at once with one `rtpy: error:` line and status 1, writing nothing."""
+    (tmp_path / "parent_only.py").write_text(
+        "import multiprocessing\n"
+        "if multiprocessing.parent_process() is not None:\n"
+        "    raise RuntimeError('imported in a worker')\n"
+    )
+    out = tmp_path / "o.png"
+    result = render_under(
+        "spawn", "week08_three_balls", "--plugin", str(tmp_path / "parent_only.py"),
+        "-j", "2", "--width", "48", "--spp", "1", "-q", "-o", str(out),
+    )  # fmt: skip
+    assert result.returncode == 1, result.stderr
+    errors = [line for line in result.stderr.splitlines() if line.startswith("rtpy: error:")]
+    assert len(errors) == 1 and "Traceback" not in result.stderr
+    assert "(start method 'spawn') cannot rebuild the scene: PluginError:" in errors[0]
+    assert "RuntimeError: imported in a worker" in errors[0]
+    assert not out.exists()
