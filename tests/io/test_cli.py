@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import select
 import signal
 import subprocess
@@ -206,8 +207,10 @@ def start_render(*args: str) -> subprocess.Popen:
 
 
 def some_paths_done(seen: str) -> bool:
-    """The progress bar shows that samples are finished."""
-    return "path" in seen and "0/" not in seen.rsplit("\r", 1)[-1]
+    """The progress bar shows at least 1% of the samples finished: more than the first
+    units, which may cover only the image's top row (black in the Cornell box)."""
+    done = re.findall(r"(\d+)%\|", seen.rsplit("\r", 1)[-1])
+    return "path" in seen and bool(done) and int(done[-1]) >= 1
 
 
 def wait_for_exit(pid: int, timeout: float = 60) -> bool:
