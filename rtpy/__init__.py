@@ -78,7 +78,7 @@ def render(
 
     Keyword overrides: any [render] setting (integrator, spp, max_depth, nee,
     russian_roulette, seed, gamma, mis), background, sky, the camera width, or a
-    whole `camera`. workers = number of processes (rtpy.renderer.available_cpus()
+    whole `camera`. workers = number of processes (rtpy.workers.available_cpus()
     is how many this process may use). progress=True shows a progress bar (a
     notebook's widget in Jupyter, else text on stderr); none by default; quiet is
     its negation (quiet=False shows it).

@@ -4,8 +4,6 @@ one loop that drives any backend."""
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -174,88 +172,12 @@ def test_pixel_sums_after_ctrl_c_add_the_units_that_wait_for_an_earlier_batch():
     np.testing.assert_array_equal(acc.counts, 2)
 
 
-# --- worker processes under every start method ---------------------------------------
-
-
-def test_workers_give_the_same_image_under_every_start_method(start_method):
-    scene, camera = small_scene()
-    one = rtpy.render(scene, camera=camera, spp=4, seed=3)
-    two = rtpy.render(scene, camera=camera, spp=4, seed=3, workers=2)
-    np.testing.assert_array_equal(one.linear, two.linear)
-
-
 def test_more_workers_than_units_start_no_idle_process(monkeypatch):
     """An image of one unit renders in this process whatever the worker count."""
     scene, camera = small_scene()
     monkeypatch.setattr("rtpy.renderer.run_on_workers", None)  # calling it would fail
     image = rtpy.render(scene, camera=camera.with_width(8), integrator="center", workers=4)
     assert image.samples_min == 1
-
-
-# A program run in its own interpreter with the start method forced: a worker that
-# cannot start must stop it at once with one message (a pool that restarts workers
-# would hang it until the timeout, which only ends such a child).
-WORKER_PROGRAM = """
-import multiprocessing, os, sys
-import rtpy
-from rtpy import Camera, Lambertian, Scene, Sphere, Vec3
-from rtpy.renderer import WorkerError
-
-class Exits(Lambertian):
-    def __reduce__(self):  # rebuilt in a worker, it ends the worker
-        return (os._exit, (3,))
-
-def local_material():
-    class Local(Lambertian):
-        pass
-    return Local()
-
-if __name__ == "__main__":
-    multiprocessing.set_start_method(sys.argv[1])
-    material = {"main": Lambertian, "exits": Exits, "local": local_material}[sys.argv[2]]()
-    if sys.argv[2] == "main":  # a class the parent has in __main__ and a worker does not
-        material.__class__ = type("NotInWorkers", (Lambertian,), {"__module__": "__main__"})
-        setattr(sys.modules["__main__"], "NotInWorkers", material.__class__)
-    scene = Scene([Sphere(Vec3(0, 0, -1), 0.5, material)])
-    camera = Camera(Vec3(0, 0, 0), Vec3(0, 0, -1), width=32)
-    try:
-        rtpy.render(scene, camera=camera, spp=2, workers=2)
-    except WorkerError as err:
-        print(err)
-        sys.exit(5)
-    print("rendered")
-"""
-
-
-def run_worker_program(tmp_path, method: str, case: str) -> subprocess.CompletedProcess:
-    program = tmp_path / "program.py"
-    program.write_text(WORKER_PROGRAM)
-    return subprocess.run(
-        [sys.executable, str(program), method, case], capture_output=True, text=True, timeout=120
-    )
-
-
-@pytest.mark.parametrize(
-    "case,reason",
-    [
-        ("main", "Can't get attribute 'NotInWorkers'"),
-        ("exits", "ended abruptly: it was killed, ran out of memory or failed while starting"),
-        ("local", "Can't pickle local object"),
-    ],
-)
-@pytest.mark.parametrize("method", ["spawn", "forkserver"])
-def test_a_scene_the_workers_cannot_rebuild_stops_with_one_message(tmp_path, method, case, reason):
-    result = run_worker_program(tmp_path, method, case)
-    assert result.returncode == 5, result.stdout + result.stderr
-    message = result.stdout.strip()
-    assert f"(start method '{method}')" in message
-    assert reason in message.splitlines()[0] and len(message.splitlines()) == 1
-    assert "--plugin FILE.py" in message and "one worker" in message
-
-
-def test_under_fork_workers_inherit_the_classes_of_main(tmp_path):
-    result = run_worker_program(tmp_path, "fork", "main")
-    assert result.returncode == 0 and result.stdout.strip() == "rendered", result.stderr
 
 
 # --- progress bar ---------------------------------------------------------------------

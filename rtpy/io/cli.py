@@ -14,7 +14,7 @@ import tomllib
 from pathlib import Path
 
 from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
-from ..renderer import WorkerError, available_cpus
+from ..workers import WorkerError, available_cpus
 from .image import OutputError, check_image_path, check_linear_path
 
 EXIT_WORKERS_FAILED = 1
