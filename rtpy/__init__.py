@@ -13,6 +13,8 @@ each name of the course's code is; docs/scene-format.md is the scene-file format
 
 from __future__ import annotations
 
+from importlib.metadata import PackageNotFoundError, version
+
 from .camera import Camera
 from .hit_info import HitInfo
 from .interval import Interval
@@ -34,6 +36,7 @@ from .materials import (
     register_material,
 )
 from .mesh import Mesh, SmoothTriangle, Transform
+from .plugins import load_plugin
 from .quad import Quad
 from .ray import Ray
 from .render_settings import SETTINGS, RenderSettings
@@ -45,7 +48,10 @@ from .texture import CheckerTexture, ImageTexture, SolidColor, Texture
 from .triangle import Triangle
 from .vec3 import Color, Point3, Vec3
 
-__version__ = "0.1.0"
+try:
+    __version__ = version("rtpy")  # pyproject.toml's version, as installed
+except PackageNotFoundError:  # a source tree that was never installed
+    __version__ = "0+unknown"
 
 
 def load_scene(path_or_name: str):
@@ -62,7 +68,8 @@ def render(
     camera: Camera | None = None,
     width: int | None = None,
     workers: int = 1,
-    quiet: bool = True,
+    progress: bool | None = None,
+    quiet: bool | None = None,
     background: Color | None = None,
     sky: bool | None = None,
     backend: str = "scalar",
@@ -72,7 +79,10 @@ def render(
 
     Keyword overrides: any [render] setting (integrator, spp, max_depth, nee,
     russian_roulette, seed, gamma, mis), background, sky, the camera width, or a
-    whole `camera`. workers = number of processes; quiet = no progress bar.
+    whole `camera`. workers = number of processes (rtpy.workers.available_cpus()
+    is how many this process may use). progress=True shows a progress bar (a
+    notebook's widget in Jupyter, else text on stderr); none by default; quiet is
+    its negation (quiet=False shows it).
     backend = "scalar" (the readable reference) or "numpy" (vectorized, many times
     faster; the same image up to Monte Carlo noise). A setting of the wrong type
     raises TypeError, one out of its range ValueError, naming the setting
@@ -80,6 +90,7 @@ def render(
     """
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {backend!r}")
+    show_progress = _show_progress(progress, quiet)
     base = scene.settings or RenderSettings()
     render_settings = base.with_overrides(**settings)
     camera = camera or scene.camera
@@ -96,9 +107,21 @@ def render(
         if sky is not None:
             scene.sky = SETTINGS["sky"].check(sky)
     renderer = Renderer(
-        scene, camera, render_settings, workers=workers, quiet=quiet, backend=backend
+        scene, camera, render_settings, workers=workers, quiet=not show_progress, backend=backend
     )
     return renderer.render()
+
+
+def _show_progress(progress: bool | None, quiet: bool | None) -> bool:
+    """render()'s progress and quiet (either, or both when they agree) -> show a bar."""
+    for name, value in (("progress", progress), ("quiet", quiet)):
+        if value is not None and not isinstance(value, bool):
+            raise TypeError(f"{name} must be True or False, got {value!r}")
+    if progress is not None and quiet is not None and progress == quiet:
+        raise ValueError(f"progress={progress} contradicts quiet={quiet}: pass one of them")
+    if progress is not None:
+        return progress
+    return quiet is False
 
 
 __all__ = [
@@ -142,6 +165,7 @@ __all__ = [
     "RenderSettings",
     "Renderer",
     "RenderedImage",
+    "load_plugin",
     "load_scene",
     "render",
 ]

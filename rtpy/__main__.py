@@ -4,4 +4,4 @@ import sys
 
 from .io.cli import main
 
-sys.exit(main())
+sys.exit(main(prog="python -m rtpy"))

@@ -3,7 +3,8 @@
 One loop (Renderer) serves both backends: a Backend plans the units of work and
 renders one unit (ScalarBackend here, ray by ray; the numpy backend's in
 rtpy/numpy_backend/renderer.py, a whole unit as arrays), and the loop runs the
-units on worker processes, shows progress, handles Ctrl-C and assembles the image.
+units on worker processes (rtpy.workers), shows progress, handles Ctrl-C and assembles
+the image.
 
 The image is cut into regions (square tiles for the scalar backend, bands of rows
 sized by the number of paths for the numpy backend) and the samples of each pixel
@@ -17,8 +18,6 @@ any number of worker processes.
 from __future__ import annotations
 
 import math
-import multiprocessing
-import signal
 import sys
 import time
 from collections.abc import Callable
@@ -26,7 +25,7 @@ from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
-from tqdm import tqdm
+from tqdm.auto import tqdm  # a notebook widget in Jupyter, else text
 
 from .camera import Camera
 from .integrators import make_integrator
@@ -35,6 +34,7 @@ from .render_settings import BACKENDS, RenderSettings
 from .sampling import make_generator, use_generator
 from .scene import Scene
 from .testing.statistics import peak_memory_mb
+from .workers import run_on_workers
 
 TILE_SIZE = 16
 MAX_BATCHES = 8  # samples per pixel are split into at most this many batches
@@ -261,20 +261,6 @@ def make_backend(name: str, scene: Scene, camera: Camera, settings: RenderSettin
     raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {name!r}")
 
 
-# --- worker processes -------------------------------------------------------
-_render_one: Callable[[Unit], np.ndarray] | None = None
-
-
-def _init_worker(backend: Backend) -> None:
-    global _render_one
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
-    _render_one = backend.start()
-
-
-def _run_unit(unit: Unit) -> tuple[Unit, np.ndarray]:
-    return unit, _render_one(unit)
-
-
 class Renderer:
     """Renders a scene with a camera and settings.
 
@@ -334,20 +320,13 @@ class Renderer:
         return self._assemble(results, spp, interrupted, seconds)
 
     def _run(self, units: list[Unit]):
-        if self.workers == 1:
-            render_one = self.backend.start()
-            for unit in units:
-                yield unit, render_one(unit)
+        workers = min(self.workers, len(units))
+        if workers > 1:
+            yield from run_on_workers(self.backend, units, workers)
             return
-        pool = multiprocessing.get_context().Pool(self.workers, _init_worker, (self.backend,))
-        try:
-            yield from pool.imap_unordered(_run_unit, units, chunksize=1)
-            pool.close()
-        except BaseException:
-            pool.terminate()  # stop the workers at once on Ctrl-C or an error
-            raise
-        finally:
-            pool.join()
+        render_one = self.backend.start()
+        for unit in units:
+            yield unit, render_one(unit)
 
     def _assemble(self, results: PixelSums, spp, interrupted, seconds) -> RenderedImage:
         results.finish()

@@ -12,6 +12,7 @@ every one has).
 """
 
 import importlib
+import multiprocessing
 import os
 import pkgutil
 
@@ -34,3 +35,16 @@ for module in pkgutil.walk_packages(rtpy.__path__, "rtpy."):
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     record_fast_tests(config, items)
+
+
+START_METHODS = ["fork", "spawn", "forkserver"]
+
+
+@pytest.fixture(params=START_METHODS)
+def start_method(request):
+    """The default start method forced to each one (Windows and macOS start workers
+    by spawn, Linux by fork, and by forkserver from Python 3.14)."""
+    before = multiprocessing.get_start_method(allow_none=True)
+    multiprocessing.set_start_method(request.param, force=True)
+    yield request.param
+    multiprocessing.set_start_method(before, force=True)

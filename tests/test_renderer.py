@@ -3,6 +3,8 @@ one loop that drives any backend."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -168,3 +170,45 @@ def test_pixel_sums_after_ctrl_c_add_the_units_that_wait_for_an_earlier_batch():
     acc.finish()
     np.testing.assert_array_equal(acc.total, 5.0)
     np.testing.assert_array_equal(acc.counts, 2)
+
+
+def test_more_workers_than_units_start_no_idle_process(monkeypatch):
+    """An image of one unit renders in this process whatever the worker count."""
+    scene, camera = small_scene()
+    monkeypatch.setattr("rtpy.renderer.run_on_workers", None)  # calling it would fail
+    image = rtpy.render(scene, camera=camera.with_width(8), integrator="center", workers=4)
+    assert image.samples_min == 1
+
+
+# --- progress bar ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "options,shown",
+    [({}, False), ({"progress": True}, True), ({"quiet": False}, True), ({"quiet": True}, False)],
+)
+def test_progress_bar_only_when_asked_for(capsys, options, shown):
+    scene, camera = small_scene()
+    rtpy.render(scene, camera=camera.with_width(8), integrator="center", **options)
+    err = capsys.readouterr().err
+    assert ("path" in err) == shown, err
+
+
+def test_the_bar_is_tqdms_notebook_aware_one():
+    import tqdm.auto
+
+    assert rtpy.renderer.tqdm is tqdm.auto.tqdm
+
+
+@pytest.mark.parametrize(
+    "options,error,message",
+    [
+        ({"progress": "yes"}, TypeError, "progress must be True or False, got 'yes'"),
+        ({"quiet": 0}, TypeError, "quiet must be True or False, got 0"),
+        ({"progress": True, "quiet": True}, ValueError, "progress=True contradicts quiet=True"),
+    ],
+)
+def test_bad_progress_options_are_refused(options, error, message):
+    scene, camera = small_scene()
+    with pytest.raises(error, match=re.escape(message)):
+        rtpy.render(scene, camera=camera, **options)

@@ -145,8 +145,10 @@ def command_bench(args: argparse.Namespace) -> int:
         print(format_table(result))
         print()
         print(format_series(result))
+        if args.quick:
+            log("rtpy bench: --quick renders take milliseconds: its timings are not meaningful")
     files = write_outputs(result, Path(args.out))
-    png = plot(result, Path(args.out))
+    png = plot(result, Path(args.out), quick=args.quick)
     if png is None:
         log("rtpy bench: matplotlib is not installed, so no plot (pip install 'rtpy[plot]')")
     else:

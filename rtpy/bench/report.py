@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import textwrap
 from dataclasses import asdict
 from pathlib import Path
 
@@ -133,17 +134,59 @@ def write_outputs(result: BenchResult, out: Path) -> list[Path]:
     return [csv_path, json_path]
 
 
-def plot(result: BenchResult, out: Path) -> Path | None:
-    """bench.png: relMSE against time per render and against spp, log-log, one row
-    per scene (levels with no error left out); None when matplotlib is not
-    installed or there is nothing to draw."""
-    try:
-        import matplotlib
+def _other_reference(integrator: str) -> bool:
+    """The variant estimates another image than full paths (direct: depth 2)."""
+    return VARIANTS[integrator]["integrator"] == "direct"
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return None
+
+def rel_mse_se(level: Level) -> float:
+    """The standard error of a level's relMSE (relMSE is MSE times a constant)."""
+    return level.rel_mse * level.mse_se / level.mse if level.mse > 0 else math.nan
+
+
+def plot_notes(result: BenchResult, quick: bool = False) -> list[str]:
+    """What the plot's reader must know: what the error bars are, which series and
+    levels are not drawn and why, the variants measured against another reference,
+    and, after --quick, that its timings mean nothing."""
+    notes = ["Error bars: relMSE ± 1 standard error (from the spread of the squared errors)."]
+    exact = [
+        f"{f.scene}/{f.integrator} ({f.backend})"
+        for f in result.fits
+        if all(lv.exact for lv in _series(result, f))
+    ]
+    if exact:
+        notes.append(
+            "Not drawn, exact (no error above rounding, nothing to put on a log axis): "
+            + ", ".join(exact)
+            + "."
+        )
+    below = [lv for lv in result.levels if not lv.exact and not lv.rel_mse > 0]
+    if below:
+        notes.append(
+            f"Not drawn: {len(below)} level(s) whose MSE estimate is not above zero "
+            "(within the reference's own noise)."
+        )
+    other = sorted({lv.integrator for lv in result.levels if _other_reference(lv.integrator)})
+    if other:
+        notes.append(
+            f"Hollow markers, dash-dot lines: {', '.join(other)} estimates one bounce and "
+            "is measured against the depth-2 reference, not the full paths' one; its "
+            "error is not comparable with the other series'."
+        )
+    if quick:
+        notes.append(
+            "--quick: each render takes milliseconds, so the timings (left column) are "
+            "overheads and noise and mean nothing; run without --quick to compare times."
+        )
+    return notes
+
+
+def draw(result: BenchResult, quick: bool = False):
+    """The bench figure (a matplotlib Figure), None when there is nothing to draw:
+    relMSE with its error bars against time per render and against spp, log-log,
+    one row per scene with drawn levels, and plot_notes() under it."""
+    import matplotlib.pyplot as plt
+
     drawn = [lv for lv in result.levels if lv.rel_mse > 0 and not lv.exact]
     scenes = list(dict.fromkeys(lv.scene for lv in drawn))  # exact scenes: nothing to draw
     if not scenes:
@@ -157,31 +200,54 @@ def plot(result: BenchResult, out: Path) -> Path | None:
             if lv.scene == scene:
                 series.setdefault((lv.backend, lv.integrator), []).append(lv)
         for (backend, integrator), lvs in series.items():
-            label = f"{integrator} ({backend})"
+            other = _other_reference(integrator)
+            color = f"C{list(VARIANTS).index(integrator) % 10}"
             style = {
-                "ls": "-" if backend == "numpy" else "--",
-                "color": f"C{list(VARIANTS).index(integrator) % 10}",
+                "ls": "-." if other else ("-" if backend == "numpy" else "--"),
+                "color": color,
                 "marker": "o" if backend == "numpy" else "s",
-                "ms": 3,
-                "label": label,
+                "mfc": "none" if other else color,
+                "ms": 4,
+                "capsize": 2,
+                "label": f"{integrator} ({backend})" + (", depth-2 reference" if other else ""),
             }
-            t = [lv.seconds for lv in lvs]
             e = [lv.rel_mse for lv in lvs]
-            axes[row, 0].loglog(t, e, **style)
-            axes[row, 1].loglog([lv.spp for lv in lvs], e, **style)
+            se = [rel_mse_se(lv) for lv in lvs]
+            axes[row, 0].errorbar([lv.seconds for lv in lvs], e, yerr=se, **style)
+            axes[row, 1].errorbar([lv.spp for lv in lvs], e, yerr=se, **style)
         axes[row, 0].set_ylabel(f"{scene}\nrelative MSE")
-        axes[row, 0].set_xlabel("seconds per render")
+        seconds = "seconds per render" + (" (--quick: not meaningful)" if quick else "")
+        axes[row, 0].set_xlabel(seconds)
         axes[row, 1].set_xlabel("samples per pixel")
-        if series:
-            s = np.array(sorted({lv.spp for lvs in series.values() for lv in lvs}), float)
-            e0 = max(lvs[0].rel_mse for lvs in series.values())
-            axes[row, 1].loglog(s, e0 * s[0] / s, ":", color="gray", label="slope -1")
-            axes[row, 1].legend(fontsize=7)
+        s = np.array(sorted({lv.spp for lvs in series.values() for lv in lvs}), float)
+        e0 = max(lvs[0].rel_mse for lvs in series.values())
+        axes[row, 1].plot(s, e0 * s[0] / s, ":", color="gray", label="slope -1")
+        axes[row, 1].legend(fontsize=7)
         for ax in axes[row]:
+            ax.set_xscale("log")
+            ax.set_yscale("log")
             ax.grid(True, which="both", alpha=0.3)
+    notes = "\n".join(textwrap.fill(note, 150) for note in plot_notes(result, quick))
+    fig.text(0.01, 0, notes, ha="left", va="top", fontsize=8)
+    return fig
+
+
+def plot(result: BenchResult, out: Path, quick: bool = False) -> Path | None:
+    """bench.png, the figure of draw(); None when matplotlib is not installed or
+    there is nothing to draw."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return None
+    fig = draw(result, quick)
+    if fig is None:
+        return None
     path = out / "bench.png"
     tmp = out / ".bench.png.tmp"
-    fig.savefig(tmp, dpi=80, format="png")
+    fig.savefig(tmp, dpi=80, format="png", bbox_inches="tight")  # the notes below included
     plt.close(fig)
     tmp.replace(path)
     return path

@@ -1,7 +1,8 @@
 """Command line: `python -m rtpy render SCENE ...` and `python -m rtpy scenes`.
 
-Exit status: 0 done, 2 bad input (scene file, option or output path; nothing is
-written), 130 interrupted by Ctrl-C (what was finished is written first).
+Exit status: 0 done, 1 the worker processes failed (nothing is written), 2 bad input
+(scene file, option or output path; nothing is written), 130 interrupted by Ctrl-C
+(what was finished is written first).
 """
 
 from __future__ import annotations
@@ -13,8 +14,10 @@ import tomllib
 from pathlib import Path
 
 from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
+from ..workers import WorkerError, available_cpus
 from .image import OutputError, check_image_path, check_linear_path
 
+EXIT_WORKERS_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
 
@@ -49,10 +52,17 @@ def add_setting_options(r: argparse.ArgumentParser) -> None:
     )
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(prog: str = "rtpy") -> argparse.ArgumentParser:
+    """The command line's parser; `prog` is the program as it was run (usage lines and
+    argparse's errors name it)."""
+    from .. import __version__
+
     parser = argparse.ArgumentParser(
-        prog="python -m rtpy", description="rtpy: a teaching ray tracer in Python."
+        prog=prog,
+        description="rtpy: a teaching ray tracer in Python.",
+        epilog=f"'{prog} COMMAND --help' shows a command's options.",
     )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     r = sub.add_parser(
@@ -73,11 +83,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="also write the linear float image: .npy, .pfm or .exr (never gamma-encoded)",
     )
     add_setting_options(r)
+    cpus = min(available_cpus(), MAX_WORKERS)
     r.add_argument(
+        "-j",
         "--workers",
         type=worker_count,
-        default=1,
-        help=f"processes (default 1, at most {MAX_WORKERS})",
+        default=cpus,
+        metavar="N",
+        help=f"processes (default {cpus}: the CPUs this process may use; at most {MAX_WORKERS})",
     )
     r.add_argument(
         "--backend",
@@ -85,7 +98,7 @@ def build_parser() -> argparse.ArgumentParser:
         default="scalar",
         help="scalar: the readable reference (default); numpy: vectorized, many times faster",
     )
-    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     r.add_argument(
         "--plugin",
         action="append",
@@ -148,20 +161,14 @@ def command_grade(week: str, json_path: str | None) -> int:
 
 
 def load_plugins(paths: list[str]) -> None:
-    """Import each file as a module (its @register_material classes become scene types)."""
-    import importlib.util
+    """Import each file (its @register_material classes become scene types)."""
+    from ..plugins import PluginError, load_plugin
 
-    for i, name in enumerate(paths):
-        path = Path(name)
-        if path.suffix != ".py" or not path.is_file():
-            raise UsageError(f"--plugin {name}: not a .py file")
-        spec = importlib.util.spec_from_file_location(f"rtpy_plugin_{i}_{path.stem}", path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[spec.name] = module
+    for path in paths:
         try:
-            spec.loader.exec_module(module)
-        except Exception as err:
-            raise UsageError(f"--plugin {name}: {type(err).__name__}: {err}") from err
+            load_plugin(path)
+        except PluginError as err:
+            raise UsageError(f"--plugin {err}") from None
 
 
 class UsageError(Exception):
@@ -281,7 +288,13 @@ def _render(args: argparse.Namespace) -> int:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
 
-    image = render(scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides)
+    try:
+        image = render(
+            scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides
+        )
+    except WorkerError as err:
+        print(f"rtpy: error: {err}", file=sys.stderr)
+        return EXIT_WORKERS_FAILED
     if image.interrupted:
         print(
             "rtpy: interrupted: writing the samples finished so far "
@@ -312,8 +325,15 @@ def _render(args: argparse.Namespace) -> int:
     return 0
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)  # usage errors exit with status 2
+def main(argv: list[str] | None = None, prog: str = "rtpy") -> int:
+    """Run the command line `argv` (default sys.argv[1:]); `prog` names the program in
+    usage lines and errors (`python -m rtpy` passes its own). Returns the exit status."""
+    parser = build_parser(prog)
+    argv = sys.argv[1:] if argv is None else argv
+    if not argv:
+        parser.print_help()
+        return 0
+    args = parser.parse_args(argv)  # usage errors exit with status 2
     if args.command == "scenes":
         return command_scenes()
     if args.command == "bench":

@@ -17,12 +17,14 @@ from rtpy.bench.machine import machine
 from rtpy.bench.report import (
     GENERATED_BEGIN,
     GENERATED_END,
+    draw,
     findings,
     format_doc_section,
     format_efficiency,
     format_series,
     format_table,
     machine_lines,
+    plot_notes,
     replace_generated,
     write_outputs,
 )
@@ -203,3 +205,59 @@ def test_direct_estimates_another_image_and_is_not_ranked(result):
     direct = replace(direct, levels=[as_direct(lv) for lv in good.levels])
     row = format_efficiency(direct).splitlines()[2]
     assert "path-brdf 1" in row and "direct" not in row
+
+
+def as_direct(result: BenchResult) -> BenchResult:
+    """The result with its path-mis series relabelled direct (measured against the
+    depth-2 reference)."""
+
+    def relabel(x):
+        return replace(x, integrator="direct") if x.integrator == "path-mis" else x
+
+    return replace(
+        result, fits=[relabel(f) for f in result.fits], levels=[relabel(lv) for lv in result.levels]
+    )
+
+
+def test_plot_notes_name_the_exact_series_left_out_and_why(result):
+    notes = plot_notes(result)
+    assert notes[0].startswith("Error bars: relMSE ± 1 standard error")
+    (left_out,) = [n for n in notes if n.startswith("Not drawn, exact")]
+    for backend in ("numpy", "scalar"):
+        for variant in ("path-brdf", "path-mis"):
+            assert f"furnace/{variant} ({backend})" in left_out
+    assert "plane_point_light" not in left_out
+    assert not any("depth-2" in n or "--quick" in n for n in notes)
+
+
+def test_plot_notes_mark_direct_and_quick(result):
+    notes = plot_notes(as_direct(result), quick=True)
+    assert any(n.startswith("Hollow markers") and "direct" in n and "depth-2" in n for n in notes)
+    assert notes[-1].startswith("--quick:") and "mean nothing" in notes[-1]
+
+
+def test_the_plot_draws_the_measured_standard_errors_and_its_notes(result):
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    fig = draw(as_direct(result), quick=True)
+    noisy = [lv for lv in result.levels if lv.scene == "plane_point_light"]
+    (time_axis, spp_axis) = fig.axes[:2]  # one row: the exact furnace is not drawn
+    assert len(fig.axes) == 2 and "not meaningful" in time_axis.get_xlabel()
+    bars = {}
+    for container in spp_axis.containers:
+        (segments,) = container.lines[2]  # the vertical bars
+        for (x, low), (_, high) in segments.get_segments():
+            bars[container.get_label(), x] = (low, high)
+    for lv in noisy:
+        label = f"{lv.integrator if lv.integrator != 'path-mis' else 'direct'} ({lv.backend})"
+        label += ", depth-2 reference" if label.startswith("direct") else ""
+        low, high = bars[label, lv.spp]
+        se = lv.mse_se * lv.rel_mse / lv.mse  # relMSE is MSE over the reference's mean square
+        assert se > 0 and math.isclose(low, lv.rel_mse - se) and math.isclose(high, lv.rel_mse + se)
+    (note,) = fig.texts
+    assert "furnace/path-brdf (numpy)" in note.get_text()
+    assert "--quick" in note.get_text()
+    styles = {c.get_label(): c.lines[0].get_linestyle() for c in spp_axis.containers}
+    assert all((s == "-.") == ("depth-2" in label) for label, s in styles.items())

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import os
+import re
 import select
 import signal
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +16,7 @@ from PIL import Image
 
 import rtpy
 from rtpy.io.bundled import bundled_scenes
-from rtpy.io.cli import main
+from rtpy.io.cli import MAX_WORKERS, build_parser, main
 from rtpy.io.image import read_pfm
 from rtpy.materials import MATERIALS
 
@@ -205,8 +207,10 @@ def start_render(*args: str) -> subprocess.Popen:
 
 
 def some_paths_done(seen: str) -> bool:
-    """The progress bar shows that samples are finished."""
-    return "path" in seen and "0/" not in seen.rsplit("\r", 1)[-1]
+    """The progress bar shows at least 1% of the samples finished: more than the first
+    units, which may cover only the image's top row (black in the Cornell box)."""
+    done = re.findall(r"(\d+)%\|", seen.rsplit("\r", 1)[-1])
+    return "path" in seen and bool(done) and int(done[-1]) >= 1
 
 
 def wait_for_exit(pid: int, timeout: float = 60) -> bool:
@@ -395,3 +399,109 @@ def test_mesh_scene_with_a_malformed_obj_exits_2_naming_file_table_key_and_line(
     (line,) = result.stderr.splitlines()
     assert line.startswith(f"rtpy: error: {scene}: [[objects]] #1 path: ")
     assert "m.obj line 3: expected 3 to 4 numbers after 'v'" in line
+
+
+def render_under(method: str, *args: str) -> subprocess.CompletedProcess:
+    """`python -m rtpy render ARGS` in a child whose start method is forced to `method`
+    (what `python -m rtpy` does, after multiprocessing.set_start_method)."""
+    code = (
+        "import multiprocessing, sys\n"
+        f"multiprocessing.set_start_method({method!r})\n"
+        "from rtpy.io.cli import main\n"
+        "sys.exit(main(sys.argv[1:], prog='python -m rtpy'))\n"
+    )
+    return subprocess.run(
+        [sys.executable, "-c", code, "render", *args], capture_output=True, text=True, timeout=120
+    )
+
+
+def test_a_plugin_render_on_two_workers_is_the_same_under_every_start_method(tmp_path):
+    """With its material from --plugin, a render on two workers started by spawn or
+    forkserver (the defaults of Windows, macOS and Python 3.14) finishes with the
+    image fork gives: the workers import the plugin under the parent's name."""
+    (tmp_path / "plug.py").write_text(
+        "from rtpy.materials import Lambertian, register_material\n"
+        "from rtpy.vec3 import Color\n\n"
+        '@register_material("tinted")\n'
+        "class Tinted(Lambertian):\n"
+        "    def __init__(self, level: float = 0.5):\n"
+        "        super().__init__(Color(level, 0.5 * level, 0.25))\n"
+    )
+    (tmp_path / "scene.toml").write_text(
+        '[render]\nintegrator = "path"\nspp = 4\nsky = true\n'
+        '[materials.m]\ntype = "tinted"\nlevel = 0.8\n'
+        '[[objects]]\ntype = "sphere"\ncenter = [0, 0, -1]\nradius = 0.5\nmaterial = "m"\n'
+    )
+    images = {}
+    for method in ["fork", "spawn", "forkserver"]:
+        out = tmp_path / f"{method}.npy"
+        result = render_under(
+            method, str(tmp_path / "scene.toml"), "--plugin", str(tmp_path / "plug.py"),
+            "--workers", "2", "--width", "24", "-q", "-o", str(tmp_path / "o.png"),
+            "--linear", str(out),
+        )  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        images[method] = np.load(out)
+    assert images["fork"].max() > 0
+    np.testing.assert_array_equal(images["spawn"], images["fork"])
+    np.testing.assert_array_equal(images["forkserver"], images["fork"])
+
+
+def test_no_command_prints_the_full_help_naming_the_program_as_run():
+    result = run_cli()
+    assert result.returncode == 0 and result.stderr == ""
+    assert result.stdout.startswith("usage: python -m rtpy ")
+    for command in ["render", "scenes", "bench", "assignment", "grade"]:
+        assert f"    {command} " in result.stdout or f"    {command}\n" in result.stdout
+    assert "'python -m rtpy COMMAND --help'" in result.stdout
+
+
+def test_errors_name_the_program_as_run(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["render"], prog="rtpy")
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("usage: rtpy render ") and "rtpy render: error:" in err
+    result = run_cli("render")
+    assert result.returncode == 2 and "python -m rtpy render: error:" in result.stderr
+
+
+def test_version_is_the_installed_package_version(capsys):
+    from importlib.metadata import version
+
+    result = run_cli("--version")
+    assert result.returncode == 0 and result.stdout.strip() == f"python -m rtpy {version('rtpy')}"
+    assert rtpy.__version__ == version("rtpy")
+
+
+def test_short_options_and_the_default_worker_count(monkeypatch):
+    """-j N and -q are --workers N and --quiet; without them the workers are the CPUs
+    this process may use."""
+    monkeypatch.setattr("rtpy.io.cli.available_cpus", lambda: 3)
+    args = build_parser().parse_args(["render", "cornell"])
+    assert args.workers == 3 and not args.quiet
+    args = build_parser().parse_args(["render", "cornell", "-j", "2", "-q"])
+    assert args.workers == 2 and args.quiet
+    monkeypatch.setattr("rtpy.io.cli.available_cpus", lambda: 10_000)
+    assert build_parser().parse_args(["render", "cornell"]).workers == MAX_WORKERS
+
+
+def test_workers_that_cannot_start_stop_the_render_with_one_error(tmp_path):
+    """A plugin that refuses to run in a worker process: under spawn the render stops
+    at once with one `rtpy: error:` line and status 1, writing nothing."""
+    (tmp_path / "parent_only.py").write_text(
+        "import multiprocessing\n"
+        "if multiprocessing.parent_process() is not None:\n"
+        "    raise RuntimeError('imported in a worker')\n"
+    )
+    out = tmp_path / "o.png"
+    result = render_under(
+        "spawn", "week08_three_balls", "--plugin", str(tmp_path / "parent_only.py"),
+        "-j", "2", "--width", "48", "--spp", "1", "-q", "-o", str(out),
+    )  # fmt: skip
+    assert result.returncode == 1, result.stderr
+    errors = [line for line in result.stderr.splitlines() if line.startswith("rtpy: error:")]
+    assert len(errors) == 1 and "Traceback" not in result.stderr
+    assert "(start method 'spawn') cannot rebuild the scene: PluginError:" in errors[0]
+    assert "RuntimeError: imported in a worker" in errors[0]
+    assert not out.exists()

@@ -44,6 +44,14 @@ def test_same_seed_same_image_for_any_worker_count():
     assert not np.array_equal(one.linear, rtpy.render(scene, **kw).linear)
 
 
+def test_workers_give_the_same_image_under_every_start_method(start_method):
+    """Worker processes started by fork, spawn or forkserver rebuild the numpy backend."""
+    scene, camera = small_scene()
+    kw = dict(camera=camera.with_width(70), spp=8, seed=3, backend="numpy")
+    one = rtpy.render(scene, **kw)
+    np.testing.assert_array_equal(one.linear, rtpy.render(scene, workers=2, **kw).linear)
+
+
 def test_render_reports_samples_speed_and_memory():
     scene, camera = small_scene()
     image = rtpy.render(scene, camera=camera, spp=3, backend="numpy")

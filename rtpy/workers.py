@@ -1,0 +1,132 @@
+"""Worker processes: the units of a render on other processes, under every start
+method.
+
+A worker process receives the backend (the scene, camera and settings) once, when
+it starts. Under the `fork` start method it inherits the object; under `spawn` and
+`forkserver` (the defaults on Windows and macOS, and on Linux from Python 3.14) it
+receives the pickled bytes and rebuilds the backend after loading the plugins the
+parent loaded (rtpy.plugins), since the scene's material classes may live in them.
+A worker that cannot rebuild it reports why with every unit it is given, so the
+render stops at once with one message rather than a pool restarting workers forever.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import pickle
+import signal
+import sys
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .plugins import PLUGINS, load_listed_plugins
+
+if TYPE_CHECKING:
+    from .renderer import Backend, Unit
+
+_render_one: Callable[[Unit], np.ndarray] | None = None
+_start_error = ""
+# Windows waits on at most 63 handles at once; ProcessPoolExecutor refuses more than
+# 61 workers there.
+WINDOWS_MAX_WORKERS = 61
+
+
+def available_cpus() -> int:
+    """The number of CPUs this process may run on (its affinity mask or, on Python
+    3.13+, also its -X cpu_count limit), the machine's count where the system does
+    not say, and 1 where nothing does."""
+    count = getattr(os, "process_cpu_count", None)  # Python 3.13+
+    if count is not None:
+        return count() or 1
+    if hasattr(os, "sched_getaffinity"):  # Linux and some other Unix systems
+        return len(os.sched_getaffinity(0)) or 1
+    return os.cpu_count() or 1
+
+
+class WorkerError(RuntimeError):
+    """The worker processes cannot rebuild the render (a class the scene uses cannot
+    be imported by a process started by spawn or forkserver), or one ended abruptly."""
+
+
+START_ADVICE = (
+    "Every class a scene uses must be importable by its module's name: define it in a "
+    ".py file and import it (or load the file with rtpy.load_plugin, --plugin FILE.py "
+    'on the command line), keep a script\'s rendering under `if __name__ == "__main__":`, '
+    "or render with one worker."
+)
+
+
+def cannot_rebuild(reason: str, method: str) -> WorkerError:
+    """The error saying why workers started by `method` cannot rebuild the scene."""
+    return WorkerError(
+        f"the worker processes (start method {method!r}) cannot rebuild the scene: "
+        f"{reason}. {START_ADVICE}"
+    )
+
+
+def _init_worker(plugins: dict[str, str], backend: Backend | bytes) -> None:
+    global _render_one, _start_error
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
+    try:
+        load_listed_plugins(plugins)
+        if isinstance(backend, bytes):
+            backend = pickle.loads(backend)
+        _render_one = backend.start()
+    except Exception as err:
+        _start_error = f"{type(err).__name__}: {err}"
+
+
+def _run_unit(unit: Unit) -> tuple[Unit, np.ndarray]:
+    if _render_one is None:
+        raise WorkerError(_start_error)
+    return unit, _render_one(unit)
+
+
+def _stop_workers(executor: ProcessPoolExecutor) -> None:
+    """End the executor's worker processes now, in the middle of their units."""
+    terminate = getattr(executor, "terminate_workers", None)  # Python 3.14+
+    if terminate is not None:
+        terminate()
+        return
+    # Python 3.11-3.13 have no public way: the executor's own table of its processes
+    for process in list(executor._processes.values()):
+        process.terminate()
+
+
+def run_on_workers(backend: Backend, units: list[Unit], workers: int):
+    """Yield (unit, sums) for every unit as worker processes finish them, in the order
+    they finish; the processes start by the default start method
+    (multiprocessing.get_context()). Raises WorkerError if they cannot start or one
+    ends abruptly."""
+    context = multiprocessing.get_context()
+    method = context.get_start_method()
+    try:
+        payload = backend if method == "fork" else pickle.dumps(backend)
+    except (pickle.PicklingError, AttributeError, TypeError) as err:  # a local class
+        raise cannot_rebuild(f"{type(err).__name__}: {err}", method) from None
+    if sys.platform == "win32":
+        workers = min(workers, WINDOWS_MAX_WORKERS)
+    executor = ProcessPoolExecutor(
+        workers, mp_context=context, initializer=_init_worker, initargs=(dict(PLUGINS), payload)
+    )
+    try:
+        for future in as_completed([executor.submit(_run_unit, unit) for unit in units]):
+            yield future.result()
+    except WorkerError as err:
+        _stop_workers(executor)
+        raise cannot_rebuild(str(err), method) from None
+    except BrokenProcessPool:
+        raise WorkerError(
+            f"a worker process (start method {method!r}) ended abruptly: it was killed, "
+            f"ran out of memory or failed while starting (its error is above). {START_ADVICE}"
+        ) from None
+    except BaseException:
+        _stop_workers(executor)  # at once on Ctrl-C or an error
+        raise
+    finally:
+        executor.shutdown(wait=True, cancel_futures=True)
