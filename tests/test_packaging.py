@@ -86,7 +86,10 @@ def test_the_wheel_holds_the_rtpy_package_alone_with_its_type_marker():
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())
     setuptools = config["tool"]["setuptools"]
     assert all(p == "rtpy" or p.startswith("rtpy.") for p in setuptools["packages"])
-    assert setuptools["package-data"] == {"rtpy": ["py.typed"], "rtpy.scenes": ["*.toml", "*.png"]}
+    assert setuptools["package-data"] == {
+        "rtpy": ["py.typed"],
+        "rtpy.scenes": ["*.toml", "*.png", "*.obj"],
+    }
     assert (ROOT / "rtpy" / "py.typed").is_file()
     assert "Typing :: Typed" in config["project"]["classifiers"]
 
