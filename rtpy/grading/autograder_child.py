@@ -151,7 +151,9 @@ def checked(function, label: str, classes: dict[str, type]):
                     f"{label} returned None, expected {wanted}: is a `return` missing?"
                 )
         elif allowed and not isinstance(result, allowed):
-            raise TaskReturnError(f"{label} returned a {type(result).__name__}, expected {wanted}")
+            raise TaskReturnError(
+                f"{label} returned a value of type {type(result).__name__}, expected {wanted}"
+            )
         return result
 
     return task

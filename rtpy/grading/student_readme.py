@@ -17,7 +17,7 @@ import re
 QUICK_RENDER = "--width 160 --spp 8 --workers 2"
 QUICK_SECONDS = "5 to 10 seconds"
 FULL_RENDER = "--width 480 --spp 128 --max-depth 5 --workers 2"
-FULL_MINUTES = "FULL_MINUTES"
+FULL_MINUTES = "about 10 minutes"
 
 
 def workflow_section(week: str, task_files: list[str], left_out: list[str]) -> str:
