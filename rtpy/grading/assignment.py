@@ -66,6 +66,7 @@ MACHINERY_TESTS = (
     "tests/grading/test_graders.py",
     "tests/grading/test_assignment.py",
     "tests/grading/test_autograder.py",
+    "tests/grading/test_autograder_answers.py",
     "tests/grading/test_autograder_child.py",
     "tests/grading/test_autograder_run.py",
     "tests/grading/test_autograder_seed.py",

@@ -75,6 +75,7 @@ class Run:
     notes: list[str] = field(default_factory=list)  # for the student, above the tests
     collection_errors: list[str] = field(default_factory=list)
     log: list[str] = field(default_factory=list)  # for the instructor (stdout)
+    seed: str = ""  # the grading seed of this run
     written: float = 0.0  # when results.json was last written
 
     def save(self) -> None:
@@ -192,8 +193,8 @@ def run_tests(run: Run) -> None:
     config_path = run.scratch / CONFIG_FILE
     config_path.write_text(json.dumps(run.config), encoding="utf-8")
     env = child_environment(run.work)
-    env[SEED_VARIABLE] = str(secrets.randbits(63))
-    run.log.append(f"grading seed {env[SEED_VARIABLE]}")
+    run.seed = env[SEED_VARIABLE] = str(secrets.randbits(63))
+    run.log.append(f"grading seed {run.seed}")
     remaining = [t["nodeid"] for t in run.config["tests"]]
     attempt = 0
     while remaining and time.monotonic() < run.deadline:
@@ -365,7 +366,7 @@ def results_of(run: Run, partial: bool = False) -> dict:
         "visibility": "visible",
         "stdout_visibility": "hidden",
         "tests": tests,
-        "extra_data": {"week": run.config["week"], "partial": partial},
+        "extra_data": {"week": run.config["week"], "seed": run.seed, "partial": partial},
     }
 
 

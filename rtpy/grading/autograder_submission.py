@@ -179,7 +179,8 @@ def compile_errors(work: Path, files: list[str]) -> dict[str, str]:
         try:
             compile(text, rel, "exec", dont_inherit=True)
         except SyntaxError as err:
-            line = (err.text or "").strip()
+            lines = text.splitlines()
+            line = lines[err.lineno - 1].strip() if err.lineno and err.lineno <= len(lines) else ""
             shown = f": {line}" if line else ""
             errors[rel] = f"line {err.lineno}: SyntaxError: {err.msg}{shown}"
         except ValueError as err:  # a NUL byte
