@@ -43,7 +43,9 @@ LEFT_OUT = ("tests", "docs")  # parts of the student repository grading does not
 
 SETUP_SH = """#!/usr/bin/env bash
 # Gradescope runs this once, as root, when it builds the autograder's image. Written
-# for Gradescope's Ubuntu 22.04 base image, whose python3 is 3.10: rtpy needs 3.11.
+# for Gradescope's Ubuntu 22.04 base image, whose python3 is 3.10 while rtpy needs 3.11:
+# apt-get installs python3.11 from Ubuntu's archive when there is no Python >= 3.11
+# (and a venv module when it lacks one); everything else comes from pip.
 set -euo pipefail
 ROOT="${AUTOGRADER_ROOT:-/autograder}"
 PY=""
@@ -59,7 +61,13 @@ if [ -z "$PY" ]; then
   DEBIAN_FRONTEND=noninteractive apt-get install -y python3.11 python3.11-venv
   PY=python3.11
 fi
-"$PY" -m venv "$ROOT/venv"
+if ! "$PY" -m venv "$ROOT/venv"; then
+  VERSION=$("$PY" -c 'import sys; print("%d.%d" % sys.version_info[:2])')
+  apt-get update
+  DEBIAN_FRONTEND=noninteractive apt-get install -y "python$VERSION-venv"
+  rm -rf "$ROOT/venv"
+  "$PY" -m venv "$ROOT/venv"
+fi
 "$ROOT/venv/bin/python" -m pip install --upgrade pip
 "$ROOT/venv/bin/python" -m pip install -r "$ROOT/source/requirements.txt"
 "$ROOT/venv/bin/python" -c "import numpy, PIL, tqdm, pytest"
@@ -141,7 +149,7 @@ def collect_tests(repo: Path, week: str, config: dict) -> list[dict]:
     if not collected or collected[0]["errors"] or not collected[0]["tests"]:
         errors = collected[0]["errors"] if collected else [proc.stderr[-2000:]]
         raise AssignmentError(f"week {week}: the graders cannot be collected: {errors}")
-    return collected[0]["tests"]
+    return sorted(collected[0]["tests"], key=lambda t: t["hidden"])  # the graders first
 
 
 def write_repository(root: Path, week: str, dest: Path) -> None:

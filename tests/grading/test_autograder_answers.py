@@ -18,7 +18,13 @@ from pathlib import Path
 
 import pytest
 
-from rtpy.grading.assignment import WEEKS, find_regions, shipped_tests, withheld
+from rtpy.grading.assignment import (
+    WEEKS,
+    _enclosing_functions,
+    find_regions,
+    shipped_tests,
+    withheld,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 MIN_CALLS = 3  # shorter solutions have too common a trace to tell
@@ -53,44 +59,34 @@ ANSWERED_QUESTIONS = {
 }
 
 
-def calls(node: ast.AST) -> Counter:
-    """The names of the functions and methods called in node, with their counts."""
-    names = Counter()
+def called(node: ast.AST) -> list[tuple[int, str]]:
+    """(line, name) of every function or method called in node."""
+    out = []
     for n in ast.walk(node):
         if isinstance(n, ast.Call):
             f = n.func
             name = f.attr if isinstance(f, ast.Attribute) else getattr(f, "id", None)
             if name:
-                names[name] += 1
-    return names
+                out.append((n.lineno, name))
+    return out
 
 
 @cache
 def function_calls(path: Path) -> dict[str, Counter]:
-    """Qualified name -> the calls of the function, for every function of the file."""
-    return {name: calls(node) for name, node in functions(path).items()}
-
-
-def functions(path: Path) -> dict[str, ast.AST]:
-    """Qualified name -> the function's node, for every function of the file."""
-    out = {}
-
-    def visit(node: ast.AST, prefix: str) -> None:
-        for child in ast.iter_child_nodes(node):
-            if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
-                name = f"{prefix}{child.name}"
-                if not isinstance(child, ast.ClassDef):
-                    out[name] = child
-                visit(child, f"{name}.")
-
-    visit(ast.parse(path.read_text()), "")
-    return out
+    """Qualified name -> the names it calls with their counts, for every function of
+    the file (a nested function's calls count for its outer functions too)."""
+    source = path.read_text()
+    found = called(ast.parse(source))
+    return {
+        name: Counter(call for line, call in found if first <= line <= last)
+        for first, last, name in _enclosing_functions(source)
+    }
 
 
 def solution_calls(root: Path, region) -> Counter:
     lines = (root / region.path).read_text().splitlines()[region.begin + 1 : region.end]
     body = "\n".join(line.removeprefix(region.indent) for line in lines)
-    return calls(ast.parse(body))
+    return Counter(name for _, name in called(ast.parse(body)))
 
 
 def shipped_code(root: Path, week: str) -> list[Path]:

@@ -27,22 +27,12 @@ CASES = 3
 N = 4000
 
 
-def vec(a) -> Vec3:
-    return Vec3(*(float(x) for x in a))
-
-
-def arr(v) -> np.ndarray:
-    return np.array(list(v), dtype=float)
-
-
-def unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v)
-
-
 def incidence(rng, cos_range=(0.05, 1.0)):
     """(unit normal n, unit direction d toward the surface, cos of incidence)."""
-    n = unit(rng.normal(size=3))
-    side = unit(np.cross(n, rng.normal(size=3)))
+    n = rng.normal(size=3)
+    n /= np.linalg.norm(n)
+    side = np.cross(n, rng.normal(size=3))
+    side /= np.linalg.norm(side)
     cos = float(rng.uniform(*cos_range))
     d = -cos * n + math.sqrt(1 - cos * cos) * side
     return n, d, cos
@@ -54,7 +44,7 @@ def test_reflect_and_refract_at_new_directions():
     rng = grading_rng(601)
     for _ in range(200):
         n, d, cos = incidence(rng)
-        got = arr(reflect(vec(d), vec(n)))
+        got = as_array(reflect(Vec3(*d), Vec3(*n)))
         want = d - 2 * (d @ n) * n
         assert np.allclose(got, want, atol=1e-12), (
             f"reflect (rtpy/vec3.py)(v={d.round(4)}, n={n.round(4)}) = {got.round(6)}, expected "
@@ -64,7 +54,7 @@ def test_reflect_and_refract_at_new_directions():
         sin_t = eta * math.sqrt(1 - cos * cos)
         if sin_t > math.sin(math.radians(88)):
             continue  # total internal reflection, or within 2 degrees of it
-        got = arr(refract(vec(d), vec(n), eta))
+        got = as_array(refract(Vec3(*d), Vec3(*n), eta))
         where = f"refract (rtpy/vec3.py)(uv={d.round(4)}, n={n.round(4)}, etai_over_etat={eta:.4f})"
         assert abs(np.linalg.norm(got) - 1) < 1e-9, f"{where} = {got.round(6)}: not a unit vector"
         assert got @ n < 0, (
@@ -77,6 +67,10 @@ def test_reflect_and_refract_at_new_directions():
         assert abs(np.cross(np.cross(d, n), np.cross(got, n)) @ n) < 1e-9, (
             f"{where} = {got.round(6)}: the refracted ray stays in the plane of incidence"
         )
+
+
+def as_array(v: Vec3) -> np.ndarray:
+    return np.array([v.x(), v.y(), v.z()])
 
 
 def binomial_p_value(k: int, n: int, p: float) -> float:
@@ -99,12 +93,12 @@ def test_dielectric_reflects_with_the_schlick_probability_at_new_angles():
             ior = float(rng.uniform(1.2, 2.4))
             n, d, cos = incidence(rng, (0.1, 1.0))
             glass = Dielectric(ior, Color(0.9, 0.95, 1.0))
-            hit = HitInfo(Vec3(0, 0, 0), vec(n), 1.0, True, glass)
-            ray = Ray(vec(-d), vec(d))
+            hit = HitInfo(Vec3(0, 0, 0), Vec3(*n), 1.0, True, glass)
+            ray = Ray(Vec3(*-d), Vec3(*d))
             reflected = 0
             for _ in range(N):
                 s = glass.scattering(ray, hit)
-                reflected += arr(s.scattered_ray.direction) @ n > 0
+                reflected += as_array(s.scattered_ray.direction) @ n > 0
             r0 = ((1 - ior) / (1 + ior)) ** 2
             r = r0 + (1 - r0) * (1 - cos) ** 5  # entering the glass: no total reflection
             p = binomial_p_value(int(reflected), N, r)

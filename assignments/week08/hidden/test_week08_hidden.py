@@ -19,10 +19,11 @@ Together: below 2e-4 per submission.
 import math
 
 import rtpy.testing as rt
-from rtpy import Camera, Color, Lambertian, Scene, Sphere, Vec3
+from rtpy import Camera, Color, Scene, Sphere, Vec3
 from rtpy.grading import points, render_stack
 from rtpy.grading.autograder_seed import grading_rng, grading_seed
 from rtpy.materials import BlinnPhong, CookTorrance, Phong
+from rtpy.testing.analytic_scenes import GlowingLambertian
 
 ALPHA = 1e-4
 Z = 4.5
@@ -95,19 +96,6 @@ def test_weight_is_brdf_cos_over_pdf_at_new_parameters():
         assert result.passed, f"{described(material)}.BRDF is not reciprocal: {result.detail}"
 
 
-class Glowing(Lambertian):
-    """A Lambertian surface that also emits Le (the inside of the furnace)."""
-
-    is_emitter = True
-
-    def __init__(self, rho: float, le: float) -> None:
-        super().__init__(Color(rho, rho, rho))
-        self.le = Color(le, le, le)
-
-    def emitting(self, hit):
-        return self.le
-
-
 PIXELS = 2 * 8 * 8
 
 
@@ -118,7 +106,7 @@ def test_path_furnace_at_new_seeds():
     rho, le = float(rng.uniform(0.3, 0.6)), float(rng.uniform(0.2, 1.0))
     eye = rng.uniform(-0.5, 0.5, 3)
     scene = Scene(
-        [Sphere(Vec3(0, 0, 0), 2.0, Glowing(rho, le))],
+        [Sphere(Vec3(0, 0, 0), 2.0, GlowingLambertian(Color(rho, rho, rho), Color(le, le, le)))],
         camera=Camera(
             Vec3(*eye), Vec3(*(eye + rng.normal(size=3))), vfov=90, aspect_ratio=1.0, width=8
         ),
