@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import re
 
-# Scalar backend, 2 worker processes on a shared 2-core machine (python -m rtpy render
-# week05_point_light / week08_three_balls with the options shown).
+# Measured with the scalar backend and 2 worker processes on a 2-core machine that other
+# jobs shared: week05_point_light and week08_three_balls, rendered with each option set.
 QUICK_RENDER = "--width 160 --spp 8 --workers 2"
-QUICK_SECONDS = "5 to 10 seconds"
+QUICK_TIME = "about 7 seconds"
 FULL_RENDER = "--width 480 --spp 128 --max-depth 5 --workers 2"
-FULL_MINUTES = "about 10 minutes"
+FULL_TIME = "10 (week05_point_light) to 25 minutes (week08_three_balls)"
 
 
 def workflow_section(week: str, task_files: list[str], left_out: list[str]) -> str:
@@ -42,11 +42,17 @@ week, all but the slow ones; `python -m pytest -m ""` runs everything.
 
 **Render** with the scalar backend (the numpy backend is withheld from assignment
 repositories: its vectorized code contains the solutions, and `--backend numpy` says
-so). Iterate on a small image first: `python -m rtpy render week05_point_light
-{QUICK_RENDER}` takes {QUICK_SECONDS} on 2 cores. The renders you submit
-(`{FULL_RENDER}`) take {FULL_MINUTES} each on 2 cores: start them once the quick
-ones look right. `--workers N` uses N processes (the same image, bit for bit); Ctrl-C
-stops a render and writes what is finished.
+so). SCENE is a scene file or a bundled scene's name:
+
+```sh
+python -m rtpy render SCENE {QUICK_RENDER}            # try it out
+python -m rtpy render SCENE {FULL_RENDER} -o out.png  # to submit
+```
+
+On 2 cores the small render of the bundled week-5 or week-8 scene takes {QUICK_TIME};
+the full one takes {FULL_TIME}, so start it once the small one looks right.
+`--workers N` uses N processes (the same image, bit for bit); Ctrl-C stops a render and
+writes what is finished.
 
 ## What is graded
 

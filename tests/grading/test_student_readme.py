@@ -16,7 +16,7 @@ def test_the_workflow_section_says_how_to_install_grade_and_render():
     assert "python -m rtpy grade 05" in text
     assert 'python -m pytest -m ""' in text
     assert "--width 160 --spp 8 --workers 2" in text  # the quick loop, with measured times
-    assert "minutes" in text and "seconds" in text
+    assert "to 25 minutes" in text and "7 seconds" in text
     assert "- `rtpy/light.py`\n- `rtpy/scene.py`\n" in text  # the files that are graded
     assert "ignores every other" in text and "- `tests/test_light.py`" in text
 
