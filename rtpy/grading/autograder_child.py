@@ -272,7 +272,7 @@ class ChildPlugin:
 
     def pytest_collection_finish(self, session) -> None:
         self.emit(
-            event="collected", tests=[test_entry(i) for i in session.items], errors=self.errors
+            event="collected", tests=[collected_test(i) for i in session.items], errors=self.errors
         )
 
     @pytest.hookimpl(hookwrapper=True)
@@ -315,7 +315,7 @@ class ChildPlugin:
         self.failure[item.nodeid] = message if call.when == "call" else f"({call.when}) {message}"
 
 
-def test_entry(item) -> dict:
+def collected_test(item) -> dict:
     """What the parent needs of a collected test: its id, the name shown (the first line
     of its docstring), its points and whether it is a hidden check."""
     mark = item.get_closest_marker("points")

@@ -44,6 +44,7 @@ from .autograder_submission import (
     compile_errors,
     ignored_changes,
     import_problem,
+    suspicious_lines,
     take_task_files,
     unpack,
 )
@@ -170,6 +171,8 @@ def prepare(run: Run, submission: Path, pristine: Path) -> None:
             run.problems[blamed] = message
             restore(run, pristine, blamed)
         usable = [] if rel is None else [u for u in usable if u != rel]
+    for line in suspicious_lines(run.work, usable):
+        run.log.append(f"check this line of the submission: {line}")
     run.notes.append(
         f"Graded from your submission: {', '.join(usable) or 'none of the task files'}."
     )

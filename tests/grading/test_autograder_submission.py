@@ -15,6 +15,7 @@ from rtpy.grading.autograder_submission import (
     find_repository,
     ignored_changes,
     import_problem,
+    suspicious_lines,
     take_task_files,
     unpack,
 )
@@ -95,3 +96,12 @@ def test_an_import_that_fails_or_hangs_blames_the_file_and_line(tmp_path):
     rel, message = import_problem(work, TASKS, timeout=1)
     assert rel == "rtpy/light.py" and "importing it did not finish within 1 s" in message
     assert import_problem(repository(tmp_path / "c"), TASKS, timeout=30) is None
+
+
+def test_lines_that_could_tamper_with_grading_are_listed_for_the_instructor(tmp_path):
+    light = "import math\nimport rtpy.grading.graders as g  # patch\nx = eval('1')\n# exec it\n"
+    repository(tmp_path, light=light)
+    assert suspicious_lines(tmp_path, TASKS) == [
+        "rtpy/light.py:2: import rtpy.grading.graders as g  # patch",
+        "rtpy/light.py:3: x = eval('1')",
+    ]
