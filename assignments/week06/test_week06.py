@@ -155,7 +155,9 @@ def test_mirror():
     for theta in (0.0, 45.0, 80.0):
         s = m.scattering(incoming(theta), glass_hit(True, m))
         t = math.radians(theta)
-        assert np.allclose(arr(s.scattered_ray.direction), [-math.sin(t), 0, math.cos(t)], atol=1e-12), (
+        assert np.allclose(
+            arr(s.scattered_ray.direction), [-math.sin(t), 0, math.cos(t)], atol=1e-12
+        ), (
             f"Mirror.scattering (rtpy/materials/mirror.py) at {theta} degrees: not the mirror direction"
         )
         assert np.allclose(arr(s.attenuation), [0.9, 0.8, 0.7]), (

@@ -50,6 +50,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from .student_readme import student_rtpy_readme, workflow_section
+
 WEEKS = ("03", "04", "05", "06", "07", "08")
 BEGIN = re.compile(r"^(?P<indent>[ \t]*)# BEGIN SOLUTION week(?P<week>\d\d)(?::\s*(?P<msg>.*))?$")
 END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
@@ -67,6 +69,13 @@ MACHINERY_TESTS = (
     "tests/grading/test_assignment.py",
     "tests/grading/test_tasks.py",
     "tests/grading/test_task_pages.py",
+    "tests/grading/test_autograder.py",
+    "tests/grading/test_autograder_answers.py",
+    "tests/grading/test_autograder_child.py",
+    "tests/grading/test_autograder_run.py",
+    "tests/grading/test_autograder_seed.py",
+    "tests/grading/test_autograder_submission.py",
+    "tests/grading/test_student_readme.py",
     "tests/docs/test_pages.py",
     "tests/test_layout.py",
 )
@@ -82,17 +91,21 @@ def never_mapped(rel: str) -> bool:
 
 NUMPY_STUB = '''"""The numpy backend is withheld from the weekly assignment repositories: its
 vectorized twins contain the solutions. Render with the scalar backend (the default)."""
+
+WITHHELD = "{message}"
 '''
 NUMPY_RENDER_STUB = '''"""Withheld: see rtpy/numpy_backend/__init__.py."""
 
 
 class NumpyBackend:
     def __init__(self, *args, **kwargs) -> None:
-        raise NotImplementedError(
-            "the numpy backend is withheld from the week {week} assignment repository "
-            "(its vectorized code contains the solutions); render with --backend scalar"
-        )
+        raise NotImplementedError("{message}")
 '''
+WITHHELD_MESSAGE = (
+    "the numpy backend is withheld from the week {week} assignment repository (its "
+    "vectorized code contains the solutions); render with the scalar backend (the default)"
+)
+HIDDEN_FOLDER = "hidden"  # assignments/weekNN/hidden/: checks only the autograder holds
 
 
 class AssignmentError(Exception):
@@ -264,12 +277,32 @@ def student_pytest_options(pyproject: Path) -> None:
     pyproject.write_text(text)
 
 
+def source_root(command: str) -> Path:
+    """The rtpy source checkout that assignments are made from: the one this rtpy is
+    imported from, else the current directory; AssignmentError in one line when
+    neither has assignments/ (an installed rtpy without its repository)."""
+    for base in (Path(__file__).resolve().parents[2], Path.cwd()):
+        if (base / "assignments").is_dir() and (base / "rtpy").is_dir():
+            return base
+    raise AssignmentError(
+        f"{command} needs rtpy's source checkout (rtpy/ and assignments/): run it in a "
+        "clone of rtpy's repository"
+    )
+
+
+def normal_permissions(path: Path) -> None:
+    """Give a folder made by tempfile.mkdtemp (0700) the mode a new folder gets."""
+    umask = os.umask(0o022)
+    os.umask(umask)
+    os.chmod(path, 0o777 & ~umask)
+
+
 def make_assignment(week: str | int, out_dir: str | Path, root: str | Path | None = None) -> Path:
     """Write week's student repository to out_dir (which must not exist or be empty).
     Everything is written to a temporary directory next to it and renamed at the end,
     so a failure leaves nothing half-written."""
     week = check_week(week)
-    root = Path(root) if root is not None else Path(__file__).resolve().parents[2]
+    root = Path(root) if root is not None else source_root("assignment make")
     out = Path(out_dir)
     src = root / "assignments" / f"week{week}"
     if not src.is_dir():
@@ -280,6 +313,7 @@ def make_assignment(week: str | int, out_dir: str | Path, root: str | Path | Non
         raise AssignmentError(f"{out.parent}: no such directory")
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}-", dir=out.parent))
     try:
+        normal_permissions(tmp)
         _write_repository(root, week, tmp)
         if out.exists():
             out.rmdir()
@@ -303,12 +337,13 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
             rewrite(path, root, lambda r: r.stub() if withheld(r.week, week) else None)
         )
     numpy_dir = root / "rtpy" / "numpy_backend"
+    message = WITHHELD_MESSAGE.format(week=week)
     for package in sorted(numpy_dir.rglob("__init__.py")):  # pyproject lists every package
         stub = dest / package.relative_to(root)
         stub.parent.mkdir(parents=True, exist_ok=True)
-        stub.write_text(NUMPY_STUB)
+        stub.write_text(NUMPY_STUB.replace("{message}", message))
     stub = dest / "rtpy" / "numpy_backend" / "renderer.py"
-    stub.write_text(NUMPY_RENDER_STUB.replace("{week}", week))
+    stub.write_text(NUMPY_RENDER_STUB.replace("{message}", message))
     for name in COPIED:
         path = root / name
         if path.is_dir():
@@ -316,37 +351,21 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
         elif path.exists():
             shutil.copy2(path, dest / name)
     student_pytest_options(dest / "pyproject.toml")
-    # the week's own folder, and the tests that can pass
+    # the week's own folder without its hidden checks, and the tests that can pass
     shutil.copytree(
-        root / "assignments" / f"week{week}", dest / "assignments" / f"week{week}", ignore=ignore
+        root / "assignments" / f"week{week}",
+        dest / "assignments" / f"week{week}",
+        ignore=shutil.ignore_patterns("__pycache__", "*.pyc", HIDDEN_FOLDER),
     )
     kept, left = shipped_tests(root, week)
     for rel in kept:
         (dest / rel).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(root / rel, dest / rel)
     readme = (root / "assignments" / f"week{week}" / "README.md").read_text()
-    (dest / "README.md").write_text(
-        readme
-        + "\n## This repository\n\n"
-        + "Generated by `python -m rtpy assignment make "
-        + f"{week} OUT_DIR` from rtpy. `python -m rtpy grade {week}` runs the graders "
-        + f"(`assignments/week{week}/`) and prints your score; "
-        + f"`python -m pytest assignments/week{week} -x` shows the first failure's traceback, "
-        + "and `python -m pytest` runs the graders with rtpy's own tests that apply this "
-        + "week, all but the slow ones (long statistical and end-to-end tests); "
-        + '`python -m pytest -m ""` runs everything, the slow tests included. '
-        + "`docs/students.md` explains how to work on an assignment and "
-        + "`docs/course-map.md` where each name of the course's code is in rtpy. "
-        + "Left out because they "
-        + "test code you write this week or later, or the numpy backend (withheld here: "
-        + "its vectorized code contains the solutions; render with the scalar backend):\n\n"
-        + "".join(
-            f"- `{rel}`\n"
-            for rel in left
-            if rel not in MACHINERY_TESTS and not rel.endswith("__init__.py")
-        )
-    )
-    (dest / "rtpy-README.md").write_text((root / "README.md").read_text())
+    task_files = sorted({r.path.as_posix() for r in find_regions(root) if r.week == week})
+    left_out = [r for r in left if r not in MACHINERY_TESTS and not r.endswith("__init__.py")]
+    (dest / "README.md").write_text(readme + workflow_section(week, task_files, left_out))
+    (dest / "rtpy-README.md").write_text(student_rtpy_readme((root / "README.md").read_text()))
 
 
 # --- which tests need which weeks ---------------------------------------------------

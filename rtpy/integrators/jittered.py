@@ -1,5 +1,5 @@
 """The "jittered" integrator (course week 3): the flat colour averaged over
-random rays inside each pixel, which anti-aliases the edges."""
+random rays inside each pixel."""
 
 from __future__ import annotations
 

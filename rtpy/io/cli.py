@@ -25,6 +25,16 @@ EXIT_INTERRUPTED = 130
 MAX_WORKERS = 256  # more processes than that only exhaust the machine
 
 
+def seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    if not 0.0 < value < 1e6:
+        raise argparse.ArgumentTypeError(f"expected seconds above 0, got {text}")
+    return value
+
+
 def worker_count(text: str) -> int:
     try:
         value = int(text)
@@ -117,12 +127,25 @@ def build_parser(prog: str = "rtpy") -> argparse.ArgumentParser:
 
 
 def add_assignment_commands(sub) -> None:
-    """`assignment make WEEK OUT_DIR`, `assignment map-tests`, `grade WEEK`."""
+    """`assignment make WEEK OUT_DIR`, `assignment autograder WEEK OUT.zip`,
+    `assignment map-tests`, `grade WEEK`."""
     a = sub.add_parser("assignment", help="write a weekly assignment repository")
     asub = a.add_subparsers(dest="assignment_command", required=True, metavar="ACTION")
     make = asub.add_parser("make", help="write week WEEK's student repository to OUT_DIR")
     make.add_argument("week", metavar="WEEK", help="03 to 08")
     make.add_argument("out_dir", metavar="OUT_DIR", help="a new or empty directory")
+    z = asub.add_parser("autograder", help="write week WEEK's Gradescope autograder zip")
+    z.add_argument("week", metavar="WEEK", help="03 to 08")
+    z.add_argument("out_zip", metavar="OUT.zip", help="the autograder to upload to Gradescope")
+    from ..grading.autograder import TEST_TIMEOUT, TOTAL_TIMEOUT
+
+    for option, default, what in (
+        ("--test-timeout", TEST_TIMEOUT, "each test"),
+        ("--total-timeout", TOTAL_TIMEOUT, "a whole submission"),
+    ):
+        z.add_argument(
+            option, type=seconds, default=default, metavar="S", help=f"seconds for {what}"
+        )
     m = asub.add_parser("map-tests", help="record which weeks each test file needs (slow)")
     m.add_argument("files", nargs="*", metavar="TEST_FILE", help="only these (tests/...)")
     g = sub.add_parser("grade", help="run a week's graders and print the score")
@@ -139,6 +162,19 @@ def command_assignment(args: argparse.Namespace) -> int:
         if args.assignment_command == "map-tests":
             weeks = map_tests(files=tuple(args.files))
             print(f"rtpy: {len(weeks)} test files need solution regions", file=sys.stderr)
+            return 0
+        if args.assignment_command == "autograder":
+            from ..grading.autograder import build_autograder
+
+            out = build_autograder(
+                args.week,
+                args.out_zip,
+                test_timeout=args.test_timeout,
+                total_timeout=args.total_timeout,
+            )
+            print(
+                f"rtpy: wrote the week {check_week(args.week)} autograder to {out}", file=sys.stderr
+            )
             return 0
         out = make_assignment(args.week, args.out_dir)
     except (AssignmentError, FileNotFoundError) as err:
@@ -223,6 +259,18 @@ def check_width(scene, path: Path, overrides: dict, option: str) -> None:
         raise UsageError(f"{option} {overrides['width']} with {path}'s aspect ratio: {e}") from None
 
 
+def check_backend(name: str) -> None:
+    """UsageError when the backend is withheld (the numpy backend in an assignment
+    repository, whose stub says so in WITHHELD)."""
+    if name != "numpy":
+        return
+    import rtpy.numpy_backend as backend
+
+    withheld = getattr(backend, "WITHHELD", None)
+    if withheld:
+        raise UsageError(f"--backend numpy: {withheld}")
+
+
 def command_scenes() -> int:
     from .bundled import bundled_scenes
 
@@ -284,6 +332,7 @@ def _render(args: argparse.Namespace) -> int:
         output = Path(args.output) if args.output is not None else Path(f"{path.stem}.png")
         check_image_path(output)
         linear = check_linear_path(args.linear) if args.linear else None
+        check_backend(args.backend)
     except (SceneError, OutputError, UsageError) as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -37,9 +37,7 @@ class BlinnPhong(Material):
     kd        strength of the diffuse part
     ks        strength of the highlight (white: the highlight has the light's colour)
     exponent  sharpness of the highlight: larger values make a smaller, brighter
-              spot. For the same look as Phong with exponent e, use about 4 e
-              (the angle between h and the normal is about half the angle
-              between r and wo).
+              spot. For the same look as Phong with exponent e, use about 4 e.
 
     Sampling (see rtpy.materials.glossy for the mixture) draws the half vector h
     around the normal with density (n + 1) / (2 pi) * (normal . h)^n and reflects

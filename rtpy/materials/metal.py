@@ -15,9 +15,9 @@ class Metal(Material):
     """Scatters toward unit(reflect(d) + fuzz * random unit vector).
 
     fuzz = 0 is a mirror; larger fuzz blurs the reflection (fuzz 1 is very
-    rough). Directions that end up below the surface are absorbed, so rough
-    metal darkens at grazing angles. Sampled only: this model has no closed-form
-    BRDF, so integrators treat it as specular (no light sampling at it).
+    rough). Directions that end up below the surface are absorbed. Sampled only:
+    this model has no closed-form BRDF, so integrators treat it as specular (no
+    light sampling at it).
     """
 
     is_specular = True

@@ -25,12 +25,11 @@ from __future__ import annotations
 import math
 
 from ..hit_info import HitInfo
-from ..onb import ONB
-from ..ray import Ray, spawn_ray
-from ..sampling import random_cosine_direction
+from ..ray import Ray
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import BLACK, Color, dot
+from .lambertian import Lambertian
 from .material import Material, as_texture
 
 INV_PI = 1.0 / math.pi
@@ -94,17 +93,18 @@ class OrenNayar(Material):
         return max(0.0, dot(normal, ray_light.direction)) * INV_PI
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
-        """A cosine-weighted direction around the normal, as Lambertian's; the weight
-        BRDF * cos / pdf = albedo / pi * factor * cos / (cos / pi) is albedo * factor."""
+        """Lambertian's sample (a cosine-weighted direction, weight albedo) with its
+        weight times factor: BRDF * cos / pdf = albedo / pi * factor * cos / (cos / pi)."""
         normal = hit.normal
         cos_o = -dot(normal, ray_in.direction)
         if cos_o <= 0.0:
             return None  # viewer below the surface
-        local = random_cosine_direction()  # z = cos(theta_i)
-        wi = ONB(normal).to_world(local)
+        sample = Lambertian.scattering(self, ray_in, hit)  # uses only self.albedo
+        if sample is None:
+            return None
+        wi = sample.scattered_ray.direction
         cos_i = dot(normal, wi)
-        if not (cos_i > 0.0 and local.z() > 0.0):
+        if not (cos_i > 0.0 and sample.pdf > 0.0):
             return None
         factor = self.factor(cos_o, cos_i, -dot(ray_in.direction, wi))
-        weight = self.albedo.value(hit) * factor
-        return ScatterInfo(spawn_ray(hit.point, normal, wi), weight, local.z() * INV_PI)
+        return ScatterInfo(sample.scattered_ray, sample.attenuation * factor, sample.pdf)

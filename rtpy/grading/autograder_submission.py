@@ -1,0 +1,285 @@
+"""What run_autograder takes from a submission: the week's task files, and only those.
+
+Gradescope puts the submission in /autograder/submission/: the repository's files
+(uploaded as a folder), a zip of them, or a GitHub checkout whose repository may sit
+one folder down. `find_repository` finds the folder holding rtpy/ with the task
+files; `take_task_files` copies those files (and nothing else) over the pristine
+copy of the assignment. A task file that cannot be used is put back to the
+assignment's stub and the reason is kept for the report:
+
+- missing from the submission, too large or not text;
+- not valid Python (`compile_errors`: the SyntaxError's line);
+- importing it fails or hangs (`import_problem`, in a child process with a time
+  limit: the exception and the line in the student's file).
+
+Files changed elsewhere in the submission are listed (`ignored_changes`) so the
+student learns that those edits do not count.
+"""
+
+from __future__ import annotations
+
+import filecmp
+import os
+import re
+import shutil
+import subprocess
+import sys
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+MAX_FILE_BYTES = 1_000_000  # a task file larger than this is not a student's source
+MAX_UNZIPPED_BYTES = 500_000_000
+MAX_DEPTH = 3  # how far below the submission folder the repository may be
+SKIPPED_FOLDERS = {"__MACOSX", ".git", "__pycache__", ".venv", "venv", "node_modules"}
+FRAME = re.compile(r'File "([^"]+)", line (\d+)')
+
+IMPORT_CHECK = """
+import faulthandler, importlib, pkgutil, sys
+faulthandler.dump_traceback_later(float(sys.argv[1]), exit=True)
+import rtpy
+for module in pkgutil.walk_packages(rtpy.__path__, "rtpy."):
+    if not module.name.endswith("__main__"):
+        importlib.import_module(module.name)
+"""
+
+
+# What a task file has no need for, and code that tampers with grading would use: the
+# autograder's stdout (the instructor's) lists the lines that match.
+SUSPICIOUS = re.compile(
+    r"\b(?:pytest|_pytest|rtpy\.grading|rtpy\.testing|sys\.modules|builtins|__import__|"
+    r"importlib|subprocess|inspect|_getframe|exec|eval|write_text|write_bytes|"
+    r"os\.(?:system|remove|rename|replace|unlink|write|kill|environ)|shutil|signal|"
+    r"faulthandler|atexit|setattr)\b"
+)
+
+
+def suspicious_lines(work: Path, files: list[str]) -> list[str]:
+    """file:line: code of the task files' lines that match SUSPICIOUS."""
+    found = []
+    for rel in files:
+        for number, line in enumerate((work / rel).read_text(encoding="utf-8").splitlines(), 1):
+            code = line.split("#", 1)[0]
+            if SUSPICIOUS.search(code):
+                found.append(f"{rel}:{number}: {line.strip()}")
+    return found
+
+
+class SubmissionError(Exception):
+    """A submission that cannot be read at all (a broken zip, nothing in it)."""
+
+
+@dataclass
+class Taken:
+    """The task files taken from a submission, and what went wrong with the others."""
+
+    repository: Path | None
+    files: list[str] = field(default_factory=list)  # task files taken (posix, from the root)
+    problems: dict[str, str] = field(default_factory=dict)  # task file -> why it is the stub
+    notes: list[str] = field(default_factory=list)  # where files were found
+
+
+def unpack(submission: Path, scratch: Path) -> Path:
+    """The folder to search: `submission` itself, or where its one zip is unpacked when
+    it holds a zip and no rtpy/ folder."""
+    if any(p.is_dir() for p in _folders(submission, "rtpy")):
+        return submission
+    zips = sorted(p for p in submission.rglob("*.zip") if _visible(p, submission))
+    if not zips:
+        return submission
+    dest = scratch / "unzipped"
+    dest.mkdir(parents=True, exist_ok=True)
+    try:
+        with zipfile.ZipFile(zips[0]) as archive:
+            _extract(archive, dest)
+    except (zipfile.BadZipFile, OSError, RuntimeError, EOFError) as err:
+        raise SubmissionError(f"{zips[0].name}: not a zip file that can be read ({err})") from err
+    return dest
+
+
+def _extract(archive: zipfile.ZipFile, dest: Path) -> None:
+    """Extract regular files only, each inside dest, at most MAX_UNZIPPED_BYTES in all."""
+    total = 0
+    root = dest.resolve()
+    for info in archive.infolist():
+        if info.is_dir() or (info.external_attr >> 16) & 0o170000 == 0o120000:
+            continue  # folders are made as needed; symbolic links are skipped
+        target = (dest / info.filename).resolve()
+        if not target.is_relative_to(root):
+            continue  # ../ or an absolute path
+        total += info.file_size
+        if total > MAX_UNZIPPED_BYTES:
+            raise SubmissionError(f"the zip unpacks to more than {MAX_UNZIPPED_BYTES:,} bytes")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        with archive.open(info) as src, open(target, "wb") as out:
+            shutil.copyfileobj(src, out)
+
+
+def _visible(path: Path, base: Path) -> bool:
+    return not any(part in SKIPPED_FOLDERS for part in path.relative_to(base).parts)
+
+
+def _folders(base: Path, name: str) -> list[Path]:
+    """Folders called `name` at most MAX_DEPTH levels below base (base/name included)."""
+    found, level = [], [base]
+    for _ in range(MAX_DEPTH + 1):
+        nxt = []
+        for folder in level:
+            try:
+                children = sorted(p for p in folder.iterdir() if p.is_dir() and not p.is_symlink())
+            except OSError:
+                continue
+            for child in children:
+                if child.name in SKIPPED_FOLDERS:
+                    continue
+                if child.name == name:
+                    found.append(child)
+                nxt.append(child)
+        level = nxt
+    return found
+
+
+def find_repository(base: Path, task_files: list[str]) -> Path | None:
+    """The folder (base or below) whose rtpy/ holds the most task files, the shallowest
+    of those; None when no rtpy/ folder holds any."""
+    best, best_count = None, 0
+    for rtpy_dir in _folders(base, "rtpy"):
+        root = rtpy_dir.parent
+        count = sum((root / rel).is_file() for rel in task_files)
+        if count > best_count:
+            best, best_count = root, count
+    return best
+
+
+def _by_name(base: Path, rel: str) -> Path | None:
+    """The one file under base with rel's file name, for a submission of loose files."""
+    name = Path(rel).name
+    matches = [p for p in base.rglob(name) if p.is_file() and _visible(p, base)]
+    return matches[0] if len(matches) == 1 else None
+
+
+def take_task_files(base: Path, task_files: list[str], work: Path) -> Taken:
+    """Copy each task file found under base over work's copy; the others keep the stub."""
+    repository = find_repository(base, task_files)
+    taken = Taken(repository)
+    if repository is not None and repository != base:
+        shown = repository.relative_to(base).as_posix()
+        taken.notes.append(f"Your repository was found in the folder {shown}/.")
+    for rel in task_files:
+        source = repository / rel if repository is not None else None
+        if source is None or not source.is_file():
+            source = _by_name(base, rel)
+            if source is not None:
+                taken.notes.append(f"{rel}: taken from {source.relative_to(base).as_posix()}")
+        problem = _unusable(source)
+        if problem:
+            taken.problems[rel] = problem
+            continue
+        shutil.copyfile(source, work / rel)
+        taken.files.append(rel)
+    return taken
+
+
+def _unusable(source: Path | None) -> str | None:
+    if source is None:
+        return "not in your submission"
+    if source.stat().st_size > MAX_FILE_BYTES:
+        return f"larger than {MAX_FILE_BYTES:,} bytes"
+    try:
+        source.read_bytes().decode("utf-8")
+    except UnicodeDecodeError:
+        return "not a UTF-8 text file"
+    return None
+
+
+def compile_errors(work: Path, files: list[str]) -> dict[str, str]:
+    """task file -> its SyntaxError (line and message), for those that do not compile."""
+    errors = {}
+    for rel in files:
+        text = (work / rel).read_text(encoding="utf-8")
+        try:
+            compile(text, rel, "exec", dont_inherit=True)
+        except SyntaxError as err:
+            lines = text.splitlines()
+            line = lines[err.lineno - 1].strip() if err.lineno and err.lineno <= len(lines) else ""
+            shown = f": {line}" if line else ""
+            errors[rel] = f"line {err.lineno}: SyntaxError: {err.msg}{shown}"
+        except ValueError as err:  # a NUL byte
+            errors[rel] = f"cannot be compiled: {err}"
+    return errors
+
+
+def import_problem(
+    work: Path, files: list[str], timeout: float, python: str = sys.executable
+) -> tuple[str | None, str] | None:
+    """None when every rtpy module imports in a child process within `timeout`; else
+    (the student's task file to blame, or None when none can be named; the problem)."""
+    env = child_environment(work)
+    try:
+        proc = subprocess.run(
+            [python, "-c", IMPORT_CHECK, str(timeout)],
+            cwd=work,
+            env=env,
+            capture_output=True,
+            text=True,
+            errors="replace",
+            timeout=timeout + 30.0,
+        )
+    except subprocess.TimeoutExpired:
+        return None, f"importing rtpy did not finish within {timeout:g} s"
+    if proc.returncode == 0:
+        return None
+    err = proc.stderr
+    hang = "Timeout (" in err and "Traceback" not in err  # faulthandler's dump
+    blamed = None
+    for path, line in FRAME.findall(err):
+        rel = _relative(path, work)
+        if rel in files:
+            blamed = (rel, line)
+    if blamed is None:  # an ImportError names the module file it looked in
+        for rel in files:
+            if str(work / rel) in err:
+                blamed = (rel, "")
+    last = [ln for ln in err.strip().splitlines() if ln.strip()][-1:] or ["no error message"]
+    what = f"importing it did not finish within {timeout:g} s" if hang else last[0].strip()
+    if blamed is None:
+        return None, what
+    rel, line = blamed
+    return rel, f"line {line}: {what}" if line else what
+
+
+def _relative(path: str, base: Path) -> str | None:
+    try:
+        return Path(path).resolve().relative_to(base.resolve()).as_posix()
+    except (ValueError, OSError):
+        return None
+
+
+def child_environment(work: Path) -> dict[str, str]:
+    """The environment of a process that runs the student's code: rtpy from work only."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
+    env.update(PYTHONPATH=str(work), PYTHONDONTWRITEBYTECODE="1", PYTHONIOENCODING="utf-8")
+    return env
+
+
+def ignored_changes(repository: Path | None, pristine: Path, task_files: list[str]) -> list[str]:
+    """Files of the submitted repository, other than the task files, that differ from
+    the assignment's or are new under rtpy/ (their changes are not graded)."""
+    if repository is None:
+        return []
+    changed = []
+    for folder in ("rtpy", "assignments", "tests", "scenes"):
+        top = repository / folder
+        if not top.is_dir():
+            continue
+        for path in sorted(top.rglob("*")):
+            rel = path.relative_to(repository).as_posix()
+            if not path.is_file() or rel in task_files or not _visible(path, repository):
+                continue
+            original = pristine / rel
+            if original.is_file():
+                if not filecmp.cmp(path, original, shallow=False):
+                    changed.append(rel)
+            elif folder == "rtpy" and path.suffix == ".py":
+                changed.append(rel)
+    return changed
