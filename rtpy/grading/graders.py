@@ -207,14 +207,26 @@ def grader_dir(week: str, root: Path | None = None) -> Path:
 
 def run_graders(folder: Path, extra_args: tuple[str, ...] = ()) -> PointsPlugin:
     """Run (or with "--collect-only", collect) the graders of a week's folder in this
-    process; the plugin holds their results."""
+    process; the plugin holds their results. The hidden checks (the folder's hidden/,
+    in rtpy's own repository only) are the autograder's: they are left out."""
     import pytest
 
     plugin = PointsPlugin()
     pytest.main(
         # quiet: the score table shows each failure's message (pytest on the folder
         # shows the tracebacks)
-        [str(folder), "-qq", "-p", "no:cacheprovider", "--tb=no", "-o", "addopts=", *extra_args],
+        [
+            str(folder),
+            "-qq",
+            "-p",
+            "no:cacheprovider",
+            "--tb=no",
+            "-o",
+            "addopts=",
+            "--ignore",
+            str(folder / "hidden"),
+            *extra_args,
+        ],  # fmt: skip
         plugins=[plugin],
     )
     return plugin

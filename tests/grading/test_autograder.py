@@ -103,7 +103,11 @@ def tamper(repo: Path, week: str) -> list[str]:
         changed.append(rel)
 
     graders_py = "rtpy/grading/graders.py"
-    edit(graders_py, "result.score = 0.0", "result.score = result.max_score")
+    edit(
+        graders_py,
+        "result.score, result.passed = 0.0, False",
+        "result.score, result.passed = result.max_score, True",
+    )
     edit(
         graders_py, "if report.failed:\n            result.score", "if 0:\n            result.score"
     )

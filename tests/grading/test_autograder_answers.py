@@ -37,18 +37,6 @@ KNOWN = {
         "rtpy/integrators/whitted.py::WhittedIntegrator.compute_scattering",
     ): "Whitted's diffuse branch is emission plus direct_lighting, the direct "
     "integrator's answer; left to the week-05 re-cut of issue 18 (whitted.py has no region)",
-    (
-        "08",
-        "CookTorrance.sample_half_vector",
-        "rtpy/materials/ward.py::Ward.sample_half_vector",
-    ): "isotropic Ward is Beckmann: its half-vector sampler shows Beckmann's inversion; "
-    "left to the week-08 re-cut of issue 18 (a region there, as Ward.pdf has)",
-    (
-        "08",
-        "sample_cosine_power",
-        "rtpy/testing/material_checks.py::directional_albedo",
-    ): "not an answer: both build a direction from (theta, phi); the task's inverse CDF "
-    "r1 ** (1 / (n + 1)) is not there",
 }
 
 # file -> a phrase that answered the week's written question and must not come back
