@@ -73,6 +73,8 @@ def render(
     background: Color | None = None,
     sky: bool | None = None,
     backend: str = "scalar",
+    preview: object = None,
+    preview_seconds: float = 5.0,
     **settings,
 ) -> RenderedImage:
     """Render `scene` and return the image (linear array + PIL image).
@@ -87,7 +89,13 @@ def render(
     faster; the same image up to Monte Carlo noise). A setting of the wrong type
     raises TypeError, one out of its range ValueError, naming the setting
     (rtpy.render_settings.SETTINGS lists them with their limits).
+    preview shows the image while it renders, at most every preview_seconds: a .png
+    or .jpg file name (rewritten atomically), True (in a Jupyter notebook, an output
+    that each preview replaces) or a function called with the image so far
+    (rtpy.io.preview.preview_target).
     """
+    from .io.preview import preview_target
+
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {backend!r}")
     show_progress = _show_progress(progress, quiet)
@@ -107,7 +115,14 @@ def render(
         if sky is not None:
             scene.sky = SETTINGS["sky"].check(sky)
     renderer = Renderer(
-        scene, camera, render_settings, workers=workers, quiet=not show_progress, backend=backend
+        scene,
+        camera,
+        render_settings,
+        workers=workers,
+        quiet=not show_progress,
+        backend=backend,
+        preview=preview_target(preview),
+        preview_seconds=preview_seconds,
     )
     return renderer.render()
 

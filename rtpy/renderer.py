@@ -106,9 +106,7 @@ def _units(regions: list[tuple[int, int, int, int]], spp: int, n_batches: int) -
     that differ by at most 1."""
     batch_spp = [spp // n_batches + (1 if b < spp % n_batches else 0) for b in range(n_batches)]
     return [
-        Unit(r, b, *regions[r], batch_spp[b])
-        for b in range(n_batches)
-        for r in range(len(regions))
+        Unit(r, b, *regions[r], batch_spp[b]) for b in range(n_batches) for r in range(len(regions))
     ]
 
 
@@ -186,13 +184,20 @@ class PixelSums:
         fewest = min(samples) if samples and pixels == self.total[..., 0].size else 0
         return fewest, max(samples, default=0)
 
+    def snapshot(self) -> np.ndarray:
+        """The mean of each pixel's samples added so far, as a new array (the sums are
+        left as they are, for more samples to be added)."""
+        image = self.total.copy()
+        for unit, samples in self._samples.values():
+            image[unit.y0 : unit.y1, unit.x0 : unit.x1] /= samples
+        return image
+
     def mean(self) -> np.ndarray:
         """The mean of each pixel's samples (black without one), an array (height,
         width, 3), computed in place after finish(): `total` becomes it (call it once)."""
         self.finish()
         for unit, samples in self._samples.values():
             self.total[unit.y0 : unit.y1, unit.x0 : unit.x1] /= samples
-        self._samples.clear()
         return self.total
 
 
@@ -268,6 +273,9 @@ class Renderer:
     quiet    no progress bar (it goes to stderr, with an ETA)
     backend  "scalar" (the readable reference) or "numpy" (vectorized; the same image
              up to Monte Carlo noise)
+    preview  called with the image rendered so far (a RenderedImage of the finished
+             samples) when a unit finishes at least preview_seconds after the last
+             call (or the start), but not at the end: the caller has the final image
     """
 
     def __init__(
@@ -278,9 +286,16 @@ class Renderer:
         workers: int = 1,
         quiet: bool = True,
         backend: str = "scalar",
+        preview: Callable[[RenderedImage], object] | None = None,
+        preview_seconds: float = 5.0,
     ) -> None:
         if workers < 1:
             raise ValueError(f"workers must be >= 1, got {workers}")
+        if preview is not None and not callable(preview):
+            raise TypeError(f"preview must be callable or None, got {preview!r}")
+        if not (isinstance(preview_seconds, int | float) and preview_seconds >= 0.0):
+            raise ValueError(f"preview_seconds must be a number >= 0, got {preview_seconds!r}")
+        self.preview, self.preview_seconds = preview, float(preview_seconds)
         self.scene = scene
         self.camera = camera
         self.settings = settings
@@ -304,13 +319,21 @@ class Renderer:
             desc=f"{self.scene.name} ({settings.integrator}, {backend.name})",
             dynamic_ncols=True,
         )
-        start = time.perf_counter()
+        start = last_preview = time.perf_counter()
         interrupted = False
         work = self._run(units)
         try:
-            for unit, sums in work:
+            for done, (unit, sums) in enumerate(work, 1):
                 results.add(unit, sums)
                 bar.update(sums.shape[0] * sums.shape[1] * unit.spp)
+                now = time.perf_counter()
+                if (
+                    self.preview
+                    and done < len(units)
+                    and now - last_preview >= self.preview_seconds
+                ):
+                    self.preview(self._image(results.snapshot(), results, spp, True, now - start))
+                    last_preview = now
         except KeyboardInterrupt:
             interrupted = True
         finally:
@@ -330,8 +353,11 @@ class Renderer:
 
     def _assemble(self, results: PixelSums, spp, interrupted, seconds) -> RenderedImage:
         results.finish()
+        return self._image(results.mean(), results, spp, interrupted, seconds)
+
+    def _image(self, linear, results: PixelSums, spp, partial, seconds) -> RenderedImage:
+        """The RenderedImage of `linear`, the mean of the samples `results` holds."""
         paths, (fewest, most) = results.paths, results.samples_range()
-        linear = results.mean()
         stats = {
             "seconds": seconds,
             "paths": paths,
@@ -347,6 +373,6 @@ class Renderer:
             spp=spp,
             samples_min=fewest,
             samples_max=most,
-            interrupted=interrupted,
+            interrupted=partial,
             stats=stats,
         )

@@ -212,3 +212,47 @@ def test_bad_progress_options_are_refused(options, error, message):
     scene, camera = small_scene()
     with pytest.raises(error, match=re.escape(message)):
         rtpy.render(scene, camera=camera, **options)
+
+
+def test_previews_are_whole_frames_that_sharpen_and_leave_the_image_alone():
+    """With preview_seconds=0 a preview follows every unit but the last: each holds
+    more samples than the one before, every pixel within one pass of the others
+    (batches are passes), and the final image is the one rendered without previews."""
+    scene, camera = small_scene()
+    previews = []
+    image = rtpy.render(scene, camera=camera, spp=8, seed=3, preview=previews.append,
+                        preview_seconds=0)  # fmt: skip
+    units = plan_units(camera.width, camera.height, 8)
+    assert len(previews) == len(units) - 1
+    paths = [p.stats["paths"] for p in previews]
+    assert paths == sorted(set(paths)) and paths[-1] < image.stats["paths"]
+    for p in previews:
+        assert p.interrupted and p.samples_max - p.samples_min <= 1  # 8 passes of 1 spp
+        assert np.isfinite(p.linear).all()
+    alone = rtpy.render(scene, camera=camera, spp=8, seed=3)
+    np.testing.assert_array_equal(image.linear, alone.linear)
+    assert not image.interrupted
+    # Batch b of 8 draws what batch b of any spp >= b + 1 draws: the preview holding
+    # k whole passes is the image of k spp.
+    for k in (1, 2):
+        whole = [p for p in previews if p.samples_min == p.samples_max == k][0]
+        fewer = rtpy.render(scene, camera=camera, spp=k, seed=3)
+        np.testing.assert_array_equal(whole.linear, fewer.linear)
+
+
+def test_previews_at_most_every_preview_seconds():
+    scene, camera = small_scene()
+    previews = []
+    rtpy.render(scene, camera=camera, spp=2, preview=previews.append, preview_seconds=1e6)
+    assert previews == []
+
+
+@pytest.mark.parametrize(
+    "kwargs,error",
+    [({"preview": 3}, TypeError), ({"preview_seconds": -1.0}, ValueError),
+     ({"preview_seconds": "5"}, ValueError)],
+)  # fmt: skip
+def test_preview_arguments_are_checked(kwargs, error):
+    scene, camera = small_scene()
+    with pytest.raises(error, match="preview"):
+        rtpy.render(scene, camera=camera, spp=1, **kwargs)

@@ -16,6 +16,7 @@ from pathlib import Path
 from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
 from ..workers import WorkerError, available_cpus
 from .image import OutputError, check_image_path, check_linear_path
+from .preview import same_file
 
 EXIT_WORKERS_FAILED = 1
 EXIT_BAD_INPUT = 2
@@ -33,6 +34,11 @@ def seconds(text: str) -> float:
     if not 0.0 < value < 1e6:
         raise argparse.ArgumentTypeError(f"expected seconds above 0, got {text}")
     return value
+
+
+def preview_seconds(text: str) -> float:
+    """--preview-seconds: 0 (a preview after every unit of work) or more."""
+    return 0.0 if text.strip() in ("0", "0.0") else seconds(text)
 
 
 def worker_count(text: str) -> int:
@@ -91,6 +97,18 @@ def build_parser(prog: str = "rtpy") -> argparse.ArgumentParser:
         "--linear",
         metavar="OUT.npy|OUT.pfm|OUT.exr",
         help="also write the linear float image: .npy, .pfm or .exr (never gamma-encoded)",
+    )
+    r.add_argument(
+        "--preview",
+        metavar="PREVIEW.png",
+        help="while rendering, rewrite this 8-bit image with the samples finished so far",
+    )
+    r.add_argument(
+        "--preview-seconds",
+        type=preview_seconds,
+        default=5.0,
+        metavar="S",
+        help="at most one preview every S seconds (default 5)",
     )
     add_setting_options(r)
     cpus = min(available_cpus(), MAX_WORKERS)
@@ -332,6 +350,11 @@ def _render(args: argparse.Namespace) -> int:
         output = Path(args.output) if args.output is not None else Path(f"{path.stem}.png")
         check_image_path(output)
         linear = check_linear_path(args.linear) if args.linear else None
+        preview = check_image_path(args.preview) if args.preview else None
+        if preview is not None and any(
+            same_file(preview, other) for other in (output, linear, path) if other is not None
+        ):
+            raise UsageError(f"--preview {args.preview}: the preview needs a file of its own")
         check_backend(args.backend)
     except (SceneError, OutputError, UsageError) as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
@@ -339,7 +362,13 @@ def _render(args: argparse.Namespace) -> int:
 
     try:
         image = render(
-            scene, workers=args.workers, quiet=args.quiet, backend=args.backend, **overrides
+            scene,
+            workers=args.workers,
+            quiet=args.quiet,
+            backend=args.backend,
+            preview=preview,
+            preview_seconds=args.preview_seconds,
+            **overrides,
         )
     except WorkerError as err:
         print(f"rtpy: error: {err}", file=sys.stderr)

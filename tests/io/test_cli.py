@@ -505,3 +505,23 @@ def test_workers_that_cannot_start_stop_the_render_with_one_error(tmp_path):
     assert "(start method 'spawn') cannot rebuild the scene: PluginError:" in errors[0]
     assert "RuntimeError: imported in a worker" in errors[0]
     assert not out.exists()
+
+
+def test_preview_is_written_while_rendering(tmp_path, capsys):
+    out, preview = tmp_path / "out.png", tmp_path / "preview.png"
+    args = ["render", "cornell", *SMALL, "--spp", "4", "-j", "1", "-q", "-o", str(out)]
+    assert main([*args, "--preview", str(preview), "--preview-seconds", "0"]) == 0
+    with Image.open(preview) as im, Image.open(out) as final:
+        assert im.size == final.size
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.png", "preview.png"]
+
+
+@pytest.mark.parametrize("same", ["out.png", "./sub/../out.png"])
+def test_preview_needs_a_file_of_its_own(tmp_path, capsys, monkeypatch, same):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "sub").mkdir()
+    status = main(["render", "cornell", *SMALL, "-o", str(tmp_path / "out.png"),
+                   "--preview", same])  # fmt: skip
+    assert status == 2
+    assert "--preview" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sub"]
