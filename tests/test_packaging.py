@@ -148,3 +148,22 @@ def test_every_module_imports_without_posix_only_modules():
     assert result.returncode == 0, result.stderr
     modules = sum(1 for _ in (ROOT / "rtpy").rglob("*.py")) - 1  # all but __main__
     assert int(result.stdout) >= modules
+
+
+WITHOUT_TEST_EXTRAS = """
+import sys
+for name in ("pytest", "hypothesis", "_pytest"):
+    sys.modules[name] = None  # not installed: `pip install rtpy` without [test]
+from rtpy.io.cli import main
+sys.exit(main(["render", "--help"]))
+"""
+
+
+def test_the_command_line_starts_without_the_test_extras():
+    """pytest and hypothesis are the `test` extra, not dependencies: the command line
+    (whose `assignment` and `grade` commands use pytest) must start without them."""
+    result = subprocess.run(
+        [sys.executable, "-c", WITHOUT_TEST_EXTRAS], capture_output=True, text=True, timeout=120
+    )
+    assert result.returncode == 0, result.stderr
+    assert "--preview" in result.stdout

@@ -39,7 +39,8 @@ from pathlib import Path
 
 import pytest
 
-DUMP_GRACE = 5.0  # seconds between GraderTimeout and the faulthandler's exit
+from .autograder_run import DUMP_GRACE
+
 HIDDEN_PART = "/hidden/"  # a test file under assignments/weekNN/hidden/ is a hidden check
 
 

@@ -35,7 +35,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..io.image import atomic_write
-from .autograder_child import DUMP_GRACE
 from .autograder_seed import SEED_VARIABLE
 from .autograder_submission import (
     FRAME,
@@ -50,6 +49,7 @@ from .autograder_submission import (
 )
 
 CONFIG_FILE = "autograder.json"
+DUMP_GRACE = 5.0  # seconds between GraderTimeout and the child's faulthandler exit
 KILL_GRACE = 10.0  # seconds after the child's own faulthandler exit before it is killed
 POLL = 0.05
 RESULTS_SIZE = 60_000  # characters of output per test at most
