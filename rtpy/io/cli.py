@@ -11,6 +11,7 @@ import argparse
 import signal
 import sys
 import tomllib
+import warnings
 from pathlib import Path
 
 from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
@@ -336,12 +337,16 @@ def command_render(args: argparse.Namespace) -> int:
 def _render(args: argparse.Namespace) -> int:
     from .. import render
     from .bundled import resolve_scene
-    from .scene_file import SceneError, load_scene
+    from .scene_file import SceneError, SceneWarning, load_scene
 
     try:
         load_plugins(args.plugin)
         path = resolve_scene(args.scene)
-        scene = load_scene(path)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", SceneWarning)
+            scene = load_scene(path)
+        for warning in caught:  # one line each, as errors are
+            print(f"rtpy: warning: {warning.message}", file=sys.stderr)
         overrides = validate_overrides(parse_set(args.set))
         flags = {name: getattr(args, name) for name, setting in SETTINGS.items() if setting.flag}
         given = {k: read_value(v) for k, v in flags.items() if v is not None}

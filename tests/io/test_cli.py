@@ -401,6 +401,21 @@ def test_mesh_scene_with_a_malformed_obj_exits_2_naming_file_table_key_and_line(
     assert "m.obj line 3: expected 3 to 4 numbers after 'v'" in line
 
 
+def test_a_mesh_with_degenerate_faces_renders_with_a_one_line_warning(tmp_path):
+    (tmp_path / "m.obj").write_text("v 0 0 -2\nv 1 0 -2\nv 0 1 -2\nv 2 0 -2\nf 1 2 3\nf 1 2 4\n")
+    scene = tmp_path / "m.toml"
+    scene.write_text(
+        '[materials.m]\ntype = "lambertian"\n\n'
+        '[[objects]]\ntype = "mesh"\npath = "m.obj"\nmaterial = "m"\n'
+    )
+    out = tmp_path / "out.png"
+    result = run_cli("render", str(scene), "-o", str(out), "--quiet", "--width", "8", "--spp", "1")
+    assert result.returncode == 0 and out.exists()
+    (warning,) = [line for line in result.stderr.splitlines() if "warning" in line]
+    assert warning.startswith(f"rtpy: warning: {scene}: [[objects]] #1 path: skipped 1 degenerate")
+    assert "warnings.warn" not in result.stderr and "SceneWarning" not in result.stderr
+
+
 def render_under(method: str, *args: str) -> subprocess.CompletedProcess:
     """`python -m rtpy render ARGS` in a child whose start method is forced to `method`
     (what `python -m rtpy` does, after multiprocessing.set_start_method)."""
