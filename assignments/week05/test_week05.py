@@ -286,7 +286,9 @@ def test_direct_render_matches_reference():
         "DirectIntegrator.compute_scattering (direct_lighting already weighs the light a "
         "scattered ray finds); too dark near the area light: light_sample_estimate without "
         "its 1/pdf, or a shadow ray blocked by the light itself (pass light_shape as "
-        "ignore and use shadow_interval)",
+        "ignore and use shadow_interval); dark speckles on lit surfaces (shadow acne): the "
+        "shadow ray must leave through spawn_ray(hit.point, hit.normal, direction), whose "
+        "offset keeps it off the surface it starts on",
     )
 
 

@@ -391,6 +391,11 @@ SOURCE_MISTAKES = {
     "lambertian_pdf_uniform": (Lambertian, "pdf", ") * INV_PI", ") * 0.0 + 0.5 * INV_PI"),
     "estimate_without_1_over_pdf": (*LIGHT_SAMPLE, "(cos_i / sample.pdf)", "cos_i"),
     "shadow_ray_blocked_by_its_light": (*LIGHT_SAMPLE, "ignore=light_shape", "ignore=None"),
+    "shadow_ray_without_offset": (
+        *LIGHT_SAMPLE,
+        "spawn_ray(hit.point, normal, wi)",
+        "Ray(hit.point, wi)",
+    ),
     "direct_without_emission": (*DIRECT, "emitted + direct_lighting(", "direct_lighting("),
     "quad_uv_swapped": (Quad, "surface_uv", "a, b = self._coords", "b, a = self._coords"),
     "phong_albedo_as_brdf": (Phong, "BRDF", "* (self.kd * INV_PI)", "* self.kd"),
@@ -448,6 +453,7 @@ PLANTED = [
         ["test_light_sample_estimate", "test_direct_render_matches_reference"],
     ),
     ("05.4", source("shadow_ray_blocked_by_its_light"), ["test_light_sample_estimate"]),
+    ("05.4", source("shadow_ray_without_offset"), ["test_direct_render_matches_reference"]),
     (
         "05.4",
         source("direct_without_emission"),
@@ -634,3 +640,11 @@ def test_graders_that_cannot_load_score_zero(tmp_path, capsys, monkeypatch):
     results = json.loads(out.read_text())
     assert results["score"] == 0 and "no_such_module" in results["output"]
     assert "could not be loaded" in capsys.readouterr().out
+
+
+def test_shadow_acne_is_blamed_on_the_missing_spawn_ray(monkeypatch):
+    """A shadow ray that leaves from the hit point itself (no offset) darkens lit
+    surfaces with acne: the render grader's message names spawn_ray."""
+    source("shadow_ray_without_offset")(monkeypatch)
+    with pytest.raises(AssertionError, match=r"spawn_ray\(hit.point, hit.normal, direction\)"):
+        run_grader_test("05", "test_direct_render_matches_reference")
