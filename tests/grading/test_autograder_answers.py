@@ -30,14 +30,7 @@ ROOT = Path(__file__).resolve().parents[2]
 MIN_CALLS = 3  # shorter solutions have too common a trace to tell
 
 # (week, task, file::function that holds its trace) -> why it stays
-KNOWN = {
-    (
-        "05",
-        "DirectIntegrator.compute_scattering",
-        "rtpy/integrators/whitted.py::WhittedIntegrator.compute_scattering",
-    ): "Whitted's diffuse branch is emission plus direct_lighting, the direct "
-    "integrator's answer; left to the week-05 re-cut of issue 18 (whitted.py has no region)",
-}
+KNOWN: dict[tuple[str, str, str], str] = {}  # none left
 
 # file -> a phrase that answered the week's written question and must not come back
 ANSWERED_QUESTIONS = {
