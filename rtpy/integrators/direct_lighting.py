@@ -37,9 +37,11 @@ def sample_one_light(
     if sample is None or sample.radiance.is_black():
         return BLACK
     normal, wi = hit.normal, sample.direction
-    cos_i = dot(normal, wi)
-    if cos_i <= 0.0:
-        return BLACK  # the light is behind the surface
+    # A light behind the surface counts only through a BRDF that transmits (rough glass);
+    # every other BRDF is 0 there.
+    cos_i = abs(dot(normal, wi))
+    if cos_i == 0.0:
+        return BLACK
     shadow_ray = spawn_ray(hit.point, normal, wi)
     f = hit.material.BRDF(ray_in, shadow_ray, hit)
     if f.is_black():

@@ -8,11 +8,13 @@ statistics they rest on, scenes whose exact image is known
 """
 
 from .chi_square import Chi2Result, chi2_test
+from .energy import AlbedoEstimate, check_energy, directional_albedo
 from .local_setup import (
     ABSORBED,
     SCATTERED,
     SPECULAR,
     Samples,
+    brdf_between,
     draw_samples,
     incident_ray,
     light_ray,
@@ -21,13 +23,10 @@ from .local_setup import (
     view_ray,
 )
 from .material_checks import (
-    AlbedoEstimate,
     CheckResult,
-    check_energy,
     check_non_negative_finite,
     check_reciprocity,
     check_weights,
-    directional_albedo,
 )
 from .material_report import MaterialReport, assert_material, check_material, material_name
 from .quadrature import AdaptiveSimpson2D
@@ -53,6 +52,7 @@ __all__ = [
     "assert_material",
     "bonferroni_alpha",
     "bonferroni_z",
+    "brdf_between",
     "check_energy",
     "check_material",
     "check_non_negative_finite",
