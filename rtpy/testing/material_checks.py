@@ -173,10 +173,10 @@ def check_reciprocity(
                     theta = math.degrees(math.acos(r()))  # uniform on the hemisphere
                 dirs.append(local_direction(theta, 360.0 * r()))
             a, b = dirs
-            inside, eta_a, eta_b = False, 1.0, 1.0
+            inside, across, eta_a, eta_b = False, False, 1.0, 1.0
             if ior is not None:
-                inside = r() < 0.5
-                if r() < 0.5:  # b below the surface, on the other side
+                inside, across = r() < 0.5, r() < 0.5
+                if across:  # b below the surface, on the other side
                     b = Vec3(b.e0, b.e1, -b.e2)
                     eta_a, eta_b = (ior, 1.0) if inside else (1.0, ior)
             f_ab = brdf_between(material, a, b, inside)
@@ -191,7 +191,7 @@ def check_reciprocity(
                         f"e.g. wo = {vector_text(a.tolist())}, wi = {vector_text(b.tolist())}"
                         f"{where}: BRDF {color_text(x)}, swapped {color_text(y)}"
                     )
-                    if eta_a != eta_b:
+                    if across:
                         first += " (each over the index of refraction squared on its side)"
     if failures:
         return CheckResult(

@@ -30,6 +30,18 @@ def fresnel_dielectric(cos_i: np.ndarray, eta: np.ndarray) -> np.ndarray:
     return np.where(tir, 1.0, 0.5 * (r_s * r_s + r_p * r_p))
 
 
+def reflection_jacobian(wo_m: np.ndarray) -> np.ndarray:
+    """rough_dielectric.reflection_jacobian: 1 / (4 |wo.m|)."""
+    with np.errstate(over="ignore"):  # wo.m subnormal: inf, saturated by the pdf
+        return 0.25 / wo_m
+
+
+def refraction_jacobian(wo_m: np.ndarray, wi_m: np.ndarray, eta: np.ndarray) -> np.ndarray:
+    """rough_dielectric.refraction_jacobian: eta^2 |wi.m| / (eta wi.m + wo.m)^2."""
+    denominator = eta * wi_m + wo_m
+    return eta * eta * np.abs(wi_m) / (denominator * denominator)
+
+
 def where3(mask: np.ndarray, a: Columns, b: Columns) -> Columns:
     return np.where(mask, a[0], b[0]), np.where(mask, a[1], b[1]), np.where(mask, a[2], b[2])
 
@@ -115,11 +127,8 @@ class RoughDielectricKernel(Kernel):
     def pdf_at(self, f: Facets) -> np.ndarray:
         """RoughDielectric.pdf at the rows of f: (n,)."""
         density_m = f.d * dot(f.normal, f.m)
-        with np.errstate(over="ignore"):  # wo.m subnormal: inf, saturated below
-            reflected = f.fresnel * density_m * (0.25 / f.wo_m)
-        denominator = f.eta * f.wi_m + f.wo_m
-        jacobian = f.eta * f.eta * np.abs(f.wi_m) / (denominator * denominator)
-        transmitted = (1.0 - f.fresnel) * density_m * jacobian
+        reflected = f.fresnel * density_m * reflection_jacobian(f.wo_m)
+        transmitted = (1.0 - f.fresnel) * density_m * refraction_jacobian(f.wo_m, f.wi_m, f.eta)
         return np.minimum(np.where(f.reflects, reflected, transmitted), MAX_PDF)
 
     def BRDF(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
