@@ -12,7 +12,7 @@ byte-identically.
 """
 
 from make_cornell import add, box_quads, cross, dot, quad_block, scale, sub
-from scene_toml import Vec, fmt, write_scene
+from scene_toml import Vec, fmt, vec, write_scene
 
 OUT_NAME = "week08_rough_glass.toml"
 DESCRIPTION = "Week 8: rough glass (anti-glare, ground, etched) before a backdrop"
@@ -33,36 +33,30 @@ HEADER = f"""# {DESCRIPTION}
 # The lecture's glasses (Walter et al. 2007), left to right: anti-glare (Beckmann,
 # roughness 0.023), ground (GGX, 0.394), etched (GGX, 0.553); ior 1.5. Each pane is a
 # closed box of six quads, 0.08 thick, 0.21 in front of a checkered backdrop.
-
-[camera]
-look_from = [0, 0.9, 4.6]
-look_at = [0, 0.6, 0]
-vfov = 30
-width = 480
-
-[render]
-spp = 256
-max_depth = 10
-background = [0.01, 0.01, 0.015]
-
-[textures.checker]
-type = "checker"
-scale = 0.12
-even = [0.85, 0.82, 0.75]
-odd = [0.08, 0.12, 0.3]
-
-[materials.backdrop]
-type = "lambertian"
-albedo = "checker"
-
-[materials.floor]
-type = "lambertian"
-albedo = [0.45, 0.42, 0.4]
-
-[materials.light]
-type = "diffuse_light"
-emit = [5, 5, 5]
 """
+
+# The scene's tables before the glasses: {table: {key: value}}.
+TABLES = {
+    "camera": dict(look_from=(0, 0.9, 4.6), look_at=(0, 0.6, 0), vfov=30, width=480),
+    "render": dict(spp=256, max_depth=10, background=(0.01, 0.01, 0.015)),
+    "textures.checker": dict(
+        type="checker", scale=0.12, even=(0.85, 0.82, 0.75), odd=(0.08, 0.12, 0.3)
+    ),
+    "materials.backdrop": dict(type="lambertian", albedo="checker"),
+    "materials.floor": dict(type="lambertian", albedo=(0.45, 0.42, 0.4)),
+    "materials.light": dict(type="diffuse_light", emit=(5, 5, 5)),
+}
+
+
+def toml_value(value) -> str:
+    if isinstance(value, str):
+        return f'"{value}"'
+    return vec(value) if isinstance(value, tuple) else fmt(value)
+
+
+def toml_table(name: str, keys: dict) -> str:
+    return f"\n[{name}]\n" + "".join(f"{k} = {toml_value(v)}\n" for k, v in keys.items())
+
 
 # (comment, q, u, v, material): the floor, the backdrop and the light, u x v facing the scene.
 ROOM = [
@@ -72,19 +66,12 @@ ROOM = [
 ]
 
 
-def glass_table(name: str, distribution: str, roughness: float) -> str:
-    return (
-        f"\n[materials.{name}]\n"
-        'type = "rough_dielectric"\n'
-        "ior = 1.5\n"
-        f"roughness = {fmt(roughness)}\n"
-        f'distribution = "{distribution}"\n'
-    )
-
-
 def build() -> str:
     parts = [HEADER]
-    parts += [glass_table(*glass) for glass in GLASSES]
+    parts += [toml_table(name, keys) for name, keys in TABLES.items()]
+    for name, distribution, roughness in GLASSES:
+        keys = dict(type="rough_dielectric", ior=1.5, roughness=roughness)
+        parts.append(toml_table(f"materials.{name}", keys | {"distribution": distribution}))
     for comment, q, u, v, material in ROOM:
         normal = cross(u, v)
         assert normal[1] < 0 if material == "light" else normal[1] > 0 or normal[2] > 0

@@ -8,7 +8,6 @@ statistics they rest on, scenes whose exact image is known
 """
 
 from .chi_square import Chi2Result, chi2_test
-from .energy import AlbedoEstimate, check_energy, directional_albedo
 from .local_setup import (
     ABSORBED,
     SCATTERED,
@@ -23,12 +22,14 @@ from .local_setup import (
     view_ray,
 )
 from .material_checks import (
+    AlbedoEstimate,
     CheckResult,
-    check_non_negative_finite,
-    check_reciprocity,
+    check_energy,
     check_weights,
+    directional_albedo,
 )
 from .material_report import MaterialReport, assert_material, check_material, material_name
+from .pointwise_checks import check_non_negative_finite, check_reciprocity
 from .quadrature import AdaptiveSimpson2D
 from .statistics import (
     bonferroni_alpha,

@@ -150,6 +150,7 @@ def draw_samples(
     n: int = 100_000,
     seed: int = 0,
     phi_deg: float = 0.0,
+    *,
     inside: bool = False,
 ) -> Samples:
     """Call material.scattering() n times for the incoming ray of the test setup,
@@ -190,7 +191,7 @@ def draw_samples(
 
 def get_samples(material, incident_deg, n, seed, phi_deg, samples, inside=False) -> Samples:
     if samples is None:
-        return draw_samples(material, incident_deg, n, seed, phi_deg, inside)
+        return draw_samples(material, incident_deg, n, seed, phi_deg, inside=inside)
     if (samples.incident_deg, samples.phi_deg, samples.inside) != (incident_deg, phi_deg, inside):
         raise ValueError("the samples were drawn for another incident direction")
     return samples

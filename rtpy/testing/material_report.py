@@ -30,14 +30,9 @@ from ..materials.material import Material
 from ..texture import Texture
 from ..vec3 import Vec3
 from .chi_square import chi2_test
-from .energy import check_energy
 from .local_setup import Samples, color_text, draw_samples
-from .material_checks import (
-    CheckResult,
-    check_non_negative_finite,
-    check_reciprocity,
-    check_weights,
-)
+from .material_checks import CheckResult, check_energy, check_weights
+from .pointwise_checks import check_non_negative_finite, check_reciprocity
 from .statistics import sidak_alpha
 
 __all__ = ["MaterialReport", "assert_material", "check_material", "material_name"]

@@ -42,11 +42,14 @@ from ..tiers import slow_except
 from ..vectors import angle, dot3, unit3
 from .directions import (
     NORMAL,
+    X,
+    Z,
     check_refused,
     hemisphere_integral,
     light_ray,
     load_material,
     make_hit,
+    mirror,
     view_ray,
 )
 from .directions import polar as direction
@@ -330,14 +333,13 @@ def visible_facet_loss(m: RoughDielectric, theta_deg: float, inside: bool) -> fl
     g_o = ref_G1(dist, a, t_o)
 
     def integrand(t, p):
-        s = math.sin(t)
-        mf = (s * math.cos(p), s * math.sin(p), math.cos(t))
+        mf = direction(t, p, Z, X)
         c = dot3(wo, mf)
         if c <= 0.0:
-            return 0.0
+            return 0.0  # a facet the viewer cannot see
         f_r = ref_fresnel(c, n_other / n_o)
-        reflected = tuple(2.0 * c * mf[k] - wo[k] for k in range(3))
-        kept = f_r * (ref_G1(dist, a, math.acos(reflected[2])) if reflected[2] > 0.0 else 0.0)
+        z_r = mirror(wo, mf)[2]
+        kept = f_r * ref_G1(dist, a, math.acos(z_r)) if z_r > 0.0 else 0.0
         if f_r < 1.0:
             eta = n_o / n_other  # Snell, through the facet
             cos_t = math.sqrt(1.0 - eta * eta * (1.0 - c * c))

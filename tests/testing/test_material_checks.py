@@ -1,23 +1,20 @@
-"""Tests for rtpy.testing.material_checks: correct materials pass, and each kind
-of broken material is caught by the check meant for it."""
+"""Tests for rtpy.testing.material_checks: correct materials pass check_weights and
+check_energy (whose directional albedos by sampling and by quadrature agree, on one
+side of the surface or both), and each kind of broken material is caught by the check
+meant for it."""
 
 from __future__ import annotations
 
 import pytest
 
-from rtpy.materials import Lambertian, Mirror
-from rtpy.testing import (
-    check_non_negative_finite,
-    check_reciprocity,
-    check_weights,
-)
-from rtpy.vec3 import dot
+from rtpy.materials import Lambertian
+from rtpy.testing import check_energy, check_weights, directional_albedo
+from rtpy.vec3 import Color
 
 from .materials_to_check import (
     DiffuseTransmitter,
     ForgetsPdf,
-    NegativeAtGrazing,
-    NonReciprocal,
+    HalfSampler,
     PhongLobe,
     UpperPdfOnly,
     WrongRecordedPdf,
@@ -41,21 +38,6 @@ def test_check_weights_catches_a_wrong_recorded_pdf():
     assert not result and "ScatterInfo.pdf" in result.detail
 
 
-def test_check_reciprocity():
-    assert check_reciprocity(Lambertian())
-    assert check_reciprocity(PhongLobe(100.0, kd=0.3, ks=0.7))
-    result = check_reciprocity(NonReciprocal(), n_pairs=200)
-    assert not result and "differ" in result.detail
-
-
-def test_check_non_negative_finite():
-    assert check_non_negative_finite(Lambertian())
-    assert check_non_negative_finite(PhongLobe(1e4, kd=0.5, ks=0.5))
-    assert check_non_negative_finite(Mirror())
-    result = check_non_negative_finite(NegativeAtGrazing(), n=10)
-    assert not result and "BRDF" in result.detail
-
-
 @pytest.mark.parametrize("inside", [False, True])
 def test_check_weights_sees_both_sides(inside):
     result = check_weights(DiffuseTransmitter(), 40.0, inside=inside)
@@ -65,28 +47,52 @@ def test_check_weights_sees_both_sides(inside):
     assert not result and "pdf() = 0.0" in result.detail
 
 
-class ScaledTransmitter(DiffuseTransmitter):
-    """Transmission scaled as radiance is on refraction into a medium of index 1.5:
-    f(wo, wi) / n_o^2 = f(wi, wo) / n_i^2 holds, f(wo, wi) = f(wi, wo) does not."""
-
-    def BRDF(self, ray_view, ray_light, hit):
-        f = super().BRDF(ray_view, ray_light, hit)
-        if dot(hit.normal, ray_light.direction) < 0.0:
-            n_o, n_i = (1.0, 1.5) if hit.front_face else (1.5, 1.0)
-            f = f * (n_o / n_i)
-        return f
-
-
-def test_check_reciprocity_across_a_refracting_surface():
-    assert check_reciprocity(DiffuseTransmitter(), ior=1.0)
-    assert check_reciprocity(ScaledTransmitter(), ior=1.5)
-    # Without ior only pairs above the surface are drawn: transmission goes unchecked.
-    assert check_reciprocity(ScaledTransmitter())
-    for ior in (1.0, 2.0):
-        result = check_reciprocity(ScaledTransmitter(), n_pairs=200, ior=ior)
-        assert not result and "index of refraction squared" in result.detail
+def test_directional_albedo_by_sampling_and_quadrature():
+    a = directional_albedo(Lambertian(Color(0.8, 0.5, 0.25)), 45.0, n_samples=1000)
+    assert a.sampled == pytest.approx((0.8, 0.5, 0.25), rel=1e-12)
+    assert a.quadrature == pytest.approx((0.8, 0.5, 0.25), rel=1e-7)
+    # A Phong lobe at 60 degrees: the part of the lobe above the surface times
+    # (n+2)/(n+1) <cos theta_i>; for n = 1e4 the lobe is a near-delta at 60 degrees.
+    a = directional_albedo(PhongLobe(1e4), 60.0, n_samples=20_000)
+    assert a.quadrature[0] == pytest.approx(0.5, abs=1e-4)
+    assert a.sampled[0] == pytest.approx(a.quadrature[0], abs=5 * a.standard_error[0] + 1e-6)
 
 
-def test_check_non_negative_finite_from_inside():
-    result = check_non_negative_finite(DiffuseTransmitter(), inside=True)
-    assert result and result.inside
+def test_check_energy_accepts_correct_materials():
+    assert check_energy(Lambertian(Color(1.0, 1.0, 1.0)), 30.0, n_samples=2000)
+    assert check_energy(PhongLobe(10.0, kd=0.5, ks=0.5), 30.0, n_samples=20_000)
+
+
+def test_check_energy_catches_an_albedo_above_one():
+    result = check_energy(Lambertian(Color(1.3, 1.3, 1.3)), 30.0, n_samples=2000)
+    assert not result and "> 1" in result.detail
+
+
+def test_check_energy_catches_sampling_that_misses_part_of_the_brdf():
+    # HalfSampler passes the chi2 and weights checks: only the energy check sees
+    # that the mean weight (albedo / 2) is not the integral of BRDF * cos (albedo).
+    assert check_weights(HalfSampler(), 30.0)
+    result = check_energy(HalfSampler(), 30.0, n_samples=20_000)
+    assert not result and "disagrees" in result.detail
+
+
+@pytest.mark.parametrize("inside", [False, True])
+def test_directional_albedo_of_a_material_that_transmits(inside):
+    a = directional_albedo(DiffuseTransmitter(0.3, 0.5), 50.0, n_samples=2000, inside=inside)
+    assert a.two_sided
+    assert a.sampled == pytest.approx((0.8, 0.8, 0.8), rel=1e-12)  # every weight is r + t
+    assert a.reflected == pytest.approx((0.3, 0.3, 0.3), rel=1e-7)
+    assert a.transmitted == pytest.approx((0.5, 0.5, 0.5), rel=1e-7)
+    assert a.transmitted_power == pytest.approx((0.5, 0.5, 0.5), rel=1e-7)  # reciprocal
+    assert a.lost == pytest.approx((0.2, 0.2, 0.2), rel=1e-6)
+    one_sided = directional_albedo(DiffuseTransmitter(), 50.0, n_samples=2000, two_sided=False)
+    assert one_sided.quadrature == pytest.approx((0.3, 0.3, 0.3), rel=1e-7)
+
+
+def test_check_energy_on_both_sides():
+    assert check_energy(DiffuseTransmitter(0.3, 0.5), 30.0, n_samples=2000, inside=True)
+    result = check_energy(DiffuseTransmitter(0.6, 0.6), 30.0, n_samples=2000)
+    assert not result and "> 1" in result.detail and "transmitted 0.6000" in result.detail
+    # The transmitted half, left out of the quadrature, is missing from it.
+    result = check_energy(DiffuseTransmitter(), 30.0, n_samples=2000, two_sided=False)
+    assert not result and "disagrees" in result.detail
