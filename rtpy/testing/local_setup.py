@@ -148,10 +148,10 @@ def draw_samples(
     material: Material,
     incident_deg: float,
     n: int = 100_000,
-    seed: int = 0,
-    phi_deg: float = 0.0,
     *,
     inside: bool = False,
+    seed: int = 0,
+    phi_deg: float = 0.0,
 ) -> Samples:
     """Call material.scattering() n times for the incoming ray of the test setup,
     under a generator fixed by (seed, incident angle, phi, side)."""
@@ -191,7 +191,7 @@ def draw_samples(
 
 def get_samples(material, incident_deg, n, seed, phi_deg, samples, inside=False) -> Samples:
     if samples is None:
-        return draw_samples(material, incident_deg, n, seed, phi_deg, inside=inside)
+        return draw_samples(material, incident_deg, n, seed=seed, phi_deg=phi_deg, inside=inside)
     if (samples.incident_deg, samples.phi_deg, samples.inside) != (incident_deg, phi_deg, inside):
         raise ValueError("the samples were drawn for another incident direction")
     return samples

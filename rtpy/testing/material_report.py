@@ -197,7 +197,7 @@ def check_material(
 def _draw(material: Material, theta: float, n: int, seed: int, inside: bool):
     """draw_samples, or a failed CheckResult when scattering() raised."""
     try:
-        return draw_samples(material, theta, n, seed, inside=inside)
+        return draw_samples(material, theta, n, seed=seed, inside=inside)
     except Exception as error:
         detail = f"raised {type(error).__name__}: {error}"
         return CheckResult("scattering", theta, False, detail, inside=inside)
