@@ -120,8 +120,8 @@ def cosine_with_unnormalised_vector(mp):
         mp,
         direct_lighting,
         "sample_one_light",
-        "cos_i = dot(normal, wi)",
-        "d = sample.point - hit.point; cos_i = dot(normal, d)",
+        "cos_i = abs(dot(normal, wi))",
+        "d = sample.point - hit.point; cos_i = abs(dot(normal, d))",
     )
 
 
