@@ -239,7 +239,7 @@ class RoughDielectric(Material):
         else:
             wi = refract(d, m, 1.0 / eta)
             if dot(normal, wi) >= 0.0:
-                return None  # refracted back out of the surface
+                return None  # refracted to the viewer's side of the surface
         ray_light = spawn_ray(hit.point, normal, wi)
         pdf = self.pdf(ray_in, ray_light, hit)
         if not pdf > 0.0:
