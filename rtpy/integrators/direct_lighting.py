@@ -40,9 +40,11 @@ def light_sample_estimate(
     testing light_shape, the light's own shape (None for a point light)."""
     # BEGIN SOLUTION week05: shadow ray toward the light, f_r * L * cos / pdf
     normal, wi = hit.normal, sample.direction
-    cos_i = dot(normal, wi)
-    if cos_i <= 0.0:
-        return BLACK  # the light is behind the surface
+    # A light behind the surface counts only through a BRDF that transmits (rough glass);
+    # every other BRDF is 0 there.
+    cos_i = abs(dot(normal, wi))
+    if cos_i == 0.0:
+        return BLACK
     shadow_ray = spawn_ray(hit.point, normal, wi)
     f = hit.material.BRDF(ray_in, shadow_ray, hit)
     if f.is_black():

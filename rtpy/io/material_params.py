@@ -33,6 +33,7 @@ MATERIAL_RANGES: dict[str, Range] = {
     "alpha_x": POSITIVE,
     "alpha_y": POSITIVE,
     "sigma": NON_NEGATIVE,
+    "tint": UNIT,
 }
 
 

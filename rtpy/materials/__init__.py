@@ -6,6 +6,8 @@
 | "mirror"        | Mirror       | albedo ([1, 1, 1])                              |
 | "metal"         | Metal        | albedo ([0.5, 0.5, 0.5]), fuzz (0)              |
 | "dielectric"    | Dielectric   | ior (1.5), albedo ([1, 1, 1])                   |
+| "rough_dielectric" | RoughDielectric | ior (1.5), roughness (0.1), distribution |
+|                 |              | ("ggx"; or "beckmann"), tint ([1, 1, 1])        |
 | "diffuse_light" | DiffuseLight | emit (required), two_sided (false)             |
 | "phong"         | Phong        | albedo ([0.5, 0.5, 0.5]), kd (1), ks (0), exponent (1) |
 | "blinn_phong"   | BlinnPhong   | albedo ([0.5, 0.5, 0.5]), kd (1), ks (0), exponent (1) |
@@ -31,6 +33,7 @@ from .metal import Metal
 from .mirror import Mirror
 from .oren_nayar import OrenNayar
 from .phong import Phong
+from .rough_dielectric import RoughDielectric
 from .ward import Ward
 
 MATERIALS: dict[str, type[Material]] = {
@@ -38,6 +41,7 @@ MATERIALS: dict[str, type[Material]] = {
     "mirror": Mirror,
     "metal": Metal,
     "dielectric": Dielectric,
+    "rough_dielectric": RoughDielectric,
     "diffuse_light": DiffuseLight,
     "phong": Phong,
     "blinn_phong": BlinnPhong,
@@ -71,6 +75,7 @@ __all__ = [
     "Mirror",
     "OrenNayar",
     "Phong",
+    "RoughDielectric",
     "Ward",
     "halfvector",
     "reflect",

@@ -13,6 +13,7 @@ from .local_setup import (
     SCATTERED,
     SPECULAR,
     Samples,
+    brdf_between,
     draw_samples,
     incident_ray,
     light_ray,
@@ -24,12 +25,11 @@ from .material_checks import (
     AlbedoEstimate,
     CheckResult,
     check_energy,
-    check_non_negative_finite,
-    check_reciprocity,
     check_weights,
     directional_albedo,
 )
 from .material_report import MaterialReport, assert_material, check_material, material_name
+from .pointwise_checks import check_non_negative_finite, check_reciprocity
 from .quadrature import AdaptiveSimpson2D
 from .statistics import (
     bonferroni_alpha,
@@ -53,6 +53,7 @@ __all__ = [
     "assert_material",
     "bonferroni_alpha",
     "bonferroni_z",
+    "brdf_between",
     "check_energy",
     "check_material",
     "check_non_negative_finite",

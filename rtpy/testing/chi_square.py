@@ -147,9 +147,14 @@ class _BinIntegrals:
     in probability, is 0.01 * sqrt(expected count) / n, at least 0.01 / n: the
     chi2 statistic moves by < 1e-4 per bin."""
 
-    def __init__(self, material: Material, ray_view: Ray, shape: tuple[int, int], n: int, spacing):
+    def __init__(
+        self, material: Material, samples: Samples, shape: tuple[int, int], spacing: float
+    ) -> None:
         theta_bins, phi_bins = shape
-        self.material, self.ray_view, self.hit = material, ray_view, local_hit(material)
+        n = samples.n
+        self.material = material
+        self.ray_view = incident_ray(samples.incident_deg, samples.phi_deg)
+        self.hit = local_hit(material, samples.inside)
         self.half = half = theta_bins // 2
         self.bad_values: list[str] = []
         self.guides: dict[tuple[int, int], tuple] = {}  # bin -> (samples' theta, phi, spacing)
@@ -345,6 +350,7 @@ def chi2_test(
     samples: Samples | None = None,
     node_spacing: float = 0.035,
     min_expected: float = 5.0,
+    inside: bool = False,
 ) -> Chi2Result:
     """Pearson's chi-square test of scattering() against pdf().
 
@@ -357,17 +363,17 @@ def chi2_test(
     category. A sample in a bin where pdf() integrates to 0 fails the test
     outright (p = 0), as does a pdf() value that is negative or not finite, or
     a pdf() whose integral over the sphere exceeds 1 by more than the
-    quadrature's uncertainty.
+    quadrature's uncertainty. inside: the viewer is inside the material (the hit
+    on its back face).
     """
     if theta_bins < 2 or theta_bins % 2 or phi_bins < 1:
         raise ValueError("theta_bins must be even and >= 2, phi_bins >= 1")
     if material.is_specular:
         raise ValueError("a specular (delta) material has no density to test")
     start = time.perf_counter()
-    samples = get_samples(material, incident_deg, n_samples, seed, phi_deg, samples)
+    samples = get_samples(material, incident_deg, n_samples, seed, phi_deg, samples, inside)
     hist = _histogram(samples, theta_bins, phi_bins)
-    ray_view = incident_ray(incident_deg, phi_deg)
-    bins = _BinIntegrals(material, ray_view, (theta_bins, phi_bins), samples.n, node_spacing)
+    bins = _BinIntegrals(material, samples, (theta_bins, phi_bins), node_spacing)
     integral, errors = bins.integrate_all(hist, samples.n)
     result = _assess(samples, hist, bins, integral, errors, min_expected)
     result.seconds = time.perf_counter() - start

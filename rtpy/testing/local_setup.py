@@ -5,6 +5,10 @@ incoming ray arrives from incident angle theta (and azimuth phi), that is
 ray_in.direction = -(sin t cos p, sin t sin p, cos t), so the viewer sits at
 wo = (sin t cos p, sin t sin p, cos t). In this frame the local and world
 coordinates are the same.
+
+The normal faces the viewer, as hit.normal always does. Seen from outside (the
+default) the hit is on the front face; seen from inside (inside=True) on the back
+face: the viewer is in the material (inside glass), the geometric outside below.
 """
 
 from __future__ import annotations
@@ -20,13 +24,14 @@ from ..hit_info import HitInfo
 from ..materials.material import Material
 from ..ray import Ray
 from ..sampling import make_generator, use_generator
-from ..vec3 import Vec3
+from ..vec3 import Color, Vec3
 
 __all__ = [
     "ABSORBED",
     "SCATTERED",
     "SPECULAR",
     "Samples",
+    "brdf_between",
     "draw_samples",
     "incident_ray",
     "light_ray",
@@ -54,10 +59,11 @@ def local_direction(theta_deg: float, phi_deg: float = 0.0) -> Vec3:
     return Vec3(s * math.cos(p), s * math.sin(p), math.cos(t))
 
 
-def local_hit(material: Material | None = None) -> HitInfo:
+def local_hit(material: Material | None = None, inside: bool = False) -> HitInfo:
     """A hit on the flat test surface: point at the origin, normal (0, 0, 1),
-    tangent (1, 0, 0), front face, surface coordinates (0.5, 0.5)."""
-    hit = HitInfo(ORIGIN, NORMAL, 1.0, True, material, None, 0.5, 0.5)
+    tangent (1, 0, 0), surface coordinates (0.5, 0.5); the front face, or with
+    inside=True the back face (the viewer inside the material)."""
+    hit = HitInfo(ORIGIN, NORMAL, 1.0, not inside, material, None, 0.5, 0.5)
     hit.tangent = TANGENT
     return hit
 
@@ -77,6 +83,22 @@ def incident_ray(theta_deg: float, phi_deg: float = 0.0) -> Ray:
     return view_ray(local_direction(theta_deg, phi_deg))
 
 
+def turned_over(v: Vec3) -> Vec3:
+    """v in the test setup turned over (half a turn about the tangent x): (x, -y, -z)."""
+    return Vec3(v.e0, -v.e1, -v.e2)
+
+
+def brdf_between(material: Material, wo: Vec3, wi: Vec3, inside: bool = False) -> Color:
+    """material.BRDF for the viewer in unit direction wo and the light in unit direction
+    wi, on either side of the test surface (inside: the side above is the inside). A
+    viewer below the surface faces the other face: the setup is turned over, so that
+    the normal faces the viewer as always."""
+    if wo.e2 >= 0.0:
+        return material.BRDF(view_ray(wo), light_ray(wi), local_hit(material, inside))
+    hit = local_hit(material, not inside)
+    return material.BRDF(view_ray(turned_over(wo)), light_ray(turned_over(wi)), hit)
+
+
 # --- sampling the material ------------------------------------------------------------------
 
 SCATTERED, ABSORBED, SPECULAR = 0, 1, 2
@@ -88,7 +110,8 @@ class Samples:
 
     directions (n, 3), weights (n, 3) and pdfs (n,) are NaN where status is not
     SCATTERED; status is SCATTERED, ABSORBED (scattering returned None) or
-    SPECULAR (a delta bounce, ScatterInfo.is_specular).
+    SPECULAR (a delta bounce, ScatterInfo.is_specular). inside: the viewer was
+    inside the material (the hit on the back face).
     """
 
     incident_deg: float
@@ -98,6 +121,7 @@ class Samples:
     pdfs: np.ndarray
     status: np.ndarray
     seconds: float
+    inside: bool = False
 
     @property
     def n(self) -> int:
@@ -107,24 +131,38 @@ class Samples:
     def scattered(self) -> np.ndarray:
         return self.status == SCATTERED
 
+    @property
+    def transmitted(self) -> np.ndarray:
+        """The scattered samples that went through the surface (below it)."""
+        return self.scattered & (self.directions[:, 2] < 0.0)
 
-def sampling_generator(seed: int, tag: int, incident_deg: float, phi_deg: float):
-    return make_generator(seed, tag, round(incident_deg * 1e6), round(phi_deg * 1e6))
+
+def sampling_generator(
+    seed: int, tag: int, incident_deg: float, phi_deg: float, inside: bool = False
+):
+    key = (seed, tag, round(incident_deg * 1e6), round(phi_deg * 1e6))
+    return make_generator(*key, 1) if inside else make_generator(*key)
 
 
 def draw_samples(
-    material: Material, incident_deg: float, n: int = 100_000, seed: int = 0, phi_deg: float = 0.0
+    material: Material,
+    incident_deg: float,
+    n: int = 100_000,
+    *,
+    inside: bool = False,
+    seed: int = 0,
+    phi_deg: float = 0.0,
 ) -> Samples:
     """Call material.scattering() n times for the incoming ray of the test setup,
-    under a generator fixed by (seed, incident angle, phi)."""
+    under a generator fixed by (seed, incident angle, phi, side)."""
     ray_in = incident_ray(incident_deg, phi_deg)
-    hit = local_hit(material)
+    hit = local_hit(material, inside)
     nan = math.nan
     none_row = (nan, nan, nan, nan, nan, nan, nan)
     rows, status = [], []
     scatter = material.scattering
     start = time.perf_counter()
-    with use_generator(sampling_generator(seed, SAMPLING, incident_deg, phi_deg)):
+    with use_generator(sampling_generator(seed, SAMPLING, incident_deg, phi_deg, inside)):
         for _ in range(n):
             s = scatter(ray_in, hit)
             if s is None:
@@ -147,13 +185,14 @@ def draw_samples(
         table[:, 6],
         np.array(status, dtype=np.int8),
         seconds,
+        inside,
     )
 
 
-def get_samples(material, incident_deg, n, seed, phi_deg, samples) -> Samples:
+def get_samples(material, incident_deg, n, seed, phi_deg, samples, inside=False) -> Samples:
     if samples is None:
-        return draw_samples(material, incident_deg, n, seed, phi_deg)
-    if samples.incident_deg != incident_deg or samples.phi_deg != phi_deg:
+        return draw_samples(material, incident_deg, n, seed=seed, phi_deg=phi_deg, inside=inside)
+    if (samples.incident_deg, samples.phi_deg, samples.inside) != (incident_deg, phi_deg, inside):
         raise ValueError("the samples were drawn for another incident direction")
     return samples
 

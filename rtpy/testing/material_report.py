@@ -30,14 +30,9 @@ from ..materials.material import Material
 from ..texture import Texture
 from ..vec3 import Vec3
 from .chi_square import chi2_test
-from .local_setup import color_text, draw_samples
-from .material_checks import (
-    CheckResult,
-    check_energy,
-    check_non_negative_finite,
-    check_reciprocity,
-    check_weights,
-)
+from .local_setup import Samples, color_text, draw_samples
+from .material_checks import CheckResult, check_energy, check_weights
+from .pointwise_checks import check_non_negative_finite, check_reciprocity
 from .statistics import sidak_alpha
 
 __all__ = ["MaterialReport", "assert_material", "check_material", "material_name"]
@@ -83,18 +78,17 @@ class MaterialReport:
         verdict = "PASSED" if self.passed else f"FAILED ({n_fail} of {len(self.checks)} checks)"
         lines = [
             f"{self.material}: {verdict}",
-            f"{'check':<12} {'angle':>6}  {'result':<7} {'p-value':<9} details",
+            f"{'check':<12} {'angle':>7}  {'result':<7} {'p-value':<9} details",
         ]
         for c in self.checks:
-            angle = "all" if c.incident_deg is None else f"{c.incident_deg:g}"
             result = "skipped" if c.skipped else ("pass" if c.passed else "FAIL")
             p = "-" if c.p_value is None else f"{c.p_value:.3g}"
-            lines.append(f"{c.check:<12} {angle:>6}  {result:<7} {p:<9} {c.detail}")
+            lines.append(f"{c.check:<12} {c.angle_text:>7}  {result:<7} {p:<9} {c.detail}")
         if not self.passed:
             lines.append(_hints(self.failures))
         lines.append(
             f"(chi2 tests reject at p < {self.alpha:.3g} each: alpha Sidak-corrected over "
-            f"the incident angles; {self.seconds:.1f} s)"
+            f"the incident angles and sides; {self.seconds:.1f} s)"
         )
         return "\n".join(lines)
 
@@ -106,7 +100,8 @@ _HINTS = {
     "energy": "energy: the mean weight and the integral of BRDF * cos disagree, or exceed 1 "
     "(check the BRDF's normalisation, and that sampling covers every direction "
     "where the BRDF is not 0).",
-    "reciprocity": "reciprocity: BRDF(wo, wi) must equal BRDF(wi, wo).",
+    "reciprocity": "reciprocity: BRDF(wo, wi) must equal BRDF(wi, wo) (across a refracting "
+    "surface, each over the index of refraction squared on its side).",
     "finite >= 0": "finite >= 0: guard divisions by cosines that reach 0 at grazing angles.",
 }
 
@@ -116,11 +111,14 @@ def _hints(failures: list[CheckResult]) -> str:
     return "\n".join("hint: " + _HINTS[name] for name in seen if name in _HINTS)
 
 
-def _run(check: str, incident_deg: float | None, fn: Callable[[], CheckResult]) -> CheckResult:
+def _run(
+    check: str, incident_deg: float | None, fn: Callable[[], CheckResult], inside: bool = False
+) -> CheckResult:
     try:
         return fn()
     except Exception as error:  # a crash is a failed check, reported like the others
-        return CheckResult(check, incident_deg, False, f"raised {type(error).__name__}: {error}")
+        detail = f"raised {type(error).__name__}: {error}"
+        return CheckResult(check, incident_deg, False, detail, inside=inside)
 
 
 def check_material(
@@ -133,62 +131,108 @@ def check_material(
     max_albedo: float | None = 1.0,
     theta_bins: int = 24,
     phi_bins: int = 48,
+    inside: bool | None = None,
+    ior: float | None = None,
 ) -> MaterialReport:
     """Run every check on `material` and return a MaterialReport (print it).
 
     Per incident angle: chi2_test, check_weights, check_energy (its <= max_albedo
     part skipped when max_albedo is None); once: check_reciprocity (when
     `reciprocal`) and check_non_negative_finite. The chi2 and energy tests use
-    the per-test significance sidak_alpha(alpha, number of angles). One set of
-    n_samples draws per angle serves the chi2, weights and energy checks.
+    the per-test significance sidak_alpha(alpha, number of angles and sides). One
+    set of n_samples draws per angle serves the chi2, weights and energy checks.
+
+    A material that transmits (glass: some sample went below the surface) is
+    checked from both sides: every angle from outside and from inside it, the
+    energy over the whole sphere (reflected plus transmitted), and reciprocity
+    across the surface too, with `ior` the index of refraction inside over outside
+    (default: the material's own `ior`). inside=True or False forces checking
+    from inside, or not.
     """
     start = time.perf_counter()
     angles = [float(t) for t in incident_angles]
-    a = sidak_alpha(alpha, max(1, len(angles)))
     checks: list[CheckResult] = []
-    specular = material.is_specular
-    for theta in angles:
-        if specular:
-            checks.append(
-                CheckResult("chi2", theta, True, "specular material: no density", skipped=True)
-            )
-            continue
-        try:
-            samples = draw_samples(material, theta, n_samples, seed)
-        except Exception as error:
-            checks.append(
-                CheckResult("scattering", theta, False, f"raised {type(error).__name__}: {error}")
-            )
-            continue
-
-        def chi2(theta=theta, samples=samples) -> CheckResult:
-            r = chi2_test(
-                material, theta, samples=samples, theta_bins=theta_bins, phi_bins=phi_bins
-            )
-            ok = r.passed(a)
-            return CheckResult("chi2", theta, ok, r.summary(worst=not ok), p_value=r.p_value)
-
-        checks.append(_run("chi2", theta, chi2))
+    if material.is_specular:
+        checks = [
+            CheckResult("chi2", theta, True, "specular material: no density", skipped=True)
+            for theta in angles
+        ]
         checks.append(
-            _run("weights", theta, lambda t=theta, s=samples: check_weights(material, t, samples=s))
+            _run("finite >= 0", None, lambda: check_non_negative_finite(material, seed=seed))
         )
+        a = sidak_alpha(alpha, max(1, len(angles)))
+        return MaterialReport(material_name(material), checks, a, time.perf_counter() - start)
+    outside = {theta: _draw(material, theta, n_samples, seed, False) for theta in angles}
+    transmits = any(
+        not isinstance(s, CheckResult) and bool(s.transmitted.any()) for s in outside.values()
+    )
+    sides = (False, True) if (transmits if inside is None else inside) else (False,)
+    a = sidak_alpha(alpha, max(1, len(angles) * len(sides)))
+    options = dict(theta_bins=theta_bins, phi_bins=phi_bins, two_sided=transmits)
+    options["max_albedo"] = math.inf if max_albedo is None else max_albedo
+    for side in sides:
+        for theta in angles:
+            samples = outside[theta] if not side else _draw(material, theta, n_samples, seed, True)
+            if isinstance(samples, CheckResult):
+                checks.append(samples)  # scattering() raised
+                continue
+            checks += _checks_at(material, samples, a, options)
+    if reciprocal:
+        if ior is None and transmits:
+            ior = getattr(material, "ior", None)
+        checks.append(
+            _run("reciprocity", None, lambda: check_reciprocity(material, seed=seed, ior=ior))
+        )
+    for side in sides:
         checks.append(
             _run(
-                "energy",
-                theta,
-                lambda t=theta, s=samples: check_energy(
-                    material,
-                    t,
-                    alpha=a,
-                    max_albedo=math.inf if max_albedo is None else max_albedo,
-                    samples=s,
-                ),
+                "finite >= 0",
+                None,
+                lambda side=side: check_non_negative_finite(material, seed=seed, inside=side),
             )
         )
-    if reciprocal and not specular:
-        checks.append(_run("reciprocity", None, lambda: check_reciprocity(material, seed=seed)))
-    checks.append(_run("finite >= 0", None, lambda: check_non_negative_finite(material, seed=seed)))
     return MaterialReport(material_name(material), checks, a, time.perf_counter() - start)
+
+
+def _draw(material: Material, theta: float, n: int, seed: int, inside: bool):
+    """draw_samples, or a failed CheckResult when scattering() raised."""
+    try:
+        return draw_samples(material, theta, n, seed=seed, inside=inside)
+    except Exception as error:
+        detail = f"raised {type(error).__name__}: {error}"
+        return CheckResult("scattering", theta, False, detail, inside=inside)
+
+
+def _checks_at(material: Material, samples: Samples, a: float, options: dict) -> list[CheckResult]:
+    """The chi2, weights and energy checks of one set of samples."""
+    theta, inside = samples.incident_deg, samples.inside
+
+    def chi2() -> CheckResult:
+        bins = dict(theta_bins=options["theta_bins"], phi_bins=options["phi_bins"])
+        r = chi2_test(material, theta, samples=samples, inside=inside, **bins)
+        ok = r.passed(a)
+        detail = r.summary(worst=not ok)
+        return CheckResult("chi2", theta, ok, detail, p_value=r.p_value, inside=inside)
+
+    def weights() -> CheckResult:
+        return check_weights(material, theta, samples=samples, inside=inside)
+
+    def energy() -> CheckResult:
+        return check_energy(
+            material,
+            theta,
+            alpha=a,
+            max_albedo=options["max_albedo"],
+            samples=samples,
+            inside=inside,
+            two_sided=options["two_sided"],
+        )
+
+    return [
+        _run("chi2", theta, chi2, inside),
+        _run("weights", theta, weights, inside),
+        _run("energy", theta, energy, inside),
+    ]
 
 
 def assert_material(material: Material, **options) -> MaterialReport:

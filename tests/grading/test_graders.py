@@ -134,8 +134,8 @@ def cosine_with_unnormalised_vector(mp):
         mp,
         direct_lighting,
         "light_sample_estimate",
-        "cos_i = dot(normal, wi)",
-        "d = sample.point - hit.point; cos_i = dot(normal, d)",
+        "cos_i = abs(dot(normal, wi))",
+        "d = sample.point - hit.point; cos_i = abs(dot(normal, d))",
     )
 
 

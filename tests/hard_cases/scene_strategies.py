@@ -117,6 +117,13 @@ class SceneMaker:
             }
         elif kind == "dielectric":
             keys = {"ior": lambda: r.log_uniform(0.2, 5.0, 1.0, 1.5), "albedo": r.colour}
+        elif kind == "rough_dielectric":
+            keys = {
+                "ior": lambda: r.log_uniform(0.2, 5.0, 1.0, 1.5),
+                "roughness": lambda: r.log_uniform(1e-3, 1.0, 1e-3, 1.0),
+                "distribution": lambda: r.rng.choice(["ggx", "beckmann"]),
+                "tint": r.colour,
+            }
         elif kind == "metal":
             keys["fuzz"] = lambda: r.uniform(0.0, 2.0, 0.0)
         elif kind == "oren_nayar":

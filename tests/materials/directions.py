@@ -208,15 +208,16 @@ def polar_integral(f, axis, peak) -> float:
     return total
 
 
-def theta_nodes(a: float) -> tuple[np.ndarray, np.ndarray]:
+def theta_nodes(a: float, breaks=()) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes and weights in theta on [0, pi/2], with breakpoints where
-    tan(theta) is a fixed multiple of the width a (so narrow lobes are resolved)."""
+    tan(theta) is a fixed multiple of the width a (so narrow lobes are resolved), and
+    at `breaks` (where the integrand has a kink)."""
     edges = [0.0]
     s = 0.125
     while math.atan(a * s) < math.pi / 2 - 1e-3 and s < 1e7:
         edges.append(math.atan(a * s))
         s *= 2.0
-    edges.append(math.pi / 2)
+    edges = sorted({*edges, *(b for b in breaks if 0.0 < b < math.pi / 2), math.pi / 2})
     xs, ws = [], []
     for lo, hi in zip(edges[:-1], edges[1:], strict=True):
         xs.append(lo + (hi - lo) * (GL_X + 1.0) / 2.0)
@@ -224,11 +225,11 @@ def theta_nodes(a: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(xs), np.concatenate(ws)
 
 
-def hemisphere_integral(f, a: float, n_phi: int = 1, phi_offset: float = 0.0) -> float:
+def hemisphere_integral(f, a: float, n_phi: int = 1, phi_offset: float = 0.0, breaks=()) -> float:
     """Integral of f(theta, phi) sin(theta) d(theta) d(phi) over the upper hemisphere
-    around z, resolved for a lobe of width a. n_phi = 1 for integrands that do not
-    depend on phi."""
-    thetas, weights = theta_nodes(a)
+    around z, resolved for a lobe of width a (and kinks at the polar angles `breaks`).
+    n_phi = 1 for integrands that do not depend on phi."""
+    thetas, weights = theta_nodes(a, breaks)
     phis = phi_offset + 2.0 * math.pi * (np.arange(n_phi) + 0.5) / n_phi
     total = 0.0
     for t, w in zip(thetas, weights, strict=True):

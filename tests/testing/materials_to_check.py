@@ -1,15 +1,17 @@
-"""Materials for the tests of rtpy.testing: a correct narrow lobe, and Lambertians
-with one planted mistake each (every check must catch the one meant for it)."""
+"""Materials for the tests of rtpy.testing: a correct narrow lobe, a correct material
+that transmits, and Lambertians with one planted mistake each (every check must catch
+the one meant for it)."""
 
 from __future__ import annotations
 
 import math
 
-from rtpy.materials import Lambertian, Phong
+from rtpy.materials import Lambertian, Material, Phong
+from rtpy.onb import ONB
 from rtpy.ray import spawn_ray
-from rtpy.sampling import generator
+from rtpy.sampling import generator, random_cosine_direction
 from rtpy.scatter_info import ScatterInfo
-from rtpy.vec3 import BLACK, Color, Vec3
+from rtpy.vec3 import BLACK, Color, Vec3, dot
 
 INV_PI = 1.0 / math.pi
 
@@ -105,4 +107,46 @@ class CrashesAtGrazing(Lambertian):
         z = ray_light.direction.e2
         if 0.0 < z < 1e-4:
             raise ZeroDivisionError("grazing")
+        return super().pdf(ray_view, ray_light, hit)
+
+
+class DiffuseTransmitter(Material):
+    """Lambertian on both sides of the surface: f = r / pi toward the viewer's side,
+    t / pi through it; cosine-weighted samples on the viewer's side with probability
+    r / (r + t), else on the other. Reciprocal (no refraction): weight r + t."""
+
+    def __init__(self, r: float = 0.3, t: float = 0.5) -> None:
+        self.r, self.t = r, t
+
+    def BRDF(self, ray_view, ray_light, hit):
+        cos_o, cos_i = -dot(hit.normal, ray_view.direction), dot(hit.normal, ray_light.direction)
+        if cos_o <= 0.0 or cos_i == 0.0:
+            return BLACK
+        value = (self.r if cos_i > 0.0 else self.t) * INV_PI
+        return Color(value, value, value)
+
+    def pdf(self, ray_view, ray_light, hit):
+        cos_o, cos_i = -dot(hit.normal, ray_view.direction), dot(hit.normal, ray_light.direction)
+        if cos_o <= 0.0:
+            return 0.0
+        p_r = self.r / (self.r + self.t)
+        return (p_r if cos_i > 0.0 else 1.0 - p_r) * abs(cos_i) * INV_PI
+
+    def scattering(self, ray_in, hit):
+        if dot(hit.normal, ray_in.direction) >= 0.0:
+            return None
+        local = random_cosine_direction()
+        side = hit.normal if generator().random() < self.r / (self.r + self.t) else -hit.normal
+        d = ONB(side).to_world(local)
+        ray = spawn_ray(hit.point, hit.normal, d)
+        weight = self.r + self.t
+        return ScatterInfo(ray, Color(weight, weight, weight), self.pdf(ray_in, ray, hit))
+
+
+class UpperPdfOnly(DiffuseTransmitter):
+    """pdf() forgets the transmitted half: 0 below the surface."""
+
+    def pdf(self, ray_view, ray_light, hit):
+        if dot(hit.normal, ray_light.direction) <= 0.0:
+            return 0.0
         return super().pdf(ray_view, ray_light, hit)

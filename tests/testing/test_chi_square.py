@@ -15,11 +15,13 @@ from rtpy.vec3 import Color
 
 from ..tiers import slow_except
 from .materials_to_check import (
+    DiffuseTransmitter,
     HalfSampler,
     OverNormalised,
     PhongLobe,
     SecretAbsorber,
     UniformSampler,
+    UpperPdfOnly,
 )
 
 ANGLES = (0.0, 30.0, 60.0, 85.0, 89.9)
@@ -155,3 +157,17 @@ def test_chi2_refuses_specular_materials_and_foreign_samples():
     samples = draw_samples(Lambertian(), 30.0, 100)
     with pytest.raises(ValueError):
         chi2_test(Lambertian(), 60.0, samples=samples)
+    with pytest.raises(ValueError):
+        chi2_test(Lambertian(), 30.0, samples=samples, inside=True)
+
+
+@pytest.mark.parametrize("inside", [False, True])
+def test_chi2_covers_the_whole_sphere(inside):
+    """A material that transmits: the bins below the surface count too, from either side."""
+    r = chi2_test(DiffuseTransmitter(0.3, 0.5), 50.0, n_samples=20_000, inside=inside)
+    assert r.p_value > 0.01, r.summary()
+    assert r.upper_integral == pytest.approx(0.375, abs=1e-6)  # r / (r + t) above
+    assert r.pdf_integral == pytest.approx(1.0, abs=1e-6)
+    assert r.observed[r.observed.shape[0] // 2 :].sum() > 10_000
+    r = chi2_test(UpperPdfOnly(0.3, 0.5), 50.0, n_samples=5000, inside=inside)
+    assert r.p_value == 0.0 and "pdf() is 0" in r.message

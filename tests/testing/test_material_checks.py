@@ -1,26 +1,22 @@
-"""Tests for rtpy.testing.material_checks: correct materials pass, and each kind
-of broken material is caught by the check meant for it."""
+"""Tests for rtpy.testing.material_checks: correct materials pass check_weights and
+check_energy (whose directional albedos by sampling and by quadrature agree, on one
+side of the surface or both), and each kind of broken material is caught by the check
+meant for it."""
 
 from __future__ import annotations
 
 import pytest
 
-from rtpy.materials import Lambertian, Mirror
-from rtpy.testing import (
-    check_energy,
-    check_non_negative_finite,
-    check_reciprocity,
-    check_weights,
-    directional_albedo,
-)
+from rtpy.materials import Lambertian
+from rtpy.testing import check_energy, check_weights, directional_albedo
 from rtpy.vec3 import Color
 
 from .materials_to_check import (
+    DiffuseTransmitter,
     ForgetsPdf,
     HalfSampler,
-    NegativeAtGrazing,
-    NonReciprocal,
     PhongLobe,
+    UpperPdfOnly,
     WrongRecordedPdf,
 )
 
@@ -42,19 +38,13 @@ def test_check_weights_catches_a_wrong_recorded_pdf():
     assert not result and "ScatterInfo.pdf" in result.detail
 
 
-def test_check_reciprocity():
-    assert check_reciprocity(Lambertian())
-    assert check_reciprocity(PhongLobe(100.0, kd=0.3, ks=0.7))
-    result = check_reciprocity(NonReciprocal(), n_pairs=200)
-    assert not result and "differ" in result.detail
-
-
-def test_check_non_negative_finite():
-    assert check_non_negative_finite(Lambertian())
-    assert check_non_negative_finite(PhongLobe(1e4, kd=0.5, ks=0.5))
-    assert check_non_negative_finite(Mirror())
-    result = check_non_negative_finite(NegativeAtGrazing(), n=10)
-    assert not result and "BRDF" in result.detail
+@pytest.mark.parametrize("inside", [False, True])
+def test_check_weights_sees_both_sides(inside):
+    result = check_weights(DiffuseTransmitter(), 40.0, inside=inside)
+    assert result and result.inside == inside
+    assert ("from inside" in str(result)) == inside
+    result = check_weights(UpperPdfOnly(), 40.0, n=200, inside=inside)
+    assert not result and "pdf() = 0.0" in result.detail
 
 
 def test_directional_albedo_by_sampling_and_quadrature():
@@ -83,4 +73,26 @@ def test_check_energy_catches_sampling_that_misses_part_of_the_brdf():
     # that the mean weight (albedo / 2) is not the integral of BRDF * cos (albedo).
     assert check_weights(HalfSampler(), 30.0)
     result = check_energy(HalfSampler(), 30.0, n_samples=20_000)
+    assert not result and "disagrees" in result.detail
+
+
+@pytest.mark.parametrize("inside", [False, True])
+def test_directional_albedo_of_a_material_that_transmits(inside):
+    a = directional_albedo(DiffuseTransmitter(0.3, 0.5), 50.0, n_samples=2000, inside=inside)
+    assert a.two_sided
+    assert a.sampled == pytest.approx((0.8, 0.8, 0.8), rel=1e-12)  # every weight is r + t
+    assert a.reflected == pytest.approx((0.3, 0.3, 0.3), rel=1e-7)
+    assert a.transmitted == pytest.approx((0.5, 0.5, 0.5), rel=1e-7)
+    assert a.transmitted_power == pytest.approx((0.5, 0.5, 0.5), rel=1e-7)  # reciprocal
+    assert a.lost == pytest.approx((0.2, 0.2, 0.2), rel=1e-6)
+    one_sided = directional_albedo(DiffuseTransmitter(), 50.0, n_samples=2000, two_sided=False)
+    assert one_sided.quadrature == pytest.approx((0.3, 0.3, 0.3), rel=1e-7)
+
+
+def test_check_energy_on_both_sides():
+    assert check_energy(DiffuseTransmitter(0.3, 0.5), 30.0, n_samples=2000, inside=True)
+    result = check_energy(DiffuseTransmitter(0.6, 0.6), 30.0, n_samples=2000)
+    assert not result and "> 1" in result.detail and "transmitted 0.6000" in result.detail
+    # The transmitted half, left out of the quadrature, is missing from it.
+    result = check_energy(DiffuseTransmitter(), 30.0, n_samples=2000, two_sided=False)
     assert not result and "disagrees" in result.detail

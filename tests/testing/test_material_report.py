@@ -8,7 +8,7 @@ import pytest
 from rtpy.materials import Lambertian, Mirror
 from rtpy.testing import assert_material, check_material
 
-from .materials_to_check import CrashesAtGrazing, OverNormalised
+from .materials_to_check import CrashesAtGrazing, DiffuseTransmitter, OverNormalised, UpperPdfOnly
 
 
 @pytest.mark.slow
@@ -47,3 +47,17 @@ def test_check_material_reports_a_crash_as_a_failed_check():
     report = check_material(CrashesAtGrazing(), incident_angles=(30.0,), n_samples=2000)
     assert not report.passed
     assert "raised ZeroDivisionError" in str(report)
+
+
+def test_check_material_checks_a_material_that_transmits_from_both_sides():
+    report = check_material(DiffuseTransmitter(), incident_angles=(30.0,), n_samples=5000)
+    assert report.passed, str(report)
+    chi2 = [c for c in report.checks if c.check == "chi2"]
+    assert [c.inside for c in chi2] == [False, True]
+    assert len([c for c in report.checks if c.check == "finite >= 0"]) == 2
+    text = str(report)
+    assert "   30 in  pass" in text and "transmitted 0.5000" in text
+    front = check_material(DiffuseTransmitter(), (30.0,), n_samples=5000, inside=False)
+    assert not any(c.inside for c in front.checks)
+    broken = check_material(UpperPdfOnly(), incident_angles=(30.0,), n_samples=5000)
+    assert {(c.check, c.inside) for c in broken.failures} >= {("chi2", False), ("chi2", True)}

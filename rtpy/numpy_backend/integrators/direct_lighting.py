@@ -36,7 +36,7 @@ def sample_one_light(
     out = np.zeros((n, 3))
     n_lights = scene.lights.count(include_area)
     s = scene.lights.sample(hits.point, rng, include_area)
-    cos_i = dot(hits.normal, s.direction)
+    cos_i = np.abs(dot(hits.normal, s.direction))  # behind the surface: BRDF 0 unless glass
     ok = s.valid & (max3(s.radiance) > 0.0) & (cos_i > 0.0)
     idx = np.flatnonzero(ok)
     if idx.size == 0:

@@ -23,12 +23,14 @@ from .metal import MetalKernel
 from .mirror import MirrorKernel
 from .oren_nayar import OrenNayarKernel
 from .phong import PhongKernel
+from .rough_dielectric import rough_dielectric_kernel
 from .ward import WardKernel
 
 KernelChoice = type[Kernel] | Callable[[Material], type[Kernel]]
 
 # Material class -> its kernel class, or a function choosing one from the instance
-# (Cook-Torrance has one kernel per distribution, so no kernel branches per hit).
+# (Cook-Torrance and the rough dielectric have one kernel per distribution, so no
+# kernel branches per hit).
 # A class the backend must not import is keyed by its full name, module and
 # qualified name, which identifies it as exactly as the class itself: the closed-form
 # scenes' GlowingLambertian lives in rtpy.testing, which the backend does not import
@@ -38,6 +40,7 @@ KERNELS: dict[type | str, KernelChoice] = {
     scalar.Mirror: MirrorKernel,
     scalar.Metal: MetalKernel,
     scalar.Dielectric: DielectricKernel,
+    scalar.RoughDielectric: rough_dielectric_kernel,
     scalar.DiffuseLight: DiffuseLightKernel,
     scalar.Phong: PhongKernel,
     scalar.BlinnPhong: BlinnPhongKernel,

@@ -22,6 +22,7 @@ from rtpy.materials import (
     Mirror,
     OrenNayar,
     Phong,
+    RoughDielectric,
     Ward,
 )
 from rtpy.numpy_backend.hit_info import HitBatch
@@ -29,6 +30,7 @@ from rtpy.numpy_backend.materials import (
     MaterialTable,
     glossy,
 )
+from rtpy.numpy_backend.materials.rough_dielectric import RoughDielectricKernel
 from rtpy.numpy_backend.scatter_info import ScatterBatch
 from rtpy.ray import Ray
 from rtpy.sampling import use_generator
@@ -47,7 +49,7 @@ from rtpy.vec3 import Color, Vec3
 # other kernels must agree bit for bit.
 ULP = 2.0**-52  # the spacing of floats in [1, 2)
 LIBM_REL = 1e-14
-LIBM_KINDS = {"phong", "blinn_phong", "cook_torrance", "ward"}
+LIBM_KINDS = {"phong", "blinn_phong", "cook_torrance", "ward", "rough_dielectric"}
 # Except below TINY: an intermediate that underflows into the subnormal range keeps only
 # the absolute spacing 2^-1074 = 4.9e-324 there (a 1 ulp difference of pow is then a
 # large relative one), which the model's factors (at most ~1e4 for the materials drawn)
@@ -144,12 +146,13 @@ def random_wi(rng: np.random.Generator, hits: HitBatch) -> np.ndarray:
     )
 
 
-def local_hits(n: int, theta_deg: float, phi_deg: float = 0.0) -> HitBatch:
-    """n copies of rtpy.testing's setup: normal z, tangent x, viewer at (theta, phi)."""
+def local_hits(n: int, theta_deg: float, phi_deg: float = 0.0, inside: bool = False) -> HitBatch:
+    """n copies of rtpy.testing's setup: normal z, tangent x, viewer at (theta, phi);
+    the back face with inside=True."""
     wo = np.tile(local_direction(theta_deg, phi_deg).tolist(), (n, 1))
     z, x = np.tile([0.0, 0.0, 1.0], (n, 1)), np.tile([1.0, 0.0, 0.0], (n, 1))
-    half = np.full(n, 0.5)
-    return HitBatch(np.zeros((n, 3)), z, wo, np.ones(n), np.ones(n, bool), half, half, x)
+    half, front = np.full(n, 0.5), np.full(n, not inside)
+    return HitBatch(np.zeros((n, 3)), z, wo, np.ones(n), front, half, half, x)
 
 
 # --- the scalar twins, hit by hit ------------------------------------------------------------
@@ -269,6 +272,13 @@ MATERIALS = {
     "mirror": albedos().map(Mirror),
     "metal": st.builds(Metal, albedos(), st.sampled_from([0.0, 0.3, 1.0, 2.0])),
     "dielectric": st.builds(Dielectric, st.floats(0.5, 2.5), albedos()),
+    "rough_dielectric": st.builds(
+        RoughDielectric,
+        st.sampled_from([1.0, 1.5]) | st.floats(0.5, 2.5),
+        widths,
+        st.sampled_from(["ggx", "beckmann"]),
+        albedos(),
+    ),
     "diffuse_light": st.builds(DiffuseLight, colors, st.booleans()),
 }
 
@@ -283,7 +293,15 @@ def random_table(data, kind: str, seed: int, n: int):
     return table, rng.integers(len(table.materials), size=n), hits, rng
 
 
-NON_SPECULAR = ["lambertian", "oren_nayar", "phong", "blinn_phong", "cook_torrance", "ward"]
+NON_SPECULAR = [
+    "lambertian",
+    "oren_nayar",
+    "phong",
+    "blinn_phong",
+    "cook_torrance",
+    "ward",
+    "rough_dielectric",
+]
 seeds = st.integers(0, 2**32 - 1)
 
 # --- sampling -----------------------------------------------------------------------------
@@ -297,12 +315,12 @@ def scalar_dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def check_samples_match_brdf_and_pdf(
     table: MaterialTable, ids, hits: HitBatch, s: ScatterBatch
 ) -> None:
-    """Every live sample: attenuation = f cos / pdf and pdf = pdf() at its direction;
-    dead samples carry nothing. The glossy kernels compute the weight as
-    BRDF() * (cos / pdf()) at the direction they return: bit for bit. Lambertian and
-    Oren-Nayar take cos(theta_i) and the pdf from the local sample's z, which the world
-    direction's normal . d matches to the rounding of the frame and of the dot product,
-    a few ulp of 1: 8 ULP / cos(theta_i) relative."""
+    """Every live sample: attenuation = f |cos| / pdf and pdf = pdf() at its direction;
+    dead samples carry nothing. The glossy and rough dielectric kernels compute the
+    weight as BRDF() * (|cos| / pdf()) at the direction they return: bit for bit.
+    Lambertian and Oren-Nayar take cos(theta_i) and the pdf from the local sample's z,
+    which the world direction's normal . d matches to the rounding of the frame and of
+    the dot product, a few ulp of 1: 8 ULP / cos(theta_i) relative."""
     assert not s.is_specular.any()
     dead = ~s.alive
     assert not s.attenuation[dead].any() and not s.pdf[dead].any()
@@ -311,11 +329,12 @@ def check_samples_match_brdf_and_pdf(
     np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, rtol=1e-14)
     part = hits.take(live)
     f, pdf = table.BRDF(ids[live], part, d), table.pdf(ids[live], part, d)
-    cos_i = scalar_dot(d, part.normal)
+    cos_i = np.abs(scalar_dot(d, part.normal))
     assert np.isfinite(s.attenuation[live]).all() and (s.pdf[live] > 0.0).all()
     assert (pdf > 0.0).all()
-    glossy_kernel = np.array([isinstance(k, glossy.GlossyKernel) for k in table.kernels])
-    rel = np.where(glossy_kernel[table.kind[ids[live]]], 0.0, 8.0 * ULP / cos_i)
+    exact = (glossy.GlossyKernel, RoughDielectricKernel)
+    exact_kernel = np.array([isinstance(k, exact) for k in table.kernels])
+    rel = np.where(exact_kernel[table.kind[ids[live]]], 0.0, 8.0 * ULP / cos_i)
     assert_agrees(s.pdf[live], pdf, "sample pdf vs pdf()", rel)
     expected = f * (cos_i / pdf)[:, None]
     assert_agrees(s.attenuation[live], expected, "sample weight vs f cos / pdf", rel[:, None])
@@ -330,10 +349,12 @@ def z_two_samples(a: np.ndarray, b: np.ndarray) -> float:
     return 0.0 if var == 0.0 else diff / math.sqrt(var)
 
 
-def batched_samples(material, theta: float, n: int, seed: int, phi: float = 0.0) -> Samples:
+def batched_samples(
+    material, theta: float, n: int, seed: int, phi: float = 0.0, inside: bool = False
+) -> Samples:
     """The batched sampler's draws in rtpy.testing's setup, as rtpy.testing.Samples."""
     s = MaterialTable([material]).scattering(
-        np.zeros(n, int), local_hits(n, theta, phi), np.random.default_rng(seed)
+        np.zeros(n, int), local_hits(n, theta, phi, inside), np.random.default_rng(seed)
     )
     status = np.where(s.alive, SCATTERED, 1).astype(np.int8)
     nan = np.where(s.alive, 0.0, np.nan)
@@ -345,14 +366,17 @@ def batched_samples(material, theta: float, n: int, seed: int, phi: float = 0.0)
         s.pdf + nan,
         status,
         0.0,
+        inside,
     )
 
 
-def compare_with_scalar_sampler(material, theta, phi=0.0, n_scalar=8000, n_batched=100_000):
+def compare_with_scalar_sampler(
+    material, theta, phi=0.0, n_scalar=8000, n_batched=100_000, inside=False
+):
     """z-tests of the absorbed fraction and the mean weight (absorbed = 0) against the
     scalar sampler in the same setup; returns the batched samples."""
-    scalar = draw_samples(material, theta, n_scalar, seed=7, phi_deg=phi)
-    batched = batched_samples(material, theta, n_batched, seed=8, phi=phi)
+    scalar = draw_samples(material, theta, n_scalar, seed=7, phi_deg=phi, inside=inside)
+    batched = batched_samples(material, theta, n_batched, seed=8, phi=phi, inside=inside)
     alive_s, alive_b = scalar.scattered.astype(float), batched.scattered.astype(float)
     p = (alive_s.sum() + alive_b.sum()) / (len(alive_s) + len(alive_b))
     if 0.0 < p < 1.0:
@@ -383,12 +407,20 @@ SAMPLING_CASES = [
         50.0,
     ),
     (Ward(Color(0.5, 0.6, 0.7), kd=0.3, ks=0.6, alpha_x=0.1, alpha_y=0.4), 65.0),
+    (RoughDielectric(1.5, 0.394, "ggx", Color(0.9, 0.8, 0.6)), 70.0),
 ]
 
 
 def head(s: Samples, n: int) -> Samples:
     return Samples(
-        s.incident_deg, s.phi_deg, s.directions[:n], s.weights[:n], s.pdfs[:n], s.status[:n], 0.0
+        s.incident_deg,
+        s.phi_deg,
+        s.directions[:n],
+        s.weights[:n],
+        s.pdfs[:n],
+        s.status[:n],
+        0.0,
+        s.inside,
     )
 
 

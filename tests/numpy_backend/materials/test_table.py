@@ -153,7 +153,7 @@ def test_sample_weight_and_pdf_match_brdf_and_pdf(kind, data, seed):
 @pytest.mark.parametrize(
     ("material", "theta"),
     SAMPLING_CASES,
-    ids=["lambertian", "oren_nayar", "phong", "blinn_phong", "ggx", "beckmann", "ward"],
+    ids=["lambertian", "oren_nayar", "phong", "blinn_phong", "ggx", "beckmann", "ward", "glass"],
 )
 def test_sampler_agrees_with_scalar_and_follows_pdf(material, theta):
     phi = 30.0  # off the tangent axis: anisotropy and the frame's orientation count
