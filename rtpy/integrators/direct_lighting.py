@@ -33,9 +33,11 @@ def light_sample_estimate(
         f_r(wi, wo) * L * cos(theta_i) / pdf
 
     with L = sample.radiance, pdf = sample.pdf (the density with which the light
-    chose the direction; 1 for a point light) and cos(theta_i) = hit.normal .
-    sample.direction (a unit vector). Black when the light is behind the surface or
-    something blocks the shadow ray: a ray that leaves the surface (spawn_ray) toward
+    chose the direction; 1 for a point light) and cos(theta_i) = |hit.normal .
+    sample.direction| (a unit vector; a light behind the surface reaches the point only
+    through a material that transmits, such as rough glass: every other BRDF is black
+    there). Black when f_r is black or something blocks the shadow ray: a ray that
+    leaves the surface (spawn_ray) toward
     the light, tested by scene.find_occlusion over shadow_interval(hit, sample), not
     testing light_shape, the light's own shape (None for a point light)."""
     # BEGIN SOLUTION week05: shadow ray toward the light, f_r * L * cos / pdf
