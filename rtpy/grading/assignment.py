@@ -57,7 +57,7 @@ BEGIN = re.compile(r"^(?P<indent>[ \t]*)# BEGIN SOLUTION week(?P<week>\d\d)(?::\
 END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
 
 # What the student repository holds besides rtpy/ (top-level names of the source tree).
-COPIED = ("pyproject.toml", ".gitignore", "scenes", "docs")
+COPIED = ("pyproject.toml", ".gitignore", "LICENSE", "scenes", "docs")
 TEST_WEEKS_FILE = "assignments/test_weeks.toml"
 # Tests that belong to rtpy's own repository only (and are not mapped): the assignment
 # machinery's, which grade every week, generate repositories and check the task maps

@@ -141,6 +141,7 @@ def test_student_repository(tmp_path, week):
     repo = make_assignment(week, tmp_path / f"week{week}")
     check_regions(repo, week)
     assert not (repo / "rtpy" / "numpy_backend" / "scene.py").exists()
+    assert "MIT License" in (repo / "LICENSE").read_text()  # MIT asks for it in copies
     with open(repo / "pyproject.toml", "rb") as f:  # pip install needs every listed package
         tool = tomllib.load(f)["tool"]
     setup, options = tool["setuptools"], tool["pytest"]["ini_options"]
