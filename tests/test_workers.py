@@ -75,6 +75,7 @@ def run_worker_program(tmp_path, method: str, case: str) -> subprocess.Completed
     ],
 )
 @pytest.mark.parametrize("method", ["spawn", "forkserver"])
+@pytest.mark.slow
 def test_a_scene_the_workers_cannot_rebuild_stops_with_one_message(tmp_path, method, case, reason):
     result = run_worker_program(tmp_path, method, case)
     assert result.returncode == 5, result.stdout + result.stderr

@@ -234,6 +234,7 @@ def test_the_autograder_of_every_week(built, tmp_path, week):
     assert f"{none_function} ({none_file}) returned None" in outputs, outputs
 
 
+@pytest.mark.slow
 def test_week_05_end_to_end(built, tmp_path):
     """A syntax error in light.py: its tests score 0 and say why, the other tests are
     still scored, and the hidden checks are reported for after the due date."""

@@ -102,6 +102,7 @@ def answers_elsewhere(root: Path, week: str) -> set[tuple[str, str, str]]:
 
 
 @pytest.mark.parametrize("week", WEEKS)
+@pytest.mark.slow
 def test_no_task_is_solved_elsewhere_in_its_week(week):
     found = answers_elsewhere(ROOT, week)
     known = {k for k in KNOWN if k[0] == week}

@@ -136,6 +136,7 @@ def test_an_exception_names_the_students_function_file_and_line():
     )
 
 
+@pytest.mark.slow
 def test_the_child_stops_an_endless_test_and_goes_on(tmp_path):
     """A planted endless loop in a task file: the test fails after the time limit,
     naming the loop's function and line; the next test still runs."""

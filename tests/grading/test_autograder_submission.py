@@ -86,6 +86,7 @@ def test_a_syntax_error_is_named_with_its_line(tmp_path):
     }
 
 
+@pytest.mark.slow
 def test_an_import_that_fails_or_hangs_blames_the_file_and_line(tmp_path):
     work = repository(tmp_path / "a", light="import math\nLIGHT = 1 / 0\n")
     assert import_problem(work, TASKS, timeout=30) == (

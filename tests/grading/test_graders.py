@@ -534,6 +534,7 @@ def run_grader_test(week: str, name: str) -> None:
 @pytest.mark.parametrize(
     "task,mistake,graders", PLANTED, ids=[f"{t}-{m.__name__}" for t, m, _ in PLANTED]
 )
+@pytest.mark.slow
 def test_a_planted_mistake_fails_its_graders(monkeypatch, task, mistake, graders):
     mistake(monkeypatch)
     for name in graders:

@@ -430,6 +430,7 @@ def render_under(method: str, *args: str) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.mark.slow
 def test_a_plugin_render_on_two_workers_is_the_same_under_every_start_method(tmp_path):
     """With its material from --plugin, a render on two workers started by spawn or
     forkserver (the defaults of Windows, macOS and Python 3.14) finishes with the

@@ -454,6 +454,7 @@ def _tables(data: dict) -> list[dict]:
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
+@pytest.mark.slow
 def test_random_perturbations_load_or_raise_scene_error(data):
     import tomllib
 

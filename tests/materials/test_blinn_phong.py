@@ -119,6 +119,7 @@ def test_reciprocity(kd, ks, n, ta, pa, tb, pb):
     [(0.5, 0.5, 80.0), (0.2, 0.8, 3.0), (0.0, 1.0, 0.0), (1.0, 0.0, 5.0), (0.3, 0.6, 1e4)],
 )
 @pytest.mark.parametrize("theta_o", [0.0, 40.0, 80.0])
+@pytest.mark.slow
 def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, n, theta_o):
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
     wo = direction(NORMAL, theta_o, 30.0)
@@ -151,6 +152,7 @@ def test_the_half_vectors_follow_the_cos_power_density(n):
         [(0.0, 0.0, 60.0), (0.0, 3.0, 70.0), (0.0, 20.0, 85.0), (0.3, 1.0, 45.0)], (0.0, 20.0, 85.0)
     ),
 )
+@pytest.mark.slow
 def test_pdf_integrates_to_the_fraction_of_samples_not_absorbed(kd, n, theta_o):
     """A half vector facing away from the viewer, or a reflection below the surface,
     gives no sample, and pdf() counts neither: over the sphere pdf() integrates to the

@@ -316,6 +316,7 @@ def test_scattering_weight_is_brdf_cos_over_pdf(dist, kd, ks, a, theta_o):
 
 @pytest.mark.parametrize("dist", DISTRIBUTIONS)
 @pytest.mark.parametrize("a, theta_o_deg", [(0.05, 30.0), (0.3, 0.0), (0.3, 70.0), (1.0, 45.0)])
+@pytest.mark.slow
 def test_mean_sample_weight_is_the_albedo_by_quadrature(dist, a, theta_o_deg):
     """The mean of BRDF * cos / pdf over the sampler's directions (absorbed samples
     count 0) estimates the directional albedo exactly when the sampler draws with

@@ -150,6 +150,7 @@ def test_sigma_zero_is_exactly_lambertian():
 
 @pytest.mark.parametrize("sigma", [0.0, 20.0, 60.0, 89.0])
 @pytest.mark.parametrize("theta_o", [0.0, 45.0, 85.0, 89.99])
+@pytest.mark.slow
 def test_scattering_weight_is_brdf_cos_over_pdf(sigma, theta_o):
     m = OrenNayar(Color(*ALBEDO), sigma=sigma)
     wo = direction(NORMAL, theta_o, 75.0)

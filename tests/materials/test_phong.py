@@ -130,6 +130,7 @@ def test_reciprocity(kd, ks, n, ta, pa, tb, pb):
     [(0.5, 0.5, 20.0), (0.2, 0.8, 3.0), (0.0, 1.0, 0.0), (1.0, 0.0, 5.0), (0.3, 0.6, 1e4)],
 )
 @pytest.mark.parametrize("theta_o", [0.0, 40.0, 80.0])
+@pytest.mark.slow
 def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, n, theta_o):
     m = Phong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
     wo = direction(NORMAL, theta_o, 30.0)

@@ -276,6 +276,7 @@ SAMPLING_CASES = [
     "name, theta, inside",
     slow_except(SAMPLING_CASES, ("ground", 30.0, False), ("anti_glare", 30.0, True)),
 )
+@pytest.mark.slow
 def test_scattering_draws_the_pdf_and_weighs_by_it(name, theta, inside):
     m = glass(name)
     samples = draw_samples(m, theta, 30_000, seed=5, inside=inside)
@@ -361,6 +362,7 @@ def visible_facet_loss(m: RoughDielectric, theta_deg: float, inside: bool) -> fl
         ("ground", 60.0, False),
     ),
 )
+@pytest.mark.slow
 def test_the_light_lost_is_what_the_facets_block(name, theta, inside):
     """reflected + transmitted + lost = 1, where lost (from rtpy.testing's quadrature of
     the BSDF over the directions) is the visible-facet integral of what G1 blocks: the

@@ -275,6 +275,7 @@ def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, ax, ay, theta_o):
         (1.0, 0.5, 60.0, 1.0),
     ],
 )
+@pytest.mark.slow
 def test_mean_sample_weight_is_the_albedo_by_quadrature(ax, ay, theta_o_deg, phi_o):
     """The mean of BRDF * cos / pdf over the sampler's directions (absorbed samples
     count 0) is the directional albedo exactly when the sampler draws with the

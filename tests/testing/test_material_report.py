@@ -49,6 +49,7 @@ def test_check_material_reports_a_crash_as_a_failed_check():
     assert "raised ZeroDivisionError" in str(report)
 
 
+@pytest.mark.slow
 def test_check_material_checks_a_material_that_transmits_from_both_sides():
     report = check_material(DiffuseTransmitter(), incident_angles=(30.0,), n_samples=5000)
     assert report.passed, str(report)

@@ -46,6 +46,7 @@ CASES = [(k, theta, inside) for k in range(3) for theta in (0.0, 45.0, 80.0) for
 
 
 @pytest.mark.parametrize("glass, theta, inside", slow_except(CASES, (1, 45.0, 1), (0, 80.0, 0)))
+@pytest.mark.slow
 def test_sampler_agrees_with_scalar_and_follows_the_pdf(glass, theta, inside):
     material = GLASSES[glass]
     batched = compare_with_scalar_sampler(material, theta, 30.0, inside=bool(inside))

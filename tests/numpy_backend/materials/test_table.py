@@ -155,6 +155,7 @@ def test_sample_weight_and_pdf_match_brdf_and_pdf(kind, data, seed):
     SAMPLING_CASES,
     ids=["lambertian", "oren_nayar", "phong", "blinn_phong", "ggx", "beckmann", "ward", "glass"],
 )
+@pytest.mark.slow
 def test_sampler_agrees_with_scalar_and_follows_pdf(material, theta):
     phi = 30.0  # off the tangent axis: anisotropy and the frame's orientation count
     batched = compare_with_scalar_sampler(material, theta, phi)
