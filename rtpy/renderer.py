@@ -187,18 +187,19 @@ class PixelSums:
     def snapshot(self) -> np.ndarray:
         """The mean of each pixel's samples added so far, as a new array (the sums are
         left as they are, for more samples to be added)."""
-        image = self.total.copy()
-        for unit, samples in self._samples.values():
-            image[unit.y0 : unit.y1, unit.x0 : unit.x1] /= samples
-        return image
+        return self._divide(self.total.copy())
 
     def mean(self) -> np.ndarray:
         """The mean of each pixel's samples (black without one), an array (height,
         width, 3), computed in place after finish(): `total` becomes it (call it once)."""
         self.finish()
+        return self._divide(self.total)
+
+    def _divide(self, sums: np.ndarray) -> np.ndarray:
+        """sums (the image of sums or a copy) divided, in place, by each region's samples."""
         for unit, samples in self._samples.values():
-            self.total[unit.y0 : unit.y1, unit.x0 : unit.x1] /= samples
-        return self.total
+            sums[unit.y0 : unit.y1, unit.x0 : unit.x1] /= samples
+        return sums
 
 
 # --- backends ---------------------------------------------------------------------

@@ -27,19 +27,21 @@ EXIT_INTERRUPTED = 130
 MAX_WORKERS = 256  # more processes than that only exhaust the machine
 
 
-def seconds(text: str) -> float:
+def seconds(text: str, zero: bool = False) -> float:
+    """A number of seconds below 1e6: above 0, or from 0 with zero=True."""
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
-    if not 0.0 < value < 1e6:
-        raise argparse.ArgumentTypeError(f"expected seconds above 0, got {text}")
+    if not ((value >= 0.0 if zero else value > 0.0) and value < 1e6):
+        lowest = "from 0" if zero else "above 0"
+        raise argparse.ArgumentTypeError(f"expected seconds {lowest}, got {text}")
     return value
 
 
 def preview_seconds(text: str) -> float:
     """--preview-seconds: 0 (a preview after every unit of work) or more."""
-    return 0.0 if text.strip() in ("0", "0.0") else seconds(text)
+    return seconds(text, zero=True)
 
 
 def worker_count(text: str) -> int:

@@ -386,13 +386,19 @@ def test_linear_exr_without_openexr_exits_2_before_rendering(tmp_path, capsys, m
     assert list(tmp_path.iterdir()) == []
 
 
-def test_mesh_scene_with_a_malformed_obj_exits_2_naming_file_table_key_and_line(tmp_path):
-    (tmp_path / "m.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1\nf 1 2 3\n")
-    scene = tmp_path / "m.toml"
+def mesh_scene(folder: Path, obj_text: str) -> Path:
+    """folder/m.toml: one Lambertian mesh read from folder/m.obj, which holds obj_text."""
+    (folder / "m.obj").write_text(obj_text)
+    scene = folder / "m.toml"
     scene.write_text(
         '[materials.m]\ntype = "lambertian"\n\n'
         '[[objects]]\ntype = "mesh"\npath = "m.obj"\nmaterial = "m"\n'
     )
+    return scene
+
+
+def test_mesh_scene_with_a_malformed_obj_exits_2_naming_file_table_key_and_line(tmp_path):
+    scene = mesh_scene(tmp_path, "v 0 0 0\nv 1 0 0\nv 0 1\nf 1 2 3\n")
     out = tmp_path / "out.png"
     result = run_cli("render", str(scene), "-o", str(out), "--quiet")
     assert result.returncode == 2 and not out.exists()
@@ -402,12 +408,7 @@ def test_mesh_scene_with_a_malformed_obj_exits_2_naming_file_table_key_and_line(
 
 
 def test_a_mesh_with_degenerate_faces_renders_with_a_one_line_warning(tmp_path):
-    (tmp_path / "m.obj").write_text("v 0 0 -2\nv 1 0 -2\nv 0 1 -2\nv 2 0 -2\nf 1 2 3\nf 1 2 4\n")
-    scene = tmp_path / "m.toml"
-    scene.write_text(
-        '[materials.m]\ntype = "lambertian"\n\n'
-        '[[objects]]\ntype = "mesh"\npath = "m.obj"\nmaterial = "m"\n'
-    )
+    scene = mesh_scene(tmp_path, "v 0 0 -2\nv 1 0 -2\nv 0 1 -2\nv 2 0 -2\nf 1 2 3\nf 1 2 4\n")
     out = tmp_path / "out.png"
     result = run_cli("render", str(scene), "-o", str(out), "--quiet", "--width", "8", "--spp", "1")
     assert result.returncode == 0 and out.exists()
@@ -541,3 +542,16 @@ def test_preview_needs_a_file_of_its_own(tmp_path, capsys, monkeypatch, same):
     assert status == 2
     assert "--preview" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["sub"]
+
+
+@pytest.mark.parametrize("value,status", [("0.00", 0), ("0e0", 0), ("-1", 2), ("nan", 2)])
+def test_preview_seconds_from_zero(tmp_path, capsys, value, status):
+    args = ["render", "cornell", *SMALL, "-j", "1", "-o", str(tmp_path / "out.png")]
+    args += ["--preview", str(tmp_path / "preview.png"), "--preview-seconds", value]
+    if status:
+        with pytest.raises(SystemExit) as exit_:
+            main(args)
+        assert exit_.value.code == 2 and "expected seconds from 0" in capsys.readouterr().err
+        assert list(tmp_path.iterdir()) == []
+    else:
+        assert main(args) == 0
