@@ -14,6 +14,8 @@ from .ray import Ray
 from .vec3 import Color
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from .camera import Camera
     from .environment import Environment
     from .render_settings import RenderSettings
@@ -38,6 +40,8 @@ class Scene:
     environment an rtpy.environment.Environment (radiance by direction) that
                 replaces both; Python API only
     camera, settings  what a scene file gave (None for scenes built in code)
+    files       the files a scene file read: itself, its images and OBJ meshes (the
+                paths an output must not overwrite); empty for scenes built in code
     """
 
     def __init__(
@@ -59,6 +63,7 @@ class Scene:
         self.settings = settings
         self.name = name
         self.environment = environment
+        self.files: tuple[Path, ...] = ()
         self.area_lights: list[AreaLight] = []
         self.lights: list[Light] = []
         self.update_lights()

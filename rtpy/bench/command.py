@@ -7,6 +7,8 @@ import sys
 from pathlib import Path
 
 from ..io.bundled import resolve_scene
+from ..io.image import OutputError, WriteError
+from ..io.outputs import check_folder
 from ..io.scene_file import SceneError
 from ..render_settings import SETTINGS, SettingError
 from ..testing.analytic_scenes import ANALYTIC_SCENES
@@ -107,8 +109,10 @@ def _options(args: argparse.Namespace) -> dict:
     for name in scenes:
         if name not in ANALYTIC_SCENES:
             resolve_scene(name)
-    if Path(args.out).exists() and not Path(args.out).is_dir():
-        raise BenchUsageError(f"--out {args.out}: not a folder")
+    try:
+        check_folder(args.out, "--out")
+    except OutputError as err:
+        raise BenchUsageError(str(err)) from None
     return {
         "scenes": scenes,
         "backends": _split(args.backends, BACKENDS, "backends") or ["numpy"],
@@ -125,7 +129,8 @@ def _options(args: argparse.Namespace) -> dict:
 
 def command_bench(args: argparse.Namespace) -> int:
     """Run the bench, print its tables, write its files; 2 for bad options (nothing
-    written), 130 when Ctrl-C stopped it (what was measured is written)."""
+    written), 1 when a file cannot be written, 130 when Ctrl-C stopped it (what was
+    measured is written)."""
 
     def log(msg: str) -> None:
         print(msg, file=sys.stderr)
@@ -147,8 +152,12 @@ def command_bench(args: argparse.Namespace) -> int:
         print(format_series(result))
         if args.quick:
             log("rtpy bench: --quick renders take milliseconds: its timings are not meaningful")
-    files = write_outputs(result, Path(args.out))
-    png = plot(result, Path(args.out), quick=args.quick)
+    try:
+        files = write_outputs(result, Path(args.out))
+        png = plot(result, Path(args.out), quick=args.quick)
+    except WriteError as err:
+        print(f"rtpy: error: {err}", file=sys.stderr)
+        return 1
     if png is None:
         log("rtpy bench: matplotlib is not installed, so no plot (pip install 'rtpy[plot]')")
     else:

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.image import WriteError, atomic_write
 from .convergence import ALPHA, SLOPE_TOLERANCE, BenchResult, Fit, Level
 from .scenes import VARIANTS
 
@@ -108,16 +109,21 @@ def _json_value(v):
 
 def write_outputs(result: BenchResult, out: Path) -> list[Path]:
     """bench.csv (one row per level) and bench.json (levels, fits, settings)."""
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise WriteError(out, err) from err
     csv_path, json_path = out / "bench.csv", out / "bench.json"
     fields = list(Level.__dataclass_fields__)
-    tmp = csv_path.with_suffix(".csv.tmp")
-    with tmp.open("w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=fields)
-        writer.writeheader()
-        for lv in result.levels:
-            writer.writerow(asdict(lv))
-    tmp.replace(csv_path)
+
+    def write_csv(tmp: Path) -> None:
+        with tmp.open("w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=fields)
+            writer.writeheader()
+            for lv in result.levels:
+                writer.writerow(asdict(lv))
+
+    atomic_write(csv_path, write_csv)
     doc = {
         "settings": result.settings,
         "interrupted": result.interrupted,
@@ -128,9 +134,7 @@ def write_outputs(result: BenchResult, out: Path) -> list[Path]:
             for f in result.fits
         ],
     }
-    tmp = json_path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(doc, indent=1))
-    tmp.replace(json_path)
+    atomic_write(json_path, lambda tmp: tmp.write_text(json.dumps(doc, indent=1)))
     return [csv_path, json_path]
 
 
@@ -245,12 +249,14 @@ def plot(result: BenchResult, out: Path, quick: bool = False) -> Path | None:
     fig = draw(result, quick)
     if fig is None:
         return None
-    path = out / "bench.png"
-    tmp = out / ".bench.png.tmp"
-    fig.savefig(tmp, dpi=80, format="png", bbox_inches="tight")  # the notes below included
-    plt.close(fig)
-    tmp.replace(path)
-    return path
+
+    def write(tmp: Path) -> None:  # the notes below the axes included
+        fig.savefig(tmp, dpi=80, format="png", bbox_inches="tight")
+
+    try:
+        return atomic_write(out / "bench.png", write)
+    finally:
+        plt.close(fig)
 
 
 # --------------------------------------------------------------------------- docs/bench.md

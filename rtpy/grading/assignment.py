@@ -222,7 +222,10 @@ def rewrite(path: Path, root: Path, replace) -> str:
 
 
 def check_week(week: str | int) -> str:
-    text = f"{int(week):02d}" if str(week).isdigit() else str(week)
+    """The week as two digits ("5", "05" -> "05") when ASCII digits name one of WEEKS."""
+    text = str(week)
+    if text.isascii() and text.isdigit() and len(text) <= 3:
+        text = f"{int(text):02d}"
     if text not in WEEKS:
         raise AssignmentError(f"week {week!r}: expected one of {', '.join(WEEKS)}")
     return text

@@ -42,6 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.image import atomic_write
 from ..testing.statistics import BlockTest, block_z_test
 
 ALPHA = 1e-3
@@ -317,4 +318,5 @@ def score_table(results: dict) -> str:
 
 
 def write_json(results: dict, path: str | Path) -> None:
-    Path(path).write_text(json.dumps(results, indent=2) + "\n")
+    text = json.dumps(results, indent=2) + "\n"
+    atomic_write(path, lambda tmp: tmp.write_text(text))

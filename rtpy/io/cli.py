@@ -1,8 +1,10 @@
-"""Command line: `python -m rtpy render SCENE ...` and `python -m rtpy scenes`.
+"""Command line: `python -m rtpy render SCENE ...` and `python -m rtpy scenes`; the
+other commands are in rtpy.io.cli_assignment and rtpy.bench.command.
 
-Exit status: 0 done, 1 the worker processes failed (nothing is written), 2 bad input
-(scene file, option or output path; nothing is written), 130 interrupted by Ctrl-C
-(what was finished is written first).
+Exit status: 0 done, 1 the work failed: the worker processes (nothing is written) or
+writing an output (disk full, file too large, I/O error: one line naming the file; an
+output that was there is untouched), 2 bad input (scene file, option or output path;
+nothing is written), 130 interrupted by Ctrl-C (what was finished is written first).
 """
 
 from __future__ import annotations
@@ -16,10 +18,12 @@ from pathlib import Path
 
 from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
 from ..workers import WorkerError, available_cpus
-from .image import OutputError, check_image_path, check_linear_path
-from .preview import same_file
+from .cli_assignment import add_assignment_commands
+from .image import OutputError, WriteError, check_image_path, check_linear_path
+from .outputs import check_output
 
 EXIT_WORKERS_FAILED = 1
+EXIT_WRITE_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
 
@@ -54,14 +58,18 @@ def worker_count(text: str) -> int:
     return value
 
 
+def flag(name: str) -> str:
+    """The option of a render setting that has a flag: max_depth -> --max-depth."""
+    return "--" + name.replace("_", "-")
+
+
 def add_setting_options(r: argparse.ArgumentParser) -> None:
     """--NAME for the render settings that have a flag, and --set KEY=VALUE for all
     of them (rtpy.render_settings.SETTINGS); the values are checked after parsing."""
     for name, setting in SETTINGS.items():
         if setting.flag:
             metavar = {"int": "N", "float": "X", "choice": "NAME"}.get(setting.kind)
-            option = "--" + name.replace("_", "-")
-            r.add_argument(option, dest=name, metavar=metavar, help=setting.help)
+            r.add_argument(flag(name), dest=name, metavar=metavar, help=setting.help)
     r.add_argument(
         "--set",
         action="append",
@@ -143,78 +151,8 @@ def build_parser(prog: str = "rtpy") -> argparse.ArgumentParser:
     from ..bench.command import add_parser as add_bench_parser
 
     add_bench_parser(sub)
-    add_assignment_commands(sub)
+    add_assignment_commands(sub, seconds)
     return parser
-
-
-def add_assignment_commands(sub) -> None:
-    """`assignment make WEEK OUT_DIR`, `assignment autograder WEEK OUT.zip`,
-    `assignment map-tests`, `grade WEEK`."""
-    a = sub.add_parser("assignment", help="write a weekly assignment repository")
-    asub = a.add_subparsers(dest="assignment_command", required=True, metavar="ACTION")
-    make = asub.add_parser("make", help="write week WEEK's student repository to OUT_DIR")
-    make.add_argument("week", metavar="WEEK", help="03 to 08")
-    make.add_argument("out_dir", metavar="OUT_DIR", help="a new or empty directory")
-    z = asub.add_parser("autograder", help="write week WEEK's Gradescope autograder zip")
-    z.add_argument("week", metavar="WEEK", help="03 to 08")
-    z.add_argument("out_zip", metavar="OUT.zip", help="the autograder to upload to Gradescope")
-    from ..grading.autograder import TEST_TIMEOUT, TOTAL_TIMEOUT
-
-    for option, default, what in (
-        ("--test-timeout", TEST_TIMEOUT, "each test"),
-        ("--total-timeout", TOTAL_TIMEOUT, "a whole submission"),
-    ):
-        z.add_argument(
-            option, type=seconds, default=default, metavar="S", help=f"seconds for {what}"
-        )
-    m = asub.add_parser("map-tests", help="record which weeks each test file needs (slow)")
-    m.add_argument("files", nargs="*", metavar="TEST_FILE", help="only these (tests/...)")
-    g = sub.add_parser("grade", help="run a week's graders and print the score")
-    g.add_argument("week", metavar="WEEK", help="03 to 08")
-    g.add_argument("--json", metavar="RESULTS.json", help="Gradescope results file")
-
-
-def command_assignment(args: argparse.Namespace) -> int:
-    from ..grading.assignment import AssignmentError, check_week, make_assignment, map_tests
-
-    try:
-        if args.command == "grade":
-            return command_grade(check_week(args.week), args.json)
-        if args.assignment_command == "map-tests":
-            weeks = map_tests(files=tuple(args.files))
-            print(f"rtpy: {len(weeks)} test files need solution regions", file=sys.stderr)
-            return 0
-        if args.assignment_command == "autograder":
-            from ..grading.autograder import build_autograder
-
-            out = build_autograder(
-                args.week,
-                args.out_zip,
-                test_timeout=args.test_timeout,
-                total_timeout=args.total_timeout,
-            )
-            print(
-                f"rtpy: wrote the week {check_week(args.week)} autograder to {out}", file=sys.stderr
-            )
-            return 0
-        out = make_assignment(args.week, args.out_dir)
-    except (AssignmentError, FileNotFoundError) as err:
-        print(f"rtpy: error: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    print(f"rtpy: wrote the week {check_week(args.week)} repository to {out}", file=sys.stderr)
-    return 0
-
-
-def command_grade(week: str, json_path: str | None) -> int:
-    """0 when every grader passes, 1 otherwise."""
-    from ..grading.graders import grade, score_table, write_json
-
-    results = grade(week)
-    print(score_table(results))
-    if json_path:
-        write_json(results, json_path)
-    passed = results["score"] == results["max_score"] and "output" not in results
-    return 0 if passed else 1
 
 
 def load_plugins(paths: list[str]) -> None:
@@ -232,10 +170,20 @@ class UsageError(Exception):
     pass
 
 
-def read_value(text: str):
-    """A command-line value read as TOML (2, 2.5, true, [0.1, 0.2, 0.3], "path"), or
-    the text itself when it is not TOML (a bare word such as path) or more than
-    TOML takes (an integer of thousands of digits, arrays nested thousands deep)."""
+def shown(text: str) -> str:
+    """text as a message shows it: as it is when printable, else quoted and escaped
+    (a message stays one line)."""
+    return text if text.isprintable() else repr(text)
+
+
+def read_value(text: str, option: str):
+    """A command-line value read as one TOML value (2, 2.5, true, [0.1, 0.2, 0.3],
+    "path"), or the text itself when it is not TOML (a bare word such as srgb) or more
+    than TOML takes (an integer of thousands of digits, arrays nested thousands deep).
+    UsageError naming `option` for a line break (TOML reads the next line as more keys);
+    a table is one value, refused by the setting's check as in a scene file."""
+    if "\n" in text or "\r" in text:
+        raise UsageError(f"{option}: expected one value on one line, got {text!r}")
     try:
         return tomllib.loads(f"v = {text}")["v"]
     except (tomllib.TOMLDecodeError, ValueError, RecursionError):
@@ -251,8 +199,9 @@ def parse_set(items: list[str]) -> dict:
         if not sep:
             raise UsageError(f"--set {item!r}: expected KEY=VALUE")
         if key not in SETTINGS:
-            raise UsageError(unknown_setting(key, list(SETTINGS)).for_option(f"--set {key}"))
-        result[key] = read_value(text)
+            error = unknown_setting(key, list(SETTINGS))
+            raise UsageError(error.for_option(f"--set {shown(key)}"))
+        result[key] = read_value(text, f"--set {key}")
     return result
 
 
@@ -264,7 +213,7 @@ def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
         try:
             checked[key] = SETTINGS[key].check(value)
         except SettingError as e:
-            option = f"--{key.replace('_', '-')}" if as_flags else f"--set {key}"
+            option = flag(key) if as_flags else f"--set {key}"
             raise UsageError(e.for_option(option)) from None
     return checked
 
@@ -336,6 +285,25 @@ def command_render(args: argparse.Namespace) -> int:
         signal.signal(signal.SIGINT, previous)
 
 
+def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
+    """(output, linear, preview) paths, each writable, none of them a file the render
+    reads (the scene file, its images and meshes, the plugins) or another output."""
+    inputs = [*scene.files, *args.plugin]
+    output = check_output(
+        args.output if args.output is not None else f"{path.stem}.png",
+        "-o",
+        inputs,
+        check=check_image_path,
+    )
+    linear = preview = None
+    if args.linear:
+        linear = check_output(args.linear, "--linear", inputs, [output], check_linear_path)
+    if args.preview:
+        others = [output] + ([linear] if linear else [])
+        preview = check_output(args.preview, "--preview", inputs, others, check_image_path)
+    return output, linear, preview
+
+
 def _render(args: argparse.Namespace) -> int:
     from .. import render
     from .bundled import resolve_scene
@@ -351,17 +319,10 @@ def _render(args: argparse.Namespace) -> int:
             print(f"rtpy: warning: {warning.message}", file=sys.stderr)
         overrides = validate_overrides(parse_set(args.set))
         flags = {name: getattr(args, name) for name, setting in SETTINGS.items() if setting.flag}
-        given = {k: read_value(v) for k, v in flags.items() if v is not None}
+        given = {k: read_value(v, flag(k)) for k, v in flags.items() if v is not None}
         overrides.update(validate_overrides(given, as_flags=True))
         check_width(scene, path, overrides, "--width" if args.width is not None else "--set width")
-        output = Path(args.output) if args.output is not None else Path(f"{path.stem}.png")
-        check_image_path(output)
-        linear = check_linear_path(args.linear) if args.linear else None
-        preview = check_image_path(args.preview) if args.preview else None
-        if preview is not None and any(
-            same_file(preview, other) for other in (output, linear, path) if other is not None
-        ):
-            raise UsageError(f"--preview {args.preview}: the preview needs a file of its own")
+        output, linear, preview = check_outputs(args, scene, path)
         check_backend(args.backend)
     except (SceneError, OutputError, UsageError) as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
@@ -380,6 +341,9 @@ def _render(args: argparse.Namespace) -> int:
     except WorkerError as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_WORKERS_FAILED
+    except WriteError as err:  # a preview
+        print(f"rtpy: error: {err}", file=sys.stderr)
+        return EXIT_WRITE_FAILED
     if image.interrupted:
         print(
             "rtpy: interrupted: writing the samples finished so far "
@@ -390,9 +354,13 @@ def _render(args: argparse.Namespace) -> int:
 
     # A Ctrl-C while the image is written (after a complete render) leaves no file:
     # writes are atomic. After a first Ctrl-C, a second one ends at once.
-    written = [image.save(output)]
-    if linear is not None:
-        written.append(image.save(linear))
+    try:
+        written = [image.save(output)]
+        if linear is not None:
+            written.append(image.save(linear))
+    except WriteError as err:
+        print(f"rtpy: error: {err}", file=sys.stderr)
+        return EXIT_WRITE_FAILED
     stats = image.stats
     files = ", ".join(str(p) for p in written)
     if image.interrupted:
@@ -426,6 +394,8 @@ def main(argv: list[str] | None = None, prog: str = "rtpy") -> int:
 
         return command_bench(args)
     if args.command in ("assignment", "grade"):
+        from .cli_assignment import command_assignment
+
         return command_assignment(args)
     return command_render(args)
 

@@ -41,6 +41,7 @@ __all__ = [
     "OUTPUT_EXTENSIONS",
     "OutputError",
     "RenderedImage",
+    "WriteError",
     "atomic_write",
     "check_image_path",
     "check_linear_path",
@@ -73,6 +74,15 @@ _JPEG_QUALITY = 95
 
 class OutputError(Exception):
     """An output file cannot be written; the message names the path and the problem."""
+
+
+class WriteError(OutputError):
+    """Writing an output failed once the work was done (disk full, file too large, I/O
+    error); whatever was there before is untouched. ``errno`` is the OSError's."""
+
+    def __init__(self, path: StrPath, err: OSError) -> None:
+        super().__init__(f"cannot write '{os.fspath(path)}': {err.strerror or err}")
+        self.errno = err.errno
 
 
 # --------------------------------------------------------------------------- path checks
@@ -200,8 +210,9 @@ def atomic_write(path: StrPath, write_fn: Callable[[Path], object]) -> Path:
     ``write_fn(tmp_path)`` must write the complete file to ``tmp_path``; the
     temporary file is then renamed over ``path`` with :func:`os.replace`. If
     anything fails (including ``KeyboardInterrupt``) the temporary file is
-    removed, the exception propagates, and ``path`` is left untouched: either
-    absent or with its previous content. Returns ``path`` as a :class:`Path`.
+    removed, the exception propagates (an OSError as :class:`WriteError`), and
+    ``path`` is left untouched: either absent or with its previous content.
+    Returns ``path`` as a :class:`Path`.
     """
     target = Path(path)
     try:
@@ -210,15 +221,20 @@ def atomic_write(path: StrPath, write_fn: Callable[[Path], object]) -> Path:
         mode = stat.S_IMODE(os.stat(target).st_mode)
     except OSError:
         mode = _new_file_mode()
-    tmp_path = _new_temporary_file(target)
+    try:
+        tmp_path = _new_temporary_file(target)
+    except OSError as err:
+        raise WriteError(target, err) from err
     try:
         write_fn(tmp_path)
         with open(tmp_path, "rb+") as f:  # make sure the data is on disk before renaming
             os.fsync(f.fileno())
         os.chmod(tmp_path, mode)
         os.replace(tmp_path, target)
-    except BaseException:
+    except BaseException as err:
         tmp_path.unlink(missing_ok=True)
+        if isinstance(err, OSError):
+            raise WriteError(target, err) from err
         raise
     finally:
         _temporary_files.discard(tmp_path)

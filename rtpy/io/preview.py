@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from pathlib import Path
 
 from .image import RenderedImage, check_image_path
 
@@ -56,8 +55,3 @@ def notebook_preview() -> Preview:
             handle.update(image)
 
     return show
-
-
-def same_file(a: Path, b: Path) -> bool:
-    """a and b name one file (compared as absolute paths, links resolved)."""
-    return Path(a).resolve() == Path(b).resolve()

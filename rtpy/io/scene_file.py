@@ -108,6 +108,7 @@ class _Loader(TableReader):
         super().__init__(text, path)
         self.textures: dict[str, Texture] = {}
         self.materials: dict[str, Any] = {}
+        self.files: list[Path] = [path]  # the files the scene reads (Scene.files)
 
     # --- sections -------------------------------------------------------------------
     def load(self, data: dict) -> Scene:
@@ -137,9 +138,11 @@ class _Loader(TableReader):
             self.light(Where.array("lights", i), t)
             for i, t in enumerate(self.array_of_tables(data, "lights"))
         ]
-        return Scene(
+        scene = Scene(
             objects, lights, background, sky, camera=camera, settings=settings, name=self.path.stem
         )
+        scene.files = tuple(self.files)
+        return scene
 
     def camera(self, t: dict) -> Camera:
         w = Where.table("camera")
@@ -239,6 +242,7 @@ class _Loader(TableReader):
                 raise self.fail(w, "path", f"{resolved} is a directory, not an image file")
             if not resolved.is_file():
                 raise self.fail(w, "path", f"image file not found: {resolved}")
+            self.files.append(resolved)
             from PIL import Image
 
             with Image.open(resolved) as im:
@@ -368,6 +372,7 @@ class _Loader(TableReader):
             )
         material = self.reference(w, t)
         resolved = self.path.parent / rel
+        self.files.append(resolved)
         try:
             obj = read_obj(resolved)
         except FileNotFoundError:

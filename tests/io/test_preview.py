@@ -10,7 +10,7 @@ import pytest
 from PIL import Image
 
 from rtpy.io.image import OutputError, RenderedImage
-from rtpy.io.preview import notebook_preview, preview_target, same_file
+from rtpy.io.preview import notebook_preview, preview_target
 
 
 def image(value: float) -> RenderedImage:
@@ -78,9 +78,3 @@ def test_a_notebook_preview_without_ipython_says_what_to_pass(monkeypatch):
     monkeypatch.setitem(sys.modules, "IPython.display", None)
     with pytest.raises(ValueError, match="file name or a function"):
         notebook_preview()
-
-
-def test_same_file(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    assert same_file(tmp_path / "a.png", "a.png")
-    assert not same_file(tmp_path / "a.png", tmp_path / "b.png")
