@@ -4,13 +4,18 @@ exit 2 with nothing written, and Ctrl-C keeps the levels measured."""
 from __future__ import annotations
 
 import csv
+import errno
 import json
+import os
 import sys
 
 import pytest
 
+from rtpy.bench import command, report
+from rtpy.bench.convergence import BenchResult
 from rtpy.bench.scenes import VARIANTS
 from rtpy.io.cli import main
+from rtpy.io.image import atomic_write
 
 from ..commands import read_until, rtpy_command
 
@@ -111,3 +116,39 @@ def test_ctrl_c_keeps_the_levels_measured(tmp_path):
     assert doc["interrupted"] is True
     assert [int(r["spp"]) for r in rows] == [1, 2, 4, 8]
     assert doc["fits"][0]["levels"] == 4 and "relMSE" in stdout
+
+
+def test_an_out_folder_at_or_under_a_file_is_refused_before_measuring(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.setattr(command, "run_bench", lambda **kwargs: pytest.fail("measured"))
+    (tmp_path / "file").write_text("")
+    for out in (tmp_path / "file", tmp_path / "file" / "sub"):
+        assert main(["bench", "--quick", "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert err == f"rtpy: error: --out {out}: {tmp_path / 'file'} is not a folder\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["file"]
+
+
+def test_a_full_disk_after_measuring_is_one_line_exit_1_and_keeps_the_old_files(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    monkeypatch.setattr(command, "run_bench", lambda **kwargs: BenchResult())
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "bench.csv").write_text("old")
+
+    def full_disk(path, write):
+        def half(tmp):
+            tmp.write_text("half")
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+        return atomic_write(path, half)
+
+    monkeypatch.setattr(report, "atomic_write", full_disk)
+    assert main(["bench", "--quick", "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err == f"rtpy: error: cannot write '{out / 'bench.csv'}': {os.strerror(errno.ENOSPC)}\n"
+    assert [p.name for p in out.iterdir()] == ["bench.csv"]
+    assert (out / "bench.csv").read_text() == "old"

@@ -2,23 +2,28 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import select
 import signal
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from PIL import Image
 
 import rtpy
-from rtpy.io.bundled import bundled_scenes
-from rtpy.io.cli import MAX_WORKERS, build_parser, main
+from rtpy.io.bundled import bundled_dir, bundled_scenes
+from rtpy.io.cli import MAX_WORKERS, UsageError, build_parser, main, parse_set, validate_overrides
 from rtpy.io.image import read_pfm
 from rtpy.materials import MATERIALS
+from rtpy.render_settings import SETTINGS
 
 from ..commands import read_until, rtpy_command, run_cli
 from ..tiers import slow_except
@@ -555,3 +560,134 @@ def test_preview_seconds_from_zero(tmp_path, capsys, value, status):
         assert list(tmp_path.iterdir()) == []
     else:
         assert main(args) == 0
+
+
+# --- one value per --set, outputs that are inputs, writes that fail ----------------------
+@settings(max_examples=150)
+@given(
+    key=st.sampled_from(sorted(SETTINGS)),
+    text=st.one_of(
+        st.text(),
+        st.integers(-5, 10**6).map(str),
+        st.sampled_from(["true", "srgb", "path", " 2.5 # c", "[0.1, 0.2, 0.3]", "{a = 1}"]),
+    ),
+)
+def test_a_set_value_is_one_line_refusal_or_applied_as_its_toml(key, text):
+    """Any text after KEY=: refused in one line naming --set KEY, or applied as the one
+    TOML value it is (a bare word as itself); never a second key smuggled past."""
+    try:
+        overrides = validate_overrides(parse_set([f"{key}={text}"]))
+    except UsageError as e:
+        assert str(e).startswith(f"--set {key}") and len(str(e).splitlines()) == 1
+        return
+    assert text.isprintable()
+    try:
+        value = tomllib.loads(f"v = {text}")["v"]
+    except (tomllib.TOMLDecodeError, ValueError, RecursionError):
+        value = text.strip()
+    assert overrides == {key: SETTINGS[key].check(value)}
+
+
+@settings(max_examples=40)
+@given(spp=st.integers(1, 10**6), other=st.sampled_from(["width=8", "spp=1", "[render]"]))
+def test_a_line_break_never_smuggles_a_second_key(spp, other):
+    assert parse_set([f"spp={spp}"]) == {"spp": spp}
+    for separator in ("\n", "\r\n", "\r"):
+        with pytest.raises(UsageError, match=r"^--set spp: expected one value on one line"):
+            parse_set([f"spp={spp}{separator}{other}"])
+
+
+def test_a_second_key_in_set_or_a_flag_exits_2_before_rendering(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(rtpy, "render", lambda *a, **k: pytest.fail("rendered"))
+    out = str(tmp_path / "x.png")
+    for option in (["--set", "spp=4\nwidth=8"], ["--spp", "4\nwidth = 8"]):
+        assert main(["render", "cornell", "--quiet", "-o", out, *option]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"rtpy: error: {option[0]}") and len(err.splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_output_that_the_render_reads_is_refused_whatever_its_extension(tmp_path, capsys):
+    """The scene file named like a PNG, a texture, a plugin behind a link: exit 2,
+    each input as it was."""
+    (tmp_path / "planet.png").write_bytes((bundled_dir() / "planet.png").read_bytes())
+    (tmp_path / "scene.png").write_text((bundled_dir() / "week07_textures.toml").read_text())
+    (tmp_path / "plugin.py").write_text("")
+    args = ["render", str(tmp_path / "scene.png"), *SMALL, "--plugin", str(tmp_path / "plugin.py")]
+    cases = [["-o", "scene.png"], ["-o", "planet.png"], ["-o", "x.png", "--preview", "planet.png"]]
+    if sys.platform != "win32":
+        os.symlink(tmp_path / "plugin.py", tmp_path / "plugin.npy")
+        cases.append(["-o", "x.png", "--linear", "plugin.npy"])
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    for case in cases:
+        argv = [*args, *(str(tmp_path / a) if "." in a else a for a in case)]
+        assert main(argv) == 2, case
+        err = capsys.readouterr().err
+        assert "an input" in err and len(err.splitlines()) == 1, err
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_a_write_that_fails_half_way_is_one_line_exit_1_and_keeps_the_old_image(
+    tmp_path, capsys, monkeypatch
+):
+    """The disk fills while the PNG is written: exit 1, one line naming the file and
+    the reason, no temporary file, the image that was there untouched."""
+    out = tmp_path / "out.png"
+    out.write_bytes(b"old image")
+
+    def half_then_full(self, fp, *args, **kwargs):
+        Path(fp).write_bytes(b"\x89PNG half")
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(Image.Image, "save", half_then_full)
+    assert main(["render", "cornell", *SMALL, "-j", "1", "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err == f"rtpy: error: cannot write '{out}': {os.strerror(errno.ENOSPC)}\n"
+    assert out.read_bytes() == b"old image" and list(tmp_path.iterdir()) == [out]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_FSIZE as on Linux")
+def test_a_file_size_limit_is_one_line_exit_1_in_a_real_process(tmp_path):
+    """A real limit on file size (SIGXFSZ ignored, so the write fails with EFBIG):
+    exit 1, one line, no traceback, the old outputs untouched, no temporary file."""
+    old = {name: b"old" for name in ("out.png", "out.npy")}
+    for name, data in old.items():
+        (tmp_path / name).write_bytes(data)
+    code = (
+        "import resource, signal, sys\n"
+        "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+        "resource.setrlimit(resource.RLIMIT_FSIZE, (64, 64))\n"
+        "from rtpy.io.cli import main\n"
+        "sys.exit(main(sys.argv[1:]))\n"
+    )
+    argv = ["render", "cornell", *SMALL, "-j", "1", "-o", "out.png", "--linear", "out.npy"]
+    proc = subprocess.run(
+        [sys.executable, "-c", code, *argv], cwd=tmp_path, capture_output=True, text=True,
+        timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 1, proc.stderr
+    assert re.fullmatch(
+        rf"rtpy: error: cannot write 'out\.(png|npy)': {os.strerror(errno.EFBIG)}\n", proc.stderr
+    )
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == old
+
+
+def test_a_preview_that_cannot_be_written_stops_the_render_in_one_line(
+    tmp_path, capsys, monkeypatch
+):
+    real = Image.Image.save
+
+    def save(self, fp, *args, **kwargs):
+        if "preview" in str(fp):
+            raise OSError(errno.EIO, os.strerror(errno.EIO))
+        return real(self, fp, *args, **kwargs)
+
+    monkeypatch.setattr(Image.Image, "save", save)
+    preview = tmp_path / "preview.png"
+    argv = ["render", "cornell", *SMALL, "-j", "1", "-o", str(tmp_path / "out.png")]
+    assert main([*argv, "--preview", str(preview), "--preview-seconds", "0"]) == 1
+    assert capsys.readouterr().err == (
+        f"rtpy: error: cannot write '{preview}': {os.strerror(errno.EIO)}\n"
+    )
+    assert list(tmp_path.iterdir()) == []

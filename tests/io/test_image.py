@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import io
 import os
 import stat
@@ -16,6 +17,7 @@ from rtpy.io import image
 from rtpy.io.image import (
     OutputError,
     RenderedImage,
+    WriteError,
     atomic_write,
     check_image_path,
     check_linear_path,
@@ -242,6 +244,43 @@ def test_failed_write_png_leaves_no_file(tmp_path: Path, monkeypatch: pytest.Mon
     monkeypatch.setattr(Image.Image, "save", fail)
     with pytest.raises(Boom):
         write_png(tmp_path / "img.png", rgb([0.5]), 2.0)
+    assert listing(tmp_path) == []
+
+
+@pytest.mark.parametrize(
+    "code", [errno.ENOSPC, errno.EFBIG, errno.EIO, errno.EACCES, errno.EROFS, errno.ENAMETOOLONG]
+)
+def test_an_os_error_half_way_is_one_write_error_and_keeps_the_old_file(
+    tmp_path: Path, code: int
+) -> None:
+    """A disk that fills (or any OSError) after some bytes are written: WriteError,
+    one line naming the file and the reason, no temporary file, the old file as it was."""
+    target = tmp_path / "out.png"
+    target.write_bytes(b"old image")
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "wb") as f:
+            f.write(b"new, partial")
+            f.flush()
+            raise OSError(code, os.strerror(code))
+
+    with pytest.raises(WriteError) as info:
+        atomic_write(target, write)
+    assert str(info.value) == f"cannot write '{target}': {os.strerror(code)}"
+    assert info.value.errno == code and isinstance(info.value, OutputError)
+    assert target.read_bytes() == b"old image"
+    assert listing(tmp_path) == ["out.png"]
+
+
+def test_a_temporary_file_that_cannot_be_made_is_a_write_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def full(*args: object) -> int:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "open", full)
+    with pytest.raises(WriteError, match="No space left on device|ENOSPC"):
+        atomic_write(tmp_path / "out.npy", lambda tmp: None)
     assert listing(tmp_path) == []
 
 

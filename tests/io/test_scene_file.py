@@ -257,6 +257,23 @@ def test_image_texture_path_is_relative_to_the_scene_file(tmp_path):
     assert err.key == "path" and str(tmp_path / "elsewhere" / "tex" / "red.png") in str(err)
 
 
+def test_a_scene_lists_the_files_it_read(tmp_path):
+    """Scene.files: the scene file, each image and each OBJ file (what an output
+    must not overwrite); a scene built in code reads none."""
+    Image.new("RGB", (2, 2)).save(tmp_path / "red.png")
+    (tmp_path / "tri.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    scene_file = tmp_path / "s.toml"
+    scene_file.write_text(
+        '[textures.img]\ntype = "image"\npath = "red.png"\n'
+        '[materials.m]\ntype = "lambertian"\nalbedo = "img"\n'
+        '[[objects]]\ntype = "mesh"\npath = "tri.obj"\nmaterial = "m"\n',
+        encoding="utf-8",
+    )
+    files = load_scene(scene_file).files
+    assert files == (scene_file, tmp_path / "red.png", tmp_path / "tri.obj")
+    assert Scene().files == ()
+
+
 def test_unused_textures_and_materials_are_allowed():
     scene = load(
         MINIMAL + '[textures.spare]\ntype = "solid"\ncolor = [1, 1, 1]\n'
