@@ -101,6 +101,11 @@ def test_unbalanced_markers_are_refused(tmp_path):
         regions_in(bad, tmp_path)
 
 
+def test_the_known_weeks_are_the_assignment_folders():
+    folders = sorted(p.name[4:] for p in (ROOT / "assignments").glob("week[0-9][0-9]"))
+    assert list(WEEKS) == folders
+
+
 def test_bad_week_and_non_empty_output_are_refused(tmp_path, capsys):
     assert main(["assignment", "make", "09", str(tmp_path / "out")]) == 2
     assert "expected one of 03" in capsys.readouterr().err

@@ -685,7 +685,7 @@ def test_a_preview_that_cannot_be_written_stops_the_render_in_one_line(
 
     monkeypatch.setattr(Image.Image, "save", save)
     preview = tmp_path / "preview.png"
-    argv = ["render", "cornell", *SMALL, "-j", "1", "-o", str(tmp_path / "out.png")]
+    argv = ["render", "cornell", *SMALL, "--spp", "4", "-j", "1", "-o", str(tmp_path / "out.png")]
     assert main([*argv, "--preview", str(preview), "--preview-seconds", "0"]) == 1
     assert capsys.readouterr().err == (
         f"rtpy: error: cannot write '{preview}': {os.strerror(errno.EIO)}\n"
