@@ -100,12 +100,15 @@ def test_assignment_make_on_a_full_disk_is_one_line_exit_1_and_writes_nothing(
     def write_repository(root, week, dest):
         full_disk(dest / "README.md")
 
+    source = tmp_path / "source"
+    (source / "assignments" / "week05").mkdir(parents=True)
+    monkeypatch.setattr(assignment, "source_root", lambda command: source)
     monkeypatch.setattr(assignment, "_write_repository", write_repository)
     out = tmp_path / "week05"
     assert main(["assignment", "make", "05", str(out)]) == 1
     err = capsys.readouterr().err
     assert err == f"rtpy: error: cannot write '{out}': {os.strerror(errno.ENOSPC)}\n"
-    assert list(tmp_path.iterdir()) == []
+    assert list(tmp_path.iterdir()) == [source]
 
 
 def test_an_autograder_that_cannot_be_written_is_refused_before_any_work(
