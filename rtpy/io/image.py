@@ -445,7 +445,8 @@ class RenderedImage:
 
         ``.png``/``.jpg``/``.jpeg`` are 8-bit and encoded with :attr:`gamma`;
         ``.npy``/``.pfm``/``.exr`` are linear and never encoded. Any other extension
-        raises :class:`OutputError`.
+        raises :class:`OutputError`, a failing write :class:`WriteError` (the file
+        that was there is untouched).
         """
         ext = _ext(Path(path))
         if ext in IMAGE_EXTENSIONS:
