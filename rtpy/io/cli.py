@@ -180,10 +180,9 @@ def read_value(text: str, option: str):
     """A command-line value read as one TOML value (2, 2.5, true, [0.1, 0.2, 0.3],
     "path"), or the text itself when it is not TOML (a bare word such as srgb) or more
     than TOML takes (an integer of thousands of digits, arrays nested thousands deep).
-    UsageError naming `option` for a line break (TOML reads the next line as more keys)
-    or any character that is not printable; a table is one value, refused by the
-    setting's check as in a scene file."""
-    if not text.isprintable():
+    UsageError naming `option` for a line break (TOML reads the next line as more
+    keys); a table is one value, refused by the setting's check as in a scene file."""
+    if "\n" in text or "\r" in text:
         raise UsageError(f"{option}: expected one value on one line, got {text!r}")
     try:
         return tomllib.loads(f"v = {text}")["v"]
