@@ -30,7 +30,7 @@ import tomllib
 import zipfile
 from pathlib import Path
 
-from ..io.image import atomic_write
+from ..io.image import atomic_write, check_writable
 from .assignment import AssignmentError, check_week, find_regions, make_assignment, source_root
 from .autograder_run import CONFIG_FILE
 from .autograder_submission import child_environment
@@ -173,13 +173,13 @@ def build_autograder(
     test_timeout: float = TEST_TIMEOUT,
     total_timeout: float = TOTAL_TIMEOUT,
 ) -> Path:
-    """Write week's Gradescope autograder to `out` (a .zip), atomically."""
+    """Write week's Gradescope autograder to `out` (a .zip), atomically; `out` is
+    checked first (OutputError when it cannot be written)."""
     week = check_week(week)
     out = Path(out)
     if out.suffix.lower() != ".zip":
         raise AssignmentError(f"{out}: the autograder is a .zip file")
-    if not out.parent.is_dir():
-        raise AssignmentError(f"{out.parent}: no such directory")
+    check_writable(out)
     for name, value in (("test timeout", test_timeout), ("total timeout", total_timeout)):
         if not 0 < value < 1e6:
             raise AssignmentError(f"{name} {value}: expected seconds > 0")

@@ -277,7 +277,7 @@ def test_the_zip_holds_what_gradescope_needs(built, tmp_path):
     [
         (["09", "x.zip"], "expected one of 03"),
         (["05", "x.txt"], "is a .zip file"),
-        (["05", "missing/x.zip"], "no such directory"),
+        (["05", "missing/x.zip"], "does not exist"),
         (["05", "x.zip", "--test-timeout", "0"], "expected seconds above 0"),
     ],
 )
