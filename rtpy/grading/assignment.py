@@ -224,7 +224,7 @@ def rewrite(path: Path, root: Path, replace) -> str:
 def check_week(week: str | int) -> str:
     """The week as two digits ("5", "05" -> "05") when ASCII digits name one of WEEKS."""
     text, digits = str(week), str(week).lstrip("0")
-    if text.isascii() and text.isdigit() and len(digits) <= 2:
+    if text.isdigit() and len(digits) <= 2:  # WEEKS are ASCII: other digits stay unknown
         text = digits.zfill(2)
     if text not in WEEKS:
         raise AssignmentError(f"week {week!r}: expected one of {', '.join(WEEKS)}")

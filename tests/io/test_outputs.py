@@ -3,8 +3,11 @@ name looks like, and output folders are checked before any work."""
 
 from __future__ import annotations
 
+import errno
 import os
+import re
 import sys
+import tempfile
 
 import pytest
 
@@ -77,6 +80,18 @@ def test_a_folder_at_or_under_a_file_is_refused_in_one_line(tmp_path, below):
     with pytest.raises(OutputError, match=r"^--out .*file.*: .*file is not a folder$") as e:
         check_folder(path, "--out")
     assert "\n" not in str(e.value)
+
+
+def test_a_folder_where_no_file_can_be_made_is_refused(tmp_path, monkeypatch):
+    """A read-only file system (as root every permission check passes, so only trying
+    to create a file tells)."""
+
+    def read_only(*args, **kwargs):
+        raise OSError(errno.EROFS, os.strerror(errno.EROFS))
+
+    monkeypatch.setattr(tempfile, "TemporaryFile", read_only)
+    with pytest.raises(OutputError, match=re.escape(f"({os.strerror(errno.EROFS)})")):
+        check_folder(tmp_path / "bench", "--out")
 
 
 @pytest.mark.skipif(
