@@ -9,8 +9,6 @@ import sys
 
 from .image import OutputError, WriteError, check_writable
 
-EXIT_FAILED = 1  # the work or its write failed
-EXIT_BAD_INPUT = 2
 WEEK_HELP = "the week's two digits, 03 to 08"
 
 
@@ -44,6 +42,7 @@ def command_assignment(args: argparse.Namespace) -> int:
     """Run `assignment ...` or `grade`: 0 done (grade: every grader passed), 1 a grader
     failed or a write failed, 2 a bad week or output (nothing written)."""
     from ..grading.assignment import AssignmentError, check_week, map_tests
+    from .cli import EXIT_BAD_INPUT, EXIT_WRITE_FAILED
 
     try:
         week = None if getattr(args, "week", None) is None else check_week(args.week)
@@ -57,7 +56,7 @@ def command_assignment(args: argparse.Namespace) -> int:
         written = write_assignment(args, week)
     except WriteError as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
-        return EXIT_FAILED
+        return EXIT_WRITE_FAILED
     except (AssignmentError, OutputError, FileNotFoundError) as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -94,4 +93,4 @@ def command_grade(week: str, json_path: str | None) -> int:
     if json_path:
         write_json(results, json_path)
     passed = results["score"] == results["max_score"] and "output" not in results
-    return 0 if passed else EXIT_FAILED
+    return 0 if passed else 1
