@@ -106,7 +106,7 @@ def test_images_agree_with_the_independent_sampler(sampler, integrator):
     """Cornell box (area light, diffuse walls): the mean of 8 renders with each sampler
     against 8 with the independent one, each side's variance from its own spread."""
     scene = rtpy.load_scene("cornell")
-    settings = {"width": 16, "spp": 8, "integrator": integrator}
+    settings = {"width": 16, "spp": 4, "integrator": integrator}
     a = renders(scene, sampler, range(8), **settings)
     b = renders(scene, "independent", range(100, 108), **settings)
     var_a, var_b = a.var(axis=0, ddof=1) / len(a), b.var(axis=0, ddof=1) / len(b)
@@ -117,9 +117,9 @@ def test_images_agree_with_the_independent_sampler(sampler, integrator):
 @pytest.mark.slow
 @pytest.mark.parametrize("sampler", ["stratified", "sobol"])
 def test_images_are_the_same_for_any_worker_count(sampler):
-    """Several units of work (64 x 64 pixels x 32 spp is more than one unit holds)."""
+    """Several units of work (48 x 48 pixels x 32 spp is more than one unit holds)."""
     scene = rtpy.load_scene("cornell")
-    settings = {"width": 64, "spp": 32, "sampler": sampler, "integrator": "path", "seed": 3}
+    settings = {"width": 48, "spp": 32, "sampler": sampler, "integrator": "path", "seed": 3}
     one = rtpy.render(scene, backend="numpy", workers=1, **settings).linear
     two = rtpy.render(scene, backend="numpy", workers=2, **settings).linear
     assert np.array_equal(one, two)
