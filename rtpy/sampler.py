@@ -80,9 +80,13 @@ def unit_float(h: int) -> float:
     return (h >> 11) * TWO_TO_MINUS_53
 
 
+_REVERSED_BYTE = [int(f"{b:08b}"[::-1], 2) for b in range(256)]
+
+
 def reverse_bits32(v: int) -> int:
-    """The 32 bits of v in reverse order."""
-    return int(f"{v & MASK32:032b}"[::-1], 2)
+    """The 32 bits of v in reverse order (byte by byte, each byte mirrored)."""
+    r = _REVERSED_BYTE
+    return r[v & 255] << 24 | r[v >> 8 & 255] << 16 | r[v >> 16 & 255] << 8 | r[v >> 24 & 255]
 
 
 def owen_scramble(v: int, seed: int) -> int:
@@ -99,20 +103,42 @@ def owen_scramble(v: int, seed: int) -> int:
     return reverse_bits32(v)
 
 
+def _sobol_columns() -> list[int]:
+    """The generator matrix of the second Sobol dimension, column k for bit k of the
+    index, as 32-bit fractions: v_0 = 1/2, v_{k+1} = v_k xor (v_k >> 1)."""
+    columns, v = [], 1 << 31
+    for _ in range(32):
+        columns.append(v)
+        v ^= v >> 1
+    return columns
+
+
+def _byte_products(columns: list[int]) -> list[list[int]]:
+    """table[b][byte]: the xor of the columns 8b .. 8b + 7 that the bits of `byte` pick,
+    so that a matrix-vector product over GF(2) takes four lookups."""
+    table = []
+    for b in range(4):
+        row = []
+        for byte in range(256):
+            product = 0
+            for k in range(8):
+                if byte >> k & 1:
+                    product ^= columns[8 * b + k]
+            row.append(product)
+        table.append(row)
+    return table
+
+
+SOBOL_Y_BYTES = _byte_products(_sobol_columns())
+
+
 def sobol_2d(index: int) -> tuple[int, int]:
-    """Point `index` of the 2D Sobol (0,2)-sequence as two 32-bit fractions: the van
-    der Corput sequence (the bits of index mirrored) and the second Sobol dimension,
-    whose generator matrix has columns v_{k+1} = v_k xor (v_k >> 1)."""
-    x = y = 0
-    vx = vy = 1 << 31
-    while index:
-        if index & 1:
-            x ^= vx
-            y ^= vy
-        index >>= 1
-        vx >>= 1
-        vy ^= vy >> 1
-    return x, y
+    """Point `index` (< 2^32) of the 2D Sobol (0,2)-sequence as two 32-bit fractions:
+    the van der Corput sequence (the bits of index mirrored: its generator matrix is
+    the reversal) and the second Sobol dimension (_sobol_columns)."""
+    t = SOBOL_Y_BYTES
+    y = t[0][index & 255] ^ t[1][index >> 8 & 255] ^ t[2][index >> 16 & 255] ^ t[3][index >> 24]
+    return reverse_bits32(index), y
 
 
 def permute(i: int, n: int, p: int) -> int:

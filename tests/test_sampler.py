@@ -23,6 +23,7 @@ from rtpy.sampler import (
     owen_scramble,
     permute,
     reverse_bits32,
+    sobol_2d,
 )
 from rtpy.testing.analytic_scenes import analytic_scene
 from rtpy.testing.statistics import block_z_test, bonferroni_alpha, chi2_sf
@@ -50,6 +51,27 @@ def test_reverse_bits32():
     assert reverse_bits32(1) == 1 << 31
     assert reverse_bits32(0b1011) == 0b1101 << 28
     assert all(reverse_bits32(reverse_bits32(v)) == v for v in (0, 7, 0x12345678, 0xFFFFFFFF))
+
+
+def test_sobol_2d_is_the_sequence():
+    """The first points of the 2D Sobol sequence, and the generator matrices applied
+    bit by bit: the identity mirrored for x, columns v_{k+1} = v_k xor (v_k >> 1) for y."""
+    first = [sobol_2d(i) for i in range(4)]
+    assert [(x / 2**32, y / 2**32) for x, y in first] == [
+        (0.0, 0.0),
+        (0.5, 0.5),
+        (0.25, 0.75),
+        (0.75, 0.25),
+    ]
+    for index in (5, 1000, 0x9ABCDEF0, 0xFFFFFFFF):
+        x = y = 0
+        vy = 1 << 31
+        for k in range(32):
+            if index >> k & 1:
+                x ^= 1 << (31 - k)
+                y ^= vy
+            vy ^= vy >> 1
+        assert sobol_2d(index) == (x, y)
 
 
 def test_owen_scramble_maps_aligned_blocks_to_aligned_blocks():

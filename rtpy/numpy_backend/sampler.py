@@ -17,10 +17,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..sampler import LIGHT_CHOICE, PIXEL, SAMPLERS, TWO_TO_MINUS_32, TWO_TO_MINUS_53, grid_2d
+from ..sampler import (
+    LIGHT_CHOICE,
+    PIXEL,
+    SAMPLERS,
+    SOBOL_Y_BYTES,
+    TWO_TO_MINUS_32,
+    TWO_TO_MINUS_53,
+    grid_2d,
+)
 
 U64, U32 = np.uint64, np.uint32
 MASK32 = U64(0xFFFFFFFF)
+_SOBOL_Y_BYTES = np.array(SOBOL_Y_BYTES, dtype=U32)
 
 
 def mix64(z: np.ndarray) -> np.ndarray:
@@ -69,15 +78,10 @@ def owen_scramble(v: np.ndarray, seed: np.ndarray) -> np.ndarray:
 def sobol_2d(index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """rtpy.sampler.sobol_2d of a uint32 array."""
     index = index.astype(U32)
-    x = np.zeros_like(index)
-    y = np.zeros_like(index)
-    vy = 1 << 31
-    for bit in range(32):
-        on = ((index >> U32(bit)) & U32(1)).astype(bool)
-        x[on] ^= U32(1 << (31 - bit))
-        y[on] ^= U32(vy)
-        vy ^= vy >> 1
-    return x, y
+    y = _SOBOL_Y_BYTES[0].take(index & U32(255))
+    for b in (1, 2, 3):
+        y ^= _SOBOL_Y_BYTES[b].take((index >> U32(8 * b)) & U32(255))
+    return reverse_bits32(index), y
 
 
 def permute(i: np.ndarray, n: int, p: np.ndarray) -> np.ndarray:
