@@ -115,9 +115,10 @@ def test_images_agree_with_the_independent_sampler(sampler, integrator):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("sampler", ["stratified", "sobol"])
-def test_images_are_the_same_for_any_worker_count(sampler):
-    """Several units of work (48 x 48 pixels x 32 spp is more than one unit holds)."""
+def test_images_are_the_same_for_any_worker_count(sampler="sobol"):
+    """Several units of work (48 x 48 pixels x 32 spp is more than one unit holds); the
+    renderer treats every sampler alike (the scalar backend's test takes the
+    stratified one)."""
     scene = rtpy.load_scene("cornell")
     settings = {"width": 48, "spp": 32, "sampler": sampler, "integrator": "path", "seed": 3}
     one = rtpy.render(scene, backend="numpy", workers=1, **settings).linear
