@@ -12,6 +12,7 @@ import pytest
 import rtpy
 from rtpy.sampler import (
     BRDF,
+    LENS,
     LIGHT,
     LIGHT_CHOICE,
     PIXEL,
@@ -170,6 +171,11 @@ def test_random_serves_the_layout_then_the_fallback():
     assert draws[3:5] == list(sampler.value_2d(30, 3, LIGHT))
     assert draws[5:7] == list(sampler.value_2d(30, 3, BRDF))
     assert draws[7:] == [twin.random(), twin.random()]
+    lens = StratifiedSampler(seed=2, spp=8, defocus=True)
+    lens.start_pixel_sample(30, 3)
+    draws = [lens.random() for _ in range(5)]
+    assert draws[2:4] == list(lens.value_2d(30, 3, LENS))
+    assert draws[4] == lens.value_1d(30, 3, LIGHT_CHOICE)
     sampler.start_pixel_sample(30, 3)
     assert sampler.get_2d() == sampler.value_2d(30, 3, 0)
     assert sampler.get_1d() == sampler.value_1d(30, 3, 1)
