@@ -240,6 +240,26 @@ def test_path_renders_are_unbiased_against_the_closed_form(sampler):
     unbiased_check("numpy", sampler, "plane_sphere_light", "path", SPP, 16)
 
 
+def agrees_with_independent(backend: str, sampler: str, integrator: str, width: int) -> None:
+    """Cornell box (area light, diffuse walls), 4 spp: the mean of 8 renders with
+    `sampler` against 8 with the independent one, block by block, each side's
+    variance from its own spread."""
+    scene = rtpy.load_scene("cornell")
+    settings = {"width": width, "spp": 4, "integrator": integrator, "backend": backend}
+    a, b = (
+        np.array([rtpy.render(scene, sampler=s, seed=k, **settings).linear for k in seeds])
+        for s, seeds in ((sampler, range(8)), ("independent", range(100, 108)))
+    )
+    var_a, var_b = a.var(axis=0, ddof=1) / len(a), b.var(axis=0, ddof=1) / len(b)
+    test = block_z_test(a.mean(axis=0), var_a, b.mean(axis=0), var_b, ALPHA, block=4)
+    assert test.passed, test.worst("the independent sampler")
+
+
+@pytest.mark.slow
+def test_scalar_images_agree_with_the_independent_sampler():
+    agrees_with_independent("scalar", "sobol", "path", width=8)
+
+
 @pytest.mark.slow
 def test_scalar_images_are_the_same_for_any_worker_count(sampler="stratified"):
     """Several tiles and batches; the renderer treats every sampler alike (the numpy

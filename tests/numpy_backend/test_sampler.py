@@ -12,8 +12,8 @@ from rtpy import sampler as scalar
 from rtpy.numpy_backend import sampler as batch
 from rtpy.numpy_backend.sampler import BATCH_SAMPLERS, LaneSampler, first_hit_generator
 from rtpy.sampler import BRDF, LENS, LIGHT, LIGHT_CHOICE, PIXEL, SAMPLERS
-from rtpy.testing.statistics import block_z_test
 
+from ..test_sampler import agrees_with_independent
 from ..tiers import slow_except
 
 ALPHA = 1e-3
@@ -87,15 +87,6 @@ def test_first_hit_generator():
     assert first_hit_generator(lane, np.arange(3), 1).dim == LIGHT_CHOICE
 
 
-def renders(scene, sampler: str, seeds, **settings) -> np.ndarray:
-    return np.array(
-        [
-            rtpy.render(scene, backend="numpy", sampler=sampler, seed=s, **settings).linear
-            for s in seeds
-        ]
-    )
-
-
 @pytest.mark.parametrize(
     "sampler, integrator",
     slow_except(
@@ -105,13 +96,7 @@ def renders(scene, sampler: str, seeds, **settings) -> np.ndarray:
 def test_images_agree_with_the_independent_sampler(sampler, integrator):
     """Cornell box (area light, diffuse walls): the mean of 8 renders with each sampler
     against 8 with the independent one, each side's variance from its own spread."""
-    scene = rtpy.load_scene("cornell")
-    settings = {"width": 16, "spp": 4, "integrator": integrator}
-    a = renders(scene, sampler, range(8), **settings)
-    b = renders(scene, "independent", range(100, 108), **settings)
-    var_a, var_b = a.var(axis=0, ddof=1) / len(a), b.var(axis=0, ddof=1) / len(b)
-    test = block_z_test(a.mean(axis=0), var_a, b.mean(axis=0), var_b, ALPHA)
-    assert test.passed, test.worst("the independent sampler")
+    agrees_with_independent("numpy", sampler, integrator, width=16)
 
 
 @pytest.mark.slow
