@@ -29,6 +29,7 @@ from .io.values import (
     suggest,
     triple,
 )
+from .sampler import SAMPLERS
 from .vec3 import Color
 
 __all__ = [
@@ -205,6 +206,17 @@ SETTINGS: dict[str, Setting] = {
             "emission that a BRDF-sampled ray finds after a non-specular bounce is not added)",
         ),
         Setting(
+            "sampler",
+            "choice",
+            "independent",
+            'where the uniform numbers of the pixel samples come from: "independent" (each '
+            'its own), "stratified" (jittered strata per pixel) or "sobol" (Owen-scrambled '
+            "Sobol points); the last two stratify the pixel, lens and first-hit light and "
+            "BRDF samples (docs/samplers.md)",
+            choices=tuple(SAMPLERS),
+            flag=True,
+        ),
+        Setting(
             "width",
             "int",
             400,
@@ -243,6 +255,7 @@ class RenderSettings:
     seed: int = SETTINGS["seed"].default
     gamma: float | str = SETTINGS["gamma"].default
     mis: bool = SETTINGS["mis"].default
+    sampler: str = SETTINGS["sampler"].default
 
     def __post_init__(self) -> None:
         for f in fields(self):

@@ -31,6 +31,7 @@ from .camera import Camera
 from .integrators import make_integrator
 from .io.image import RenderedImage
 from .render_settings import BACKENDS, RenderSettings
+from .sampler import SAMPLERS
 from .sampling import make_generator, use_generator
 from .scene import Scene
 from .testing.statistics import peak_memory_mb
@@ -53,6 +54,7 @@ class Unit:
     x1: int
     y1: int
     spp: int
+    first_sample: int = 0  # the index of the batch's first sample in each pixel
 
 
 def plan_units(
@@ -106,22 +108,36 @@ def _units(regions: list[tuple[int, int, int, int]], spp: int, n_batches: int) -
     that differ by at most 1."""
     batch_spp = [spp // n_batches + (1 if b < spp % n_batches else 0) for b in range(n_batches)]
     return [
-        Unit(r, b, *regions[r], batch_spp[b]) for b in range(n_batches) for r in range(len(regions))
+        Unit(r, b, *regions[r], batch_spp[b], sum(batch_spp[:b]))
+        for b in range(n_batches)
+        for r in range(len(regions))
     ]
 
 
-def render_unit(scene: Scene, camera: Camera, integrator, seed: int, unit: Unit) -> np.ndarray:
+def render_unit(
+    scene: Scene, camera: Camera, integrator, seed: int, unit: Unit, sampler: str = "independent"
+) -> np.ndarray:
     """Sum of `unit.spp` radiance samples for each pixel of the unit's region:
-    an array (region height, region width, 3)."""
+    an array (region height, region width, 3). Every draw comes from the unit's
+    generator, or with another sampler (rtpy.sampler) from that sampler, told which
+    pixel sample each path is."""
     sums = []  # (r, g, b) per pixel, row by row: one array at the end, not one write per pixel
     radiance = integrator.compute_scattering
     get_ray = camera.get_center_ray if integrator.uses_center_ray else camera.get_ray
-    samples = range(unit.spp)
-    with use_generator(make_generator(seed, unit.region, unit.batch)):
+    samples = range(unit.first_sample, unit.first_sample + unit.spp)
+    source = make_generator(seed, unit.region, unit.batch)
+    start = None
+    if sampler != "independent":
+        spp = 1 if integrator.uses_center_ray else integrator.settings.spp
+        source = SAMPLERS[sampler](seed, spp, camera.defocus_angle > 0.0, fallback=source)
+        start = source.start_pixel_sample
+    with use_generator(source):
         for j in range(unit.y0, unit.y1):
             for i in range(unit.x0, unit.x1):
                 r = g = b = 0.0
-                for _ in samples:
+                for index in samples:
+                    if start:
+                        start(j * camera.width + i, index)
                     c = radiance(get_ray(i, j), scene)
                     r += c.e0
                     g += c.e1
@@ -252,7 +268,15 @@ class ScalarBackend(Backend):
 
     def start(self) -> Callable[[Unit], np.ndarray]:
         integrator = self.make_integrator()
-        return partial(render_unit, self.scene, self.camera, integrator, self.settings.seed)
+        settings = self.settings
+        return partial(
+            render_unit,
+            self.scene,
+            self.camera,
+            integrator,
+            settings.seed,
+            sampler=settings.sampler,
+        )
 
 
 def make_backend(name: str, scene: Scene, camera: Camera, settings: RenderSettings) -> Backend:

@@ -4,7 +4,9 @@ rtpy never draws from Python's or numpy's global generator. The renderer gives
 every unit of work (a tile and a batch of samples) its own generator, seeded by
 (seed, tile, batch), and installs it with `use_generator` while that unit runs;
 the functions below draw from the installed one. So an image depends only on the
-seed and the settings, never on how many worker processes rendered it.
+seed and the settings, never on how many worker processes rendered it. With a
+sampler other than "independent" (rtpy/sampler.py) the installed object is that
+sampler: its random() returns the current pixel sample's next dimension.
 """
 
 from __future__ import annotations

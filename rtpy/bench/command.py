@@ -11,9 +11,10 @@ from ..io.image import OutputError, WriteError
 from ..io.outputs import check_folder
 from ..io.scene_file import SceneError
 from ..render_settings import SETTINGS, SettingError
+from ..sampler import SAMPLERS
 from ..testing.analytic_scenes import ANALYTIC_SCENES
 from ..testing.reference import DEFAULT_REFERENCE_SPP
-from .report import format_series, format_table, plot, write_outputs
+from .report import format_sampler_efficiency, format_series, format_table, plot, write_outputs
 from .run import DEFAULT_SPP, run_bench
 from .scenes import BACKENDS, VARIANTS
 
@@ -40,6 +41,12 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "--integrators",
         default=None,
         help=f"comma-separated variants: {','.join(VARIANTS)} (default all)",
+    )
+    b.add_argument(
+        "--samplers",
+        default=None,
+        help=f"comma-separated samplers: {','.join(SAMPLERS)} (default independent; "
+        "docs/samplers.md)",
     )
     g = b.add_mutually_exclusive_group()
     g.add_argument("--budget", type=float, metavar="SECONDS", help="seconds per series")
@@ -117,6 +124,7 @@ def _options(args: argparse.Namespace) -> dict:
         "scenes": scenes,
         "backends": _split(args.backends, BACKENDS, "backends") or ["numpy"],
         "variants": _split(args.integrators, tuple(VARIANTS), "integrators") or list(VARIANTS),
+        "samplers": _split(args.samplers, tuple(SAMPLERS), "samplers") or ["independent"],
         "spps": _spp_list(args.spp) if args.spp else (QUICK["spp"] if args.quick else DEFAULT_SPP),
         "budget": args.budget,
         "repeats": repeats,
@@ -150,6 +158,10 @@ def command_bench(args: argparse.Namespace) -> int:
         print(format_table(result))
         print()
         print(format_series(result))
+        gains = format_sampler_efficiency(result)
+        if gains:
+            print()
+            print(gains)
         if args.quick:
             log("rtpy bench: --quick renders take milliseconds: its timings are not meaningful")
     try:

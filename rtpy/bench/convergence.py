@@ -19,7 +19,10 @@ each level weighted by 1 / var(log MSE), var(log MSE) ~ (SE(MSE) / MSE)^2 with
 SE(MSE) from the spread of the per-pixel squared errors; the slope's standard
 error is sqrt(1 / sum w (x - mean_w x)^2). An unbiased estimator has
 E[MSE] = sigma^2 / spp exactly (independent samples), so slope = -1; a bias b
-adds b^2, which flattens the slope as spp grows.
+adds b^2, which flattens the slope as spp grows. With a stratified or Sobol sampler
+(rtpy.sampler) the samples of a pixel are not independent and the MSE may fall
+faster than 1/spp: a slope steeper than -1 is "faster than 1/N", never bias (a bias
+flattens the slope); only a slope above -1 + SLOPE_TOLERANCE is a problem there.
 """
 
 from __future__ import annotations
@@ -106,6 +109,7 @@ class Level:
     significant: bool = False
     efficiency: float = math.nan
     reference: str = ""
+    sampler: str = "independent"
 
 
 @dataclass
@@ -119,10 +123,36 @@ class Fit:
     slope_se: float | None
     levels: int
     note: str = ""
+    sampler: str = "independent"
 
     @property
     def slope_ok(self) -> bool:
-        return self.slope is not None and abs(self.slope + 1.0) < SLOPE_TOLERANCE
+        """-1 within the tolerance; with a sampler other than independent, also any
+        steeper slope (faster than 1/N)."""
+        if self.slope is None:
+            return False
+        return abs(self.slope + 1.0) < SLOPE_TOLERANCE or self.faster
+
+    @property
+    def faster(self) -> bool:
+        """A stratifying sampler's error falls faster than 1/N (slope below -1 by more
+        than the tolerance)."""
+        return (
+            self.sampler != "independent"
+            and self.slope is not None
+            and self.slope < -1.0 - SLOPE_TOLERANCE
+        )
+
+
+def series_key(x: Level | Fit) -> tuple[str, str, str, str]:
+    """What a series is: (scene, backend, integrator variant, sampler)."""
+    return x.scene, x.backend, x.integrator, x.sampler
+
+
+def series_name(x: Level | Fit) -> str:
+    """scene/backend/variant, and the sampler when it is not the independent one."""
+    name = f"{x.scene}/{x.backend}/{x.integrator}"
+    return name if x.sampler == "independent" else f"{name}/{x.sampler}"
 
 
 def fit_slope(spps, mses, mse_ses, zero: float = 0.0) -> tuple[float | None, float | None]:
@@ -171,14 +201,14 @@ class BenchResult:
         for lv in self.levels:
             if (variants is None or lv.integrator in variants) and lv.significant:
                 out.append(
-                    f"{lv.scene}/{lv.backend}/{lv.integrator} spp {lv.spp}: bias "
+                    f"{series_name(lv)} spp {lv.spp}: bias "
                     f"{lv.bias:+.3g} (z = {lv.bias_z:.1f} > {self.z_critical:.2f})"
                 )
         for f in self.fits:
             if (variants is None or f.integrator in variants) and f.slope is not None:
                 if not f.slope_ok:
                     out.append(
-                        f"{f.scene}/{f.backend}/{f.integrator}: slope {f.slope:.3f} "
+                        f"{series_name(f)}: slope {f.slope:.3f} "
                         f"+- {f.slope_se:.3f} outside -1 +- {SLOPE_TOLERANCE}"
                     )
         return out

@@ -12,13 +12,23 @@ from pathlib import Path
 import numpy as np
 
 from ..io.image import WriteError, atomic_write
-from .convergence import ALPHA, SLOPE_TOLERANCE, BenchResult, Fit, Level
+from ..sampler import SAMPLERS
+from .convergence import (
+    ALPHA,
+    SLOPE_TOLERANCE,
+    BenchResult,
+    Fit,
+    Level,
+    series_key,
+    series_name,
+)
 from .scenes import VARIANTS
 
 TABLE_COLUMNS = (
     ("scene", "scene", "{}"),
     ("backend", "backend", "{}"),
     ("integrator", "integrator", "{}"),
+    ("sampler", "sampler", "{}"),
     ("spp", "spp", "{}"),
     ("seconds", "s/render", "{:.3f}"),
     ("paths_per_second", "paths/s", "{:,.0f}"),
@@ -61,8 +71,7 @@ def format_table(result: BenchResult, markdown: bool = False) -> str:
 
 def _series(result: BenchResult, fit: Fit) -> list[Level]:
     """The levels of the series of `fit`, lowest spp first."""
-    key = (fit.scene, fit.backend, fit.integrator)
-    return [lv for lv in result.levels if (lv.scene, lv.backend, lv.integrator) == key]
+    return [lv for lv in result.levels if series_key(lv) == series_key(fit)]
 
 
 def _last_levels(result: BenchResult) -> list[Level]:
@@ -73,17 +82,19 @@ def _last_levels(result: BenchResult) -> list[Level]:
 def format_series(result: BenchResult, markdown: bool = False) -> str:
     """One row per series: its last (highest-spp) level, the fitted slope, and
     whether any level was significantly biased."""
-    head = ["scene", "backend", "integrator", "spp", "s/render", "paths/s", "peak MB"]
+    head = ["scene", "backend", "integrator", "sampler", "spp", "s/render", "paths/s", "peak MB"]
     head += ["relMSE", "1/(relMSE*s)", "slope", "biased?"]
     rows = []
     for f, last in zip(result.fits, _last_levels(result), strict=True):
         slope = "exact" if f.slope is None else f"{f.slope:+.2f} ± {f.slope_se:.2f}"
+        slope += " (faster than 1/N)" if f.faster else ""
         biased = "YES" if any(lv.significant for lv in _series(result, f)) else "no"
         rows.append(
             [
                 f.scene,
                 f.backend,
                 f.integrator,
+                f.sampler,
                 str(last.spp),
                 f"{last.seconds:.2f}",
                 f"{last.paths_per_second:,.0f}",
@@ -95,7 +106,8 @@ def format_series(result: BenchResult, markdown: bool = False) -> str:
             ]
         )
     note = (
-        f"slope: of log MSE against log spp (unbiased: -1); biased?: |z| > "
+        f"slope: of log MSE against log spp (unbiased: -1; a stratifying sampler may fall "
+        f"faster than 1/N, below -1); biased?: |z| > "
         f"{result.z_critical:.2f} at some level (family-wise alpha {ALPHA:g})"
     )
     return _layout(head, rows, markdown) + "\n" + ("\n" if markdown else "") + note
@@ -154,7 +166,9 @@ def plot_notes(result: BenchResult, quick: bool = False) -> list[str]:
     and, after --quick, that its timings mean nothing."""
     notes = ["Error bars: relMSE ± 1 standard error (from the spread of the squared errors)."]
     exact = [
-        f"{f.scene}/{f.integrator} ({f.backend})"
+        f"{f.scene}/{f.integrator}"
+        + ("" if f.sampler == "independent" else f"/{f.sampler}")
+        + f" ({f.backend})"
         for f in result.fits
         if all(lv.exact for lv in _series(result, f))
     ]
@@ -202,10 +216,12 @@ def draw(result: BenchResult, quick: bool = False):
         series = {}
         for lv in drawn:
             if lv.scene == scene:
-                series.setdefault((lv.backend, lv.integrator), []).append(lv)
-        for (backend, integrator), lvs in series.items():
+                series.setdefault((lv.backend, lv.integrator, lv.sampler), []).append(lv)
+        for (backend, integrator, sampler), lvs in series.items():
             other = _other_reference(integrator)
-            color = f"C{list(VARIANTS).index(integrator) % 10}"
+            k = list(VARIANTS).index(integrator) * len(SAMPLERS) + list(SAMPLERS).index(sampler)
+            color = f"C{k % 10}"
+            named = integrator if sampler == "independent" else f"{integrator}, {sampler}"
             style = {
                 "ls": "-." if other else ("-" if backend == "numpy" else "--"),
                 "color": color,
@@ -213,7 +229,7 @@ def draw(result: BenchResult, quick: bool = False):
                 "mfc": "none" if other else color,
                 "ms": 4,
                 "capsize": 2,
-                "label": f"{integrator} ({backend})" + (", depth-2 reference" if other else ""),
+                "label": f"{named} ({backend})" + (", depth-2 reference" if other else ""),
             }
             e = [lv.rel_mse for lv in lvs]
             se = [rel_mse_se(lv) for lv in lvs]
@@ -292,7 +308,7 @@ def findings(result: BenchResult) -> list[str]:
     tolerance, as in the tests), and the numpy backend's speed against the
     scalar one."""
     biased = [
-        f"{lv.scene}/{lv.backend}/{lv.integrator} at {lv.spp} spp (z = {lv.bias_z:+.1f})"
+        f"{series_name(lv)} at {lv.spp} spp (z = {lv.bias_z:+.1f})"
         for lv in result.levels
         if lv.significant
     ]
@@ -306,10 +322,9 @@ def findings(result: BenchResult) -> list[str]:
     ]
     fitted = [f for f in result.fits if f.slope is not None]
     judged = [f for f in fitted if f.slope_se <= SLOPE_TOLERANCE / 4]
-    off = [
-        f"{f.scene}/{f.backend}/{f.integrator} ({f.slope:+.2f})" for f in judged if not f.slope_ok
-    ]
-    loose = [f"{f.scene}/{f.backend}/{f.integrator}" for f in fitted if f not in judged]
+    off = [f"{series_name(f)} ({f.slope:+.2f})" for f in judged if not f.slope_ok]
+    faster = [f"{series_name(f)} ({f.slope:+.2f})" for f in judged if f.faster]
+    loose = [series_name(f) for f in fitted if f not in judged]
     tolerance = f"{SLOPE_TOLERANCE:g}"
     verdict = (
         f"off -1 by more than {tolerance}: " + ", ".join(off)
@@ -322,12 +337,15 @@ def findings(result: BenchResult) -> list[str]:
         if judged
         else f"no slope is measured to ± {SLOPE_TOLERANCE / 4:g} or better"
     )
+    if faster:
+        text += f"; faster than 1/N (a stratifying sampler, not bias): {', '.join(faster)}"
     if loose:
         text += f". Too few levels or too noisy to judge: {', '.join(loose)}"
     lines.append(f"- Slopes: {text}.")
     speed: dict[tuple[str, str, str], list[float]] = {}
     for lv in result.levels:
-        speed.setdefault((lv.scene, lv.integrator, lv.backend), []).append(lv.paths_per_second)
+        key = (lv.scene, f"{lv.integrator} {lv.sampler}", lv.backend)
+        speed.setdefault(key, []).append(lv.paths_per_second)
     ratios = [
         np.mean(speed[scene, integrator, "numpy"]) / np.mean(speed[scene, integrator, "scalar"])
         for scene, integrator, backend in speed
@@ -349,8 +367,9 @@ def format_efficiency(result: BenchResult) -> str:
     best: dict[tuple[str, str], list[tuple[float, str]]] = {}
     for f, last in zip(result.fits, _last_levels(result), strict=True):
         same_image = VARIANTS[f.integrator]["integrator"] == "path"
+        named = f.integrator if f.sampler == "independent" else f"{f.integrator}+{f.sampler}"
         if same_image and f.slope is not None and math.isfinite(last.efficiency):
-            best.setdefault((f.scene, f.backend), []).append((last.efficiency, f.integrator))
+            best.setdefault((f.scene, f.backend), []).append((last.efficiency, named))
     backends = list(dict.fromkeys(backend for _, backend in best))
     scenes = list(dict.fromkeys(scene for scene, _ in best))
     rows = []
@@ -362,6 +381,38 @@ def format_efficiency(result: BenchResult) -> str:
         rows.append(row)
     head = ["scene", *(f"path tracing, {b}: efficiency relative to the best" for b in backends)]
     return _layout(head, rows, markdown=True)
+
+
+def sampler_gains(result: BenchResult) -> dict[tuple[str, str, str], dict[str, float]]:
+    """Per (scene, backend, variant) measured with the independent sampler and another:
+    each sampler's efficiency 1/(relMSE*s) at its series' highest spp divided by the
+    independent sampler's (above 1: the sampler buys the same error in less time)."""
+    last = {series_key(f): lv for f, lv in zip(result.fits, _last_levels(result), strict=True)}
+    gains: dict[tuple[str, str, str], dict[str, float]] = {}
+    for (scene, backend, variant, sampler), lv in last.items():
+        base = last.get((scene, backend, variant, "independent"))
+        if sampler == "independent" or base is None:
+            continue
+        finite = math.isfinite(lv.efficiency) and math.isfinite(base.efficiency)
+        ratio = lv.efficiency / base.efficiency if finite else math.nan
+        gains.setdefault((scene, backend, variant), {})[sampler] = ratio
+    return gains
+
+
+def format_sampler_efficiency(result: BenchResult, markdown: bool = False) -> str:
+    """A table of sampler_gains(), one row per series measured with several samplers
+    ("" when there is none)."""
+    gains = sampler_gains(result)
+    samplers = [s for s in SAMPLERS if any(s in g for g in gains.values())]
+    if not samplers:
+        return ""
+    head = ["scene", "backend", "integrator", *(f"{s} / independent" for s in samplers)]
+    rows = [
+        [*key, *(_fmt("{:.2f}", g[s]) if s in g else "-" for s in samplers)]
+        for key, g in gains.items()
+    ]
+    note = "efficiency 1/(relMSE*s) at the highest spp, relative to the independent sampler's"
+    return _layout(head, rows, markdown) + "\n" + ("\n" if markdown else "") + note
 
 
 def format_doc_section(result: BenchResult, command: str, before: dict, after: dict) -> str:
@@ -389,6 +440,8 @@ def format_doc_section(result: BenchResult, command: str, before: dict, after: d
         *findings(result),
         "",
         format_efficiency(result),
+        "",
+        format_sampler_efficiency(result, markdown=True),
         "",
         GENERATED_END,
     ]

@@ -20,6 +20,7 @@ from .convergence import (
     Level,
     error_stats,
     fit_slope,
+    series_name,
     z_score,
 )
 from .machine import machine
@@ -29,7 +30,15 @@ DEFAULT_SPP = (1, 4, 16, 64)
 MAX_BUDGET_SPP = 1 << 16
 
 
-def render_once(bs: BenchScene, backend: str, variant: str, spp: int, seed: int, workers: int):
+def render_once(
+    bs: BenchScene,
+    backend: str,
+    variant: str,
+    spp: int,
+    seed: int,
+    workers: int,
+    sampler: str = "independent",
+):
     """(linear image, seconds, peak RSS in MB) of one render."""
     from .. import render
 
@@ -44,6 +53,7 @@ def render_once(bs: BenchScene, backend: str, variant: str, spp: int, seed: int,
         max_depth=bs.max_depth,
         russian_roulette=bs.russian_roulette,
         workers=workers,
+        sampler=sampler,
         **VARIANTS[variant],
     )
     seconds = time.perf_counter() - start
@@ -64,6 +74,7 @@ def run_series(
     log=print,
     seed: int = 1,
     levels: list[Level] | None = None,
+    sampler: str = "independent",
 ) -> list[Level]:
     """Render the levels of one series, appended to `levels` as they are done (so
     a Ctrl-C keeps them); with a budget, spp doubles from 1 while the next level is
@@ -81,7 +92,8 @@ def run_series(
         images, times, peaks = [], [], []
         for r in range(repeats):
             # independent across levels and repeats
-            img, sec, peak = render_once(bs, backend, variant, spp, seed + 1000 * k + r, workers)
+            render_seed = seed + 1000 * k + r
+            img, sec, peak = render_once(bs, backend, variant, spp, render_seed, workers, sampler)
             images.append(img)
             times.append(sec)
             peaks.append(peak)
@@ -105,12 +117,10 @@ def run_series(
             bias_z=z_score(st["bias"], st["bias_se"], scale),
             exact=bool(st["mse"] <= (ROUNDING * scale) ** 2),
             reference=ref.source,
+            sampler=sampler,
         )
         levels.append(lv)
-        log(
-            f"  {bs.name} {backend} {variant} spp {spp}: {seconds:.3f} s/render, "
-            f"relMSE {lv.rel_mse:.3g}"
-        )
+        log(f"  {series_name(lv)} spp {spp}: {seconds:.3f} s/render, relMSE {lv.rel_mse:.3g}")
         k += 1
         if budget is not None:
             # The next level costs about twice this one.
@@ -133,7 +143,9 @@ def fit_series(levels: list[Level], ref: Reference) -> Fit:
     )
     note = "" if slope is not None else "no slope: error is zero (exact) or one level"
     first = levels[0]
-    return Fit(first.scene, first.backend, first.integrator, slope, se, len(levels), note)
+    return Fit(
+        first.scene, first.backend, first.integrator, slope, se, len(levels), note, first.sampler
+    )
 
 
 def run_bench(
@@ -142,6 +154,7 @@ def run_bench(
     variants=tuple(VARIANTS),
     spps=DEFAULT_SPP,
     *,
+    samplers=("independent",),
     budget: float | None = None,
     repeats: int = 4,
     width: int | None = 64,
@@ -151,7 +164,7 @@ def run_bench(
     log=print,
     seed: int = 1,
 ) -> BenchResult:
-    """Measure every series (scene x backend x variant) and decide significance over
+    """Measure every series (scene x backend x variant x sampler) and decide significance over
     all of them; a Ctrl-C stops the run and keeps the levels measured so far
     (BenchResult.interrupted)."""
     result = BenchResult(
@@ -159,6 +172,7 @@ def run_bench(
             "scenes": list(scenes),
             "backends": list(backends),
             "integrators": list(variants),
+            "samplers": list(samplers),
             "spp": None if budget is not None else list(spps),
             "budget_seconds": budget,
             "repeats": repeats,
@@ -176,30 +190,31 @@ def run_bench(
         for name in scenes:
             bs = load_bench_scene(name, width, cache, reference_spp, log)
             refs: dict[int, Reference] = {}
-            for backend in backends:
-                for variant in variants:
-                    depth = effective_depth(variant, bs.max_depth)
-                    if depth not in refs:
-                        refs[depth] = bs.reference_for(depth)
-                    levels: list[Level] = []
-                    try:
-                        run_series(
-                            bs,
-                            backend,
-                            variant,
-                            spps,
-                            budget,
-                            repeats,
-                            workers,
-                            refs[depth],
-                            log,
-                            seed,
-                            levels=levels,
-                        )
-                    finally:  # also the levels of a series that Ctrl-C stopped
-                        if levels:
-                            result.levels.extend(levels)
-                            result.fits.append(fit_series(levels, refs[depth]))
+            series = [(b, v, s) for b in backends for v in variants for s in samplers]
+            for backend, variant, sampler in series:
+                depth = effective_depth(variant, bs.max_depth)
+                if depth not in refs:
+                    refs[depth] = bs.reference_for(depth)
+                levels: list[Level] = []
+                try:
+                    run_series(
+                        bs,
+                        backend,
+                        variant,
+                        spps,
+                        budget,
+                        repeats,
+                        workers,
+                        refs[depth],
+                        log,
+                        seed,
+                        levels=levels,
+                        sampler=sampler,
+                    )
+                finally:  # also the levels of a series that Ctrl-C stopped
+                    if levels:
+                        result.levels.extend(levels)
+                        result.fits.append(fit_series(levels, refs[depth]))
     except KeyboardInterrupt:
         result.interrupted = True
     result.finish()

@@ -25,6 +25,7 @@ import numpy as np
 from ..renderer import Backend, Unit, plan_bands
 from .camera import CameraRays
 from .integrators import BatchIntegrator, make_integrator
+from .sampler import BATCH_SAMPLERS, LaneSampler
 from .sampling import make_generator
 from .scene import BatchScene
 
@@ -40,18 +41,31 @@ def plan_units(width: int, height: int, spp: int) -> list[Unit]:
 
 
 def render_unit(
-    scene: BatchScene, rays: CameraRays, integrator: BatchIntegrator, seed: int, unit: Unit
+    scene: BatchScene,
+    rays: CameraRays,
+    integrator: BatchIntegrator,
+    seed: int,
+    unit: Unit,
+    sampler: str = "independent",
 ) -> np.ndarray:
-    """Sum of unit.spp radiance samples per pixel of the unit's region: (h, w, 3)."""
+    """Sum of unit.spp radiance samples per pixel of the unit's region: (h, w, 3).
+    Every draw comes from the unit's generator, or with another sampler from a
+    LaneSampler that knows which pixel sample each lane is."""
     rng = make_generator(seed, unit.region, unit.batch)
     h, w = unit.y1 - unit.y0, unit.x1 - unit.x0
     j, i = np.divmod(np.arange(h * w), w)
     i = np.repeat(i + unit.x0, unit.spp)
     j = np.repeat(j + unit.y0, unit.spp)
+    camera_rng = rng
+    if sampler != "independent":
+        spp = 1 if integrator.uses_center_ray else integrator.settings.spp
+        index = np.tile(np.arange(unit.first_sample, unit.first_sample + unit.spp), h * w)
+        rng = LaneSampler(BATCH_SAMPLERS[sampler](seed, spp), j * rays.width + i, index, rng)
+        camera_rng = rng.camera()
     if integrator.uses_center_ray:
-        o, d = rays.center_rays(i, j, rng)
+        o, d = rays.center_rays(i, j, camera_rng)
     else:
-        o, d = rays.jittered_rays(i, j, rng)
+        o, d = rays.jittered_rays(i, j, camera_rng)
     radiance = integrator.compute_scattering(o, d, scene, rng)
     return radiance.reshape(h, w, unit.spp, 3).sum(axis=2)
 
@@ -72,7 +86,10 @@ class NumpyBackend(Backend):
         keep_freed_memory()
         scene, rays = BatchScene(self.scene), CameraRays(self.camera)
         integrator = self.make_integrator()
-        return partial(render_unit, scene, rays, integrator, self.settings.seed)
+        settings = self.settings
+        return partial(
+            render_unit, scene, rays, integrator, settings.seed, sampler=settings.sampler
+        )
 
 
 def keep_freed_memory() -> None:

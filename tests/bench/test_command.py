@@ -67,6 +67,7 @@ def test_bench_plot_is_drawn_when_matplotlib_is_installed(tmp_path):
     [
         (["--backends", "gpu"], "--backends"),
         (["--integrators", "path-mis,bogus"], "--integrators"),
+        (["--samplers", "sobol,halton"], "--samplers"),
         (["--spp", "1,x"], "--spp"),
         (["--repeats", "1"], "--repeats"),
         (["no_such_scene"], "no_such_scene"),

@@ -21,11 +21,13 @@ from rtpy.bench.report import (
     findings,
     format_doc_section,
     format_efficiency,
+    format_sampler_efficiency,
     format_series,
     format_table,
     machine_lines,
     plot_notes,
     replace_generated,
+    sampler_gains,
     write_outputs,
 )
 from rtpy.bench.run import run_bench
@@ -50,11 +52,11 @@ def result():
 def test_tables_have_a_row_per_level_and_per_series(result):
     table = format_table(result).splitlines()
     assert len(table) == 1 + len(result.levels) == 1 + 2 * 2 * 2 * 2
-    assert table[0].split()[:4] == ["scene", "backend", "integrator", "spp"]
+    assert table[0].split()[:5] == ["scene", "backend", "integrator", "sampler", "spp"]
     series = format_series(result, markdown=True).splitlines()
     rows = [line for line in series if line.startswith("| ") and "---" not in line]
     assert len(rows) == 1 + len(result.fits) == 1 + 8
-    assert all(row.count("|") == 12 for row in rows)  # 11 columns
+    assert all(row.count("|") == 13 for row in rows)  # 12 columns
     furnace = [row for row in rows if row.startswith("| furnace ")]
     assert furnace and all("| exact |" in row for row in furnace)
     assert series[-1].startswith("slope: of log MSE against log spp")
@@ -261,3 +263,42 @@ def test_the_plot_draws_the_measured_standard_errors_and_its_notes(result):
     assert "--quick" in note.get_text()
     styles = {c.get_label(): c.lines[0].get_linestyle() for c in spp_axis.containers}
     assert all((s == "-.") == ("depth-2" in label) for label, s in styles.items())
+
+
+def test_samplers_get_their_own_series_and_efficiency_ratios():
+    """One series per sampler; the gains table divides each sampler's efficiency by
+    the independent sampler's, and a slope steeper than -1 is reported as faster than
+    1/N, not as a problem."""
+    run = run_bench(
+        ["plane_point_light"],
+        ("numpy",),
+        ("direct",),
+        (4, 16),
+        samplers=("independent", "sobol"),
+        repeats=2,
+        width=8,
+        log=lambda _: None,
+    )
+    assert [f.sampler for f in run.fits] == ["independent", "sobol"]
+    gains = sampler_gains(run)
+    last = {lv.sampler: lv for lv in run.levels if lv.spp == 16}
+    ratio = last["sobol"].efficiency / last["independent"].efficiency
+    assert gains == {("plane_point_light", "numpy", "direct"): {"sobol": ratio}}
+    table = format_sampler_efficiency(run).splitlines()
+    assert table[0].split()[-3:] == ["sobol", "/", "independent"]
+    assert table[1].split()[-1] == f"{ratio:.2f}"
+    assert format_sampler_efficiency(converged(run_without_samplers(run))) == ""
+    steep = replace(run, fits=[replace(f, slope=-1.8, slope_se=0.01) for f in run.fits])
+    assert [f.faster for f in steep.fits] == [False, True]
+    assert [f.slope_ok for f in steep.fits] == [False, True]
+    assert (
+        "faster than 1/N (a stratifying sampler, not bias): plane_point_light/numpy/direct/sobol"
+        in (findings(steep)[1])
+    )
+    assert len(steep.problems()) == 1 and "independent" not in steep.problems()[0]
+    assert "(faster than 1/N)" in format_series(steep)
+
+
+def run_without_samplers(run: BenchResult) -> BenchResult:
+    keep = [f for f in run.fits if f.sampler == "independent"]
+    return replace(run, fits=keep, levels=[lv for lv in run.levels if lv.sampler == "independent"])

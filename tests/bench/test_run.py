@@ -24,7 +24,7 @@ class FakeRenders:
         self.ref, self.unit, self.interrupt_at = ref, unit, interrupt_at
         self.calls: list[tuple[int, int]] = []
 
-    def __call__(self, bs, backend, variant, spp, seed, workers):
+    def __call__(self, bs, backend, variant, spp, seed, workers, sampler="independent"):
         if len(self.calls) == self.interrupt_at:
             raise KeyboardInterrupt
         self.calls.append((spp, seed))

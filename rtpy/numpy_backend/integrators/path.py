@@ -6,6 +6,7 @@ import numpy as np
 
 from ..arrays import add_rows, divide, max3, rows
 from ..ray import spawn_origins
+from ..sampler import first_hit_generator
 from .direct_lighting import Bounce, add_emission, sample_one_light
 from .integrator import BatchIntegrator
 
@@ -67,9 +68,10 @@ class PathIntegrator(BatchIntegrator):
                 paths, ids, hits, beta = paths.take(k), ids.take(k), hits.take(k), rows(beta, k)
                 if paths.size == 0:
                     break
+            draw = first_hit_generator(rng, paths, segment)  # a sampler's first-hit numbers
             if n_lights:
-                add_direct_light(result, paths, beta, scene, hits, ids, rng, nee, mis)
-            sc = materials.scattering(ids, hits, rng)
+                add_direct_light(result, paths, beta, scene, hits, ids, draw, nee, mis)
+            sc = materials.scattering(ids, hits, draw)
             beta = beta * sc.attenuation
             bmax = max3(beta)
             alive = sc.alive & (bmax > 0.0)

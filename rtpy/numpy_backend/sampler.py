@@ -1,0 +1,264 @@
+"""Samplers for arrays of pixel samples: the twin of rtpy/sampler.py.
+
+value_1d(pixel, index, dim) and value_2d(...) of each sampler take arrays of pixels
+and sample indices and return, element by element, the numbers rtpy.sampler's
+sampler of the same name returns (the same integer hashes, in 64- and 32-bit
+unsigned arithmetic that wraps as the scalar code's masks do).
+
+LaneSampler is what the backend's kernels draw from: a numpy-Generator-like object
+whose random(size) returns, for the lanes (camera samples) it is told about, the
+next dimension of each lane's sample. It serves the camera's draws (pixel, lens) and
+the first hit's draws when the call covers all the lanes; a call for part of the
+lanes (a kernel that handles some of the hits) and every later draw get independent
+numbers of the unit's Generator, so every estimate stays unbiased.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..sampler import (
+    LIGHT_CHOICE,
+    PIXEL,
+    SAMPLERS,
+    SOBOL_Y_BYTES,
+    TWO_TO_MINUS_32,
+    TWO_TO_MINUS_53,
+    grid_2d,
+)
+
+U64, U32 = np.uint64, np.uint32
+MASK32 = U64(0xFFFFFFFF)
+_SOBOL_Y_BYTES = np.array(SOBOL_Y_BYTES, dtype=U32)
+
+
+def mix64(z: np.ndarray) -> np.ndarray:
+    """rtpy.sampler.mix64 of uint64 arrays (products wrap modulo 2^64)."""
+    with np.errstate(over="ignore"):
+        z = z + U64(0x9E3779B97F4A7C15)
+        z = (z ^ (z >> U64(30))) * U64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> U64(27))) * U64(0x94D049BB133111EB)
+    return z ^ (z >> U64(31))
+
+
+def hash_key(*key) -> np.ndarray:
+    """rtpy.sampler.hash_key of integers and integer arrays (broadcast together)."""
+    h = U64(0)
+    for k in key:
+        h = mix64(h ^ np.asarray(k).astype(U64))
+    return np.asarray(h, dtype=U64)
+
+
+def unit_float(h: np.ndarray) -> np.ndarray:
+    return (h >> U64(11)).astype(np.float64) * TWO_TO_MINUS_53
+
+
+def reverse_bits32(v: np.ndarray) -> np.ndarray:
+    """The 32 bits of each uint32 in reverse order."""
+    v = v.astype(U32)
+    v = ((v >> U32(1)) & U32(0x55555555)) | ((v & U32(0x55555555)) << U32(1))
+    v = ((v >> U32(2)) & U32(0x33333333)) | ((v & U32(0x33333333)) << U32(2))
+    v = ((v >> U32(4)) & U32(0x0F0F0F0F)) | ((v & U32(0x0F0F0F0F)) << U32(4))
+    v = ((v >> U32(8)) & U32(0x00FF00FF)) | ((v & U32(0x00FF00FF)) << U32(8))
+    return (v >> U32(16)) | (v << U32(16))
+
+
+def owen_scramble(v: np.ndarray, seed: np.ndarray) -> np.ndarray:
+    """rtpy.sampler.owen_scramble of uint32 arrays."""
+    seed = seed.astype(U32)
+    v = reverse_bits32(v)
+    v ^= v * U32(0x3D20ADEA)
+    v += seed
+    v *= (seed >> U32(16)) | U32(1)
+    v ^= v * U32(0x05526C56)
+    v ^= v * U32(0x53A22864)
+    return reverse_bits32(v)
+
+
+def sobol_2d(index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """rtpy.sampler.sobol_2d of a uint32 array."""
+    index = index.astype(U32)
+    y = _SOBOL_Y_BYTES[0].take(index & U32(255))
+    for b in (1, 2, 3):
+        y ^= _SOBOL_Y_BYTES[b].take((index >> U32(8 * b)) & U32(255))
+    return reverse_bits32(index), y
+
+
+def permute(i: np.ndarray, n: int, p: np.ndarray) -> np.ndarray:
+    """rtpy.sampler.permute of arrays i and p (uint32), cycle-walking each element."""
+    w = n - 1
+    for s in (1, 2, 4, 8, 16):
+        w |= w >> s
+    w = U32(w)
+    p = np.broadcast_to(p.astype(U32), np.shape(i)).copy()
+    i = np.asarray(i).astype(U32)
+    out = np.empty_like(i)
+    todo = np.arange(i.size)
+    while todo.size:
+        k, q = i[todo], p[todo]
+        k ^= q
+        k *= U32(0xE170893D)
+        k ^= q >> U32(16)
+        k ^= (k & w) >> U32(4)
+        k ^= q >> U32(8)
+        k *= U32(0x0929EB3F)
+        k ^= q >> U32(23)
+        k ^= (k & w) >> U32(1)
+        k *= U32(1) | (q >> U32(27))
+        k *= U32(0x6935FA69)
+        k ^= (k & w) >> U32(11)
+        k *= U32(0x74DCB303)
+        k ^= (k & w) >> U32(2)
+        k *= U32(0x9E501CC3)
+        k ^= (k & w) >> U32(2)
+        k *= U32(0xC860A3DF)
+        k &= w
+        k ^= k >> U32(5)
+        i[todo] = k
+        done = k < U32(n)
+        out[todo[done]] = ((k[done].astype(np.int64) + q[done]) % n).astype(U32)
+        todo = todo[~done]
+    return out.astype(np.int64)
+
+
+class Sampler:
+    """rtpy.sampler.Sampler's values for arrays of pixels and sample indices."""
+
+    name = ""
+
+    def __init__(self, seed: int = 0, spp: int = 1) -> None:
+        self.seed, self.spp = int(seed), int(spp)
+
+    def value_1d(self, pixel: np.ndarray, index: np.ndarray, dim: int) -> np.ndarray:
+        raise NotImplementedError
+
+    def value_2d(self, pixel: np.ndarray, index: np.ndarray, dim: int) -> np.ndarray:
+        """An array (2, N): the x and y of each sample's point."""
+        raise NotImplementedError
+
+
+class IndependentSampler(Sampler):
+    name = "independent"
+
+    def value_1d(self, pixel, index, dim):
+        return unit_float(hash_key(self.seed, pixel, index, dim, 0))
+
+    def value_2d(self, pixel, index, dim):
+        return np.stack(
+            [
+                self.value_1d(pixel, index, dim),
+                unit_float(hash_key(self.seed, pixel, index, dim, 1)),
+            ]
+        )
+
+
+class StratifiedSampler(Sampler):
+    name = "stratified"
+
+    def _stratum(self, pixel, index, dim, strata):
+        index = np.asarray(index)
+        if index.size and not (0 <= index.min() and index.max() < self.spp):
+            raise ValueError(f"index must be in [0, spp = {self.spp})")
+        p = hash_key(self.seed, pixel, dim) & MASK32
+        return permute(index, strata, p), hash_key(self.seed, pixel, index, dim)
+
+    def value_1d(self, pixel, index, dim):
+        k, h = self._stratum(pixel, index, dim, self.spp)
+        return (k + unit_float(h)) / self.spp
+
+    def value_2d(self, pixel, index, dim):
+        nx, ny = grid_2d(self.spp)
+        k, h = self._stratum(pixel, index, dim, nx * ny)
+        row, column = np.divmod(k, nx)
+        return np.stack([(column + unit_float(h)) / nx, (row + unit_float(mix64(h))) / ny])
+
+
+class SobolSampler(Sampler):
+    name = "sobol"
+
+    def _point(self, pixel, index, dim):
+        h = hash_key(self.seed, pixel, dim)
+        shuffled = owen_scramble(np.asarray(index).astype(U64) & MASK32, h & MASK32)
+        x, y = sobol_2d(shuffled)
+        return x, y, mix64(h)
+
+    def value_1d(self, pixel, index, dim):
+        x, _, h = self._point(pixel, index, dim)
+        return owen_scramble(x, h & MASK32).astype(np.float64) * TWO_TO_MINUS_32
+
+    def value_2d(self, pixel, index, dim):
+        x, y, h = self._point(pixel, index, dim)
+        return np.stack(
+            [
+                owen_scramble(x, h & MASK32).astype(np.float64) * TWO_TO_MINUS_32,
+                owen_scramble(y, h >> U64(32)).astype(np.float64) * TWO_TO_MINUS_32,
+            ]
+        )
+
+
+BATCH_SAMPLERS: dict[str, type[Sampler]] = {
+    "independent": IndependentSampler,
+    "stratified": StratifiedSampler,
+    "sobol": SobolSampler,
+}
+assert BATCH_SAMPLERS.keys() == SAMPLERS.keys()
+
+
+class LaneSampler:
+    """A numpy Generator for the kernels that draws the sampler's dimensions.
+
+    pixel, index  the pixel (row * width + column) and sample index of each lane
+    generator     the unit's Generator: every draw the sampler does not serve
+    lanes         the lanes a full call covers (None: every draw is independent)
+    dim           the dimension the next served draw takes
+
+    random(size) with size n or (k, n) and n = len(lanes) returns the lanes' next
+    dimensions: k = 1 one 1D dimension, k = 2 one 2D dimension, k = 3 a 1D then a 2D
+    one. Every other method and call is the Generator's.
+    """
+
+    def __init__(self, sampler: Sampler, pixel, index, generator, lanes=None, dim=PIXEL):
+        self.sampler, self.pixel, self.index = sampler, pixel, index
+        self.generator, self.lanes, self.dim = generator, lanes, dim
+
+    def camera(self) -> LaneSampler:
+        """The sampler of the camera's draws (pixel, then lens): every lane."""
+        return LaneSampler(self.sampler, self.pixel, self.index, self.generator, slice(None))
+
+    def first_hit(self, lanes: np.ndarray) -> LaneSampler:
+        """The sampler of the first hit's draws for the lanes (camera samples) `lanes`."""
+        return LaneSampler(
+            self.sampler, self.pixel, self.index, self.generator, lanes, LIGHT_CHOICE
+        )
+
+    def random(self, size=None):
+        shape = (size,) if isinstance(size, int) else tuple(size or ())
+        if self.lanes is None:
+            return self.generator.random(size)
+        n = len(self.pixel) if isinstance(self.lanes, slice) else len(self.lanes)
+        if not shape or shape[-1] != n or len(shape) > 2 or n == 0:
+            return self.generator.random(size)
+        pixel, index = self.pixel[self.lanes], self.index[self.lanes]
+        rows = 1 if len(shape) == 1 else shape[0]
+        if rows > 3:
+            return self.generator.random(size)
+        parts = []
+        if rows % 2:
+            parts.append(self.sampler.value_1d(pixel, index, self.dim)[None])
+            self.dim += 1
+        if rows >= 2:
+            parts.append(self.sampler.value_2d(pixel, index, self.dim))
+            self.dim += 1
+        values = np.concatenate(parts)
+        return values[0] if len(shape) == 1 else values
+
+    def __getattr__(self, name):
+        return getattr(self.generator, name)
+
+
+def first_hit_generator(rng, lanes: np.ndarray, segment: int):
+    """What the path integrator's kernels draw from at segment `segment` for the
+    live lanes `lanes`: a LaneSampler's first-hit draws, else the plain generator."""
+    if not isinstance(rng, LaneSampler):
+        return rng
+    return rng.first_hit(lanes) if segment == 1 else rng.generator

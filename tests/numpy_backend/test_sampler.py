@@ -1,0 +1,111 @@
+"""The batched samplers (rtpy/numpy_backend/sampler.py) give rtpy.sampler's values,
+sample for sample; LaneSampler serves them to the kernels; and the numpy backend's
+images with each sampler agree with the independent sampler's (block z-test)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rtpy
+from rtpy import sampler as scalar
+from rtpy.numpy_backend import sampler as batch
+from rtpy.numpy_backend.sampler import BATCH_SAMPLERS, LaneSampler, first_hit_generator
+from rtpy.sampler import BRDF, LENS, LIGHT, LIGHT_CHOICE, PIXEL, SAMPLERS
+
+from ..test_sampler import agrees_with_independent
+from ..tiers import slow_except
+
+ALPHA = 1e-3
+PIXELS = np.repeat(np.arange(0, 700, 97), 10)
+INDICES = np.tile(np.arange(10), len(PIXELS) // 10)
+
+
+@pytest.mark.parametrize("name", list(SAMPLERS))
+def test_values_equal_the_scalar_samplers(name):
+    one, many = SAMPLERS[name](seed=7, spp=10), BATCH_SAMPLERS[name](seed=7, spp=10)
+    keys = list(zip(PIXELS.tolist(), INDICES.tolist(), strict=True))
+    for dim in (PIXEL, LENS, LIGHT_CHOICE, LIGHT, BRDF):
+        ones = [one.value_1d(p, i, dim) for p, i in keys]
+        twos = np.array([one.value_2d(p, i, dim) for p, i in keys]).T
+        assert np.array_equal(many.value_1d(PIXELS, INDICES, dim), ones)
+        assert np.array_equal(many.value_2d(PIXELS, INDICES, dim), twos)
+
+
+def test_building_blocks_equal_the_scalar_ones():
+    v = np.array([0, 1, 7, 0x12345678, 0xFFFFFFFF], dtype=np.uint32)
+    seeds = np.array([0, 3, 0xCAFEF00D, 99, 0xFFFFFFFF], dtype=np.uint32)
+    assert batch.reverse_bits32(v).tolist() == [scalar.reverse_bits32(int(x)) for x in v]
+    assert batch.owen_scramble(v, seeds).tolist() == [
+        scalar.owen_scramble(int(x), int(s)) for x, s in zip(v, seeds, strict=True)
+    ]
+    assert [list(a) for a in zip(*batch.sobol_2d(v), strict=True)] == [
+        list(scalar.sobol_2d(int(x))) for x in v
+    ]
+    for n in (1, 6, 17):
+        i = np.arange(n)
+        assert batch.permute(i, n, seeds[2]).tolist() == [
+            scalar.permute(k, n, int(seeds[2])) for k in range(n)
+        ]
+    assert batch.hash_key(3, np.arange(4), 5).tolist() == [
+        scalar.hash_key(3, k, 5) for k in range(4)
+    ]
+
+
+def make_lane_sampler(seed: int = 2) -> LaneSampler:
+    return LaneSampler(
+        BATCH_SAMPLERS["sobol"](seed, 10), PIXELS, INDICES, np.random.default_rng(seed)
+    )
+
+
+def test_lane_sampler_serves_whole_calls_and_leaves_parts_independent():
+    sobol = BATCH_SAMPLERS["sobol"](2, 10)
+    camera = make_lane_sampler().camera()
+    assert np.array_equal(camera.random((2, len(PIXELS))), sobol.value_2d(PIXELS, INDICES, PIXEL))
+    assert np.array_equal(camera.random((2, len(PIXELS))), sobol.value_2d(PIXELS, INDICES, LENS))
+    lanes = np.array([3, 5, 8, 13])
+    hit = make_lane_sampler().first_hit(lanes)
+    p, i = PIXELS[lanes], INDICES[lanes]
+    assert np.array_equal(hit.random(4), sobol.value_1d(p, i, LIGHT_CHOICE))
+    three = hit.random((3, 4))  # a 1D dimension, then a 2D one
+    assert np.array_equal(three[0], sobol.value_1d(p, i, LIGHT))
+    assert np.array_equal(three[1:], sobol.value_2d(p, i, BRDF))
+    # A call for part of the lanes, and the sampler without lanes: the generator's numbers.
+    twin = np.random.default_rng(2)
+    assert np.array_equal(hit.random((2, 3)), twin.random((2, 3)))
+    assert np.array_equal(make_lane_sampler().random(5), np.random.default_rng(2).random(5))
+    assert make_lane_sampler().integers(10, size=3).tolist() == (
+        np.random.default_rng(2).integers(10, size=3).tolist()
+    )
+
+
+def test_first_hit_generator():
+    rng = np.random.default_rng(0)
+    assert first_hit_generator(rng, np.arange(3), 1) is rng
+    lane = make_lane_sampler()
+    assert first_hit_generator(lane, np.arange(3), 2) is lane.generator
+    assert first_hit_generator(lane, np.arange(3), 1).dim == LIGHT_CHOICE
+
+
+@pytest.mark.parametrize(
+    "sampler, integrator",
+    slow_except(
+        [(s, i) for s in ("stratified", "sobol") for i in ("direct", "path")], ("sobol", "direct")
+    ),
+)
+def test_images_agree_with_the_independent_sampler(sampler, integrator):
+    """Cornell box (area light, diffuse walls): the mean of 8 renders with each sampler
+    against 8 with the independent one, each side's variance from its own spread."""
+    agrees_with_independent("numpy", sampler, integrator, width=16)
+
+
+@pytest.mark.slow
+def test_images_are_the_same_for_any_worker_count(sampler="sobol"):
+    """Several units of work (48 x 48 pixels x 32 spp is more than one unit holds); the
+    renderer treats every sampler alike (the scalar backend's test takes the
+    stratified one)."""
+    scene = rtpy.load_scene("cornell")
+    settings = {"width": 48, "spp": 32, "sampler": sampler, "integrator": "path", "seed": 3}
+    one = rtpy.render(scene, backend="numpy", workers=1, **settings).linear
+    two = rtpy.render(scene, backend="numpy", workers=2, **settings).linear
+    assert np.array_equal(one, two)
