@@ -37,7 +37,6 @@ spp, so its ratio is the ratio of errors squared at equal time.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import subprocess
 import sys
