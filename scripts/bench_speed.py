@@ -74,15 +74,20 @@ def startup_child(out: str) -> dict[str, float]:
         marks[step] = now - last
         last = now
 
+    import numpy  # noqa: F401
+
+    mark("import numpy")
+    import PIL.Image  # noqa: F401
+
+    mark("import Pillow")
     from rtpy.io.cli import build_parser
 
-    build_parser()
-    mark("CLI imports and parser")
+    build_parser(every_command=False)  # as `rtpy render` builds it
+    mark("rtpy's CLI imports and parser")
     import rtpy
-    import rtpy.io.image
     import rtpy.renderer
 
-    mark("render imports (numpy, Pillow)")
+    mark("rtpy's renderer imports")
     import rtpy.numpy_backend.renderer  # noqa: F401
 
     mark("numpy backend imports")
