@@ -145,18 +145,29 @@ def timed(command: list[str]) -> float:
     return time.perf_counter() - start
 
 
-def rtpy_command(out: Path, width: int, spp: int, max_depth: int, seed: int, workers: int):
-    """`python -m rtpy render` of the scene with the numpy backend, the linear image
-    to `out`."""
+def rtpy_command(
+    out: Path, width: int, spp: int, max_depth: int, seed: int, workers: int, sampler=None
+):
+    """`python -m rtpy render` of the scene with the numpy backend (and --sampler
+    `sampler` unless None), the linear image to `out`."""
     return [
         sys.executable, "-m", "rtpy", "render", SCENE, "--backend", "numpy", "-q",
         "--width", str(width), "--spp", str(spp), "--max-depth", str(max_depth),
         "--seed", str(seed), "-j", str(workers), "-o", str(out.with_suffix(".png")),
-        "--linear", str(out),
+        "--linear", str(out), *(["--sampler", sampler] if sampler else []),
     ]  # fmt: skip
 
 
-def mitsuba_command(out: Path, width: int, spp: int, max_depth: int, seed: int, threads: int):
+def has_sampler_option() -> bool:
+    """Does `rtpy render` take --sampler?"""
+    command = [sys.executable, "-m", "rtpy", "render", "--help"]
+    return "--sampler" in subprocess.run(command, capture_output=True, text=True).stdout
+
+
+def mitsuba_command(
+    out: Path, width: int, spp: int, max_depth: int, seed: int, threads: int, sampler=None
+):
+    """This script's child rendering with Mitsuba (its own independent sampler)."""
     return [
         sys.executable, __file__, "--child", str(out), str(width), str(spp), str(max_depth),
         str(seed), str(threads),
@@ -171,8 +182,17 @@ def error(image, reference) -> float:
     return math.sqrt(max(mse, 0.0))
 
 
-def compare(width: int, spp: int, max_depth: int, repeat: int, workers: int, ref_spp: int) -> dict:
-    """Run both renderers `repeat` times, alternating; the measurements as a dict."""
+def compare(
+    width: int,
+    spp: int,
+    max_depth: int,
+    repeat: int,
+    workers: int,
+    ref_spp: int,
+    sampler: str | None = None,
+) -> dict:
+    """Run both renderers `repeat` times, alternating; the measurements as a dict.
+    rtpy renders with `sampler` when its CLI has --sampler, else with its default."""
     import numpy as np
 
     from rtpy.io.bundled import resolve_scene
@@ -182,13 +202,17 @@ def compare(width: int, spp: int, max_depth: int, repeat: int, workers: int, ref
     reference = get_reference(
         resolve_scene(SCENE), width, max_depth, ref_spp, log=lambda m: print(m, file=sys.stderr)
     )
+    if sampler and not has_sampler_option():
+        print(f"rtpy render has no --sampler: {sampler!r} left out", file=sys.stderr)
+        sampler = None
     times = {"rtpy": [], "mitsuba": []}
     images = {"rtpy": [], "mitsuba": []}
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(repeat):
             for name, make in (("rtpy", rtpy_command), ("mitsuba", mitsuba_command)):
                 out = Path(tmp) / f"{name}{r}.npy"
-                times[name].append(timed(make(out, width, spp, max_depth, r + 1, workers)))
+                command = make(out, width, spp, max_depth, r + 1, workers, sampler)
+                times[name].append(timed(command))
                 images[name].append(np.load(out))
     ratios = sorted(m / t for m, t in zip(times["mitsuba"], times["rtpy"], strict=True))
     result = {
@@ -198,6 +222,7 @@ def compare(width: int, spp: int, max_depth: int, repeat: int, workers: int, ref
         "workers": workers,
         "repeat": repeat,
         "reference": reference.source,
+        "sampler": sampler or "its default",
         "paths": width * reference.image.shape[0] * spp,
         "ratio": ratios[len(ratios) // 2],
     }
@@ -229,7 +254,8 @@ def format_result(r: dict) -> list[str]:
         "| renderer | seconds | paths/s | RMSE | efficiency 1/(MSE s) |",
         "|---|---|---|---|---|",
     ]
-    for name, label in (("rtpy", "rtpy numpy"), ("mitsuba", "Mitsuba 3 scalar_rgb")):
+    rtpy_label = f"rtpy numpy ({r['sampler']} sampler)"
+    for name, label in (("rtpy", rtpy_label), ("mitsuba", "Mitsuba 3 scalar_rgb (independent)")):
         m = r[name]
         lines.append(
             f"| {label} | {m['seconds']:.2f} | {r['paths'] / m['seconds']:,.0f} "
@@ -259,6 +285,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--workers", type=int, default=2, help="rtpy processes, Mitsuba threads")
     parser.add_argument("--reference-spp", type=int, default=4096)
+    parser.add_argument("--sampler", help="rtpy render --sampler NAME, when rtpy has it")
     parser.add_argument("--quick", action="store_true", help="32x32, 16 spp, 2 rounds")
     args = parser.parse_args(argv)
     if not have_mitsuba():
@@ -267,7 +294,13 @@ def main(argv: list[str] | None = None) -> int:
     if args.quick:
         args.width, args.spp, args.repeat, args.reference_spp = 32, 16, 2, 1024
     result = compare(
-        args.width, args.spp, args.max_depth, args.repeat, args.workers, args.reference_spp
+        args.width,
+        args.spp,
+        args.max_depth,
+        args.repeat,
+        args.workers,
+        args.reference_spp,
+        args.sampler,
     )
     print("\n".join(format_result(result)))
     return 0

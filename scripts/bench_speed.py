@@ -277,6 +277,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("course_dir", nargs="?", help="checkout of the course's week-8 code")
     parser.add_argument("--repeat", type=int, default=3, help="rounds of each measurement")
     parser.add_argument("--samplers", default="all", help="handed to rtpy bench --samplers")
+    parser.add_argument("--sampler", help="rtpy's sampler against Mitsuba (rtpy --sampler)")
     parser.add_argument("--quick", action="store_true", help="small images, 1 round")
     parser.add_argument("--write-doc", action="store_true", help="update docs/bench.md")
     args = parser.parse_args(argv)
@@ -292,7 +293,7 @@ def main(argv: list[str] | None = None) -> int:
     mitsuba = None
     if bench_mitsuba.have_mitsuba():
         width, spp, ref = (32, 16, 1024) if args.quick else (128, 64, 4096)
-        mitsuba = bench_mitsuba.compare(width, spp, 8, max(2, repeat), 2, ref)
+        mitsuba = bench_mitsuba.compare(width, spp, 8, max(2, repeat), 2, ref, args.sampler)
     course, course_note = course_measurement(args.course_dir, args.quick, repeat)
     samplers = sampler_lines(args.samplers, args.quick)
     lines = format_report(startup, scaling, mitsuba, course, course_note, samplers)
