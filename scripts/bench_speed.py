@@ -244,13 +244,13 @@ def plot(scaling, mitsuba, course, path: Path) -> bool:
     except ImportError:
         return False
     rows = [r for r in summary(scaling, mitsuba, course) if r[1] is not None]
-    fig, ax = plt.subplots(figsize=(6.4, 0.6 + 0.6 * len(rows)))
+    fig, ax = plt.subplots(figsize=(6.4, 1.2 + 0.6 * len(rows)))
     names = [r[0] for r in rows]
     ax.barh(names, [r[1] for r in rows], color="tab:blue", label="measured")
     ax.scatter([r[2] for r in rows], names, marker="|", s=400, color="black", label="goal")
     ax.invert_yaxis()
     ax.set_xlabel("ratio (x)")
-    ax.legend(loc="lower right")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=2, frameon=False)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=100)
