@@ -12,6 +12,8 @@ import pytest
 
 from rtpy.grading.assignment import TEST_WEEKS_FILE
 
+from .commands import modules_imported_by
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -169,33 +171,8 @@ def test_the_command_line_starts_without_the_test_extras():
     assert "--preview" in result.stdout
 
 
-def modules_imported_by(code: str) -> set[str]:
-    """The top-level modules and rtpy subpackages that `code`, run in a fresh
-    interpreter, imports beyond what the interpreter starts with."""
-    script = (
-        "import sys\n"
-        "before = set(sys.modules)\n"
-        f"{code}\n"
-        "print(' '.join(sorted(set(sys.modules) - before)))\n"
-    )
-    result = subprocess.run(
-        [sys.executable, "-c", script], capture_output=True, text=True, timeout=120
-    )
-    assert result.returncode == 0, result.stderr
-    return set(result.stdout.split())
-
-
 def test_import_rtpy_loads_neither_numpy_nor_pillow_nor_tqdm():
     """They are for rendering and writing images; the scene classes do without."""
     loaded = modules_imported_by("import rtpy")
     assert "rtpy.vec3" in loaded
     assert not loaded & {"numpy", "PIL", "tqdm", "importlib.metadata", "rtpy.renderer"}
-
-
-def test_a_quiet_render_loads_no_progress_bar_and_no_other_command(tmp_path):
-    out = tmp_path / "out.png"
-    argv = ["render", "cornell", "--width", "4", "--spp", "1", "-j", "1", "-q", "-o", str(out)]
-    loaded = modules_imported_by(f"from rtpy.io.cli import main\nmain({argv!r})")
-    assert out.exists() and "numpy" in loaded
-    unneeded = {"tqdm", "rtpy.bench", "rtpy.grading", "importlib.metadata"}
-    assert not loaded & unneeded

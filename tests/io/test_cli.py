@@ -20,7 +20,7 @@ from rtpy.io.cli import MAX_WORKERS, build_parser, main
 from rtpy.io.image import read_pfm
 from rtpy.materials import MATERIALS
 
-from ..commands import read_until, rtpy_command, run_cli
+from ..commands import modules_imported_by, read_until, rtpy_command, run_cli
 from ..tiers import slow_except
 
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
@@ -555,3 +555,12 @@ def test_preview_seconds_from_zero(tmp_path, capsys, value, status):
         assert list(tmp_path.iterdir()) == []
     else:
         assert main(args) == 0
+
+
+def test_a_quiet_render_loads_no_progress_bar_and_no_other_command(tmp_path):
+    out = tmp_path / "out.png"
+    argv = ["render", "cornell", "--width", "4", "--spp", "1", "-j", "1", "-q", "-o", str(out)]
+    loaded = modules_imported_by(f"from rtpy.io.cli import main\nmain({argv!r})")
+    assert out.exists() and "numpy" in loaded
+    unneeded = {"tqdm", "rtpy.bench", "rtpy.grading", "importlib.metadata"}
+    assert not loaded & unneeded
