@@ -13,12 +13,11 @@ each name of the course's code is; docs/scene-format.md is the scene-file format
 
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version
+from typing import TYPE_CHECKING
 
 from .camera import Camera
 from .hit_info import HitInfo
 from .interval import Interval
-from .io.image import RenderedImage
 from .light import PointLight
 from .materials import (
     Blinn,
@@ -39,8 +38,7 @@ from .mesh import Mesh, SmoothTriangle, Transform
 from .plugins import load_plugin
 from .quad import Quad
 from .ray import Ray
-from .render_settings import SETTINGS, RenderSettings
-from .renderer import BACKENDS, Renderer
+from .render_settings import BACKENDS, SETTINGS, RenderSettings
 from .scatter_info import ScatterInfo
 from .scene import Scene
 from .sphere import Sphere
@@ -48,10 +46,35 @@ from .texture import CheckerTexture, ImageTexture, SolidColor, Texture
 from .triangle import Triangle
 from .vec3 import Color, Point3, Vec3
 
-try:
-    __version__ = version("rtpy")  # pyproject.toml's version, as installed
-except PackageNotFoundError:  # a source tree that was never installed
-    __version__ = "0+unknown"
+if TYPE_CHECKING:
+    from .io.image import RenderedImage
+    from .renderer import Renderer
+
+# Imported on first use: `import rtpy` loads neither numpy, Pillow nor tqdm, which
+# only rendering and writing images need (a command starts sooner without them).
+_LAZY = {"RenderedImage": ".io.image", "Renderer": ".renderer"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        from importlib import import_module
+
+        value = getattr(import_module(_LAZY[name], __name__), name)
+    elif name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            value = version("rtpy")  # pyproject.toml's version, as installed
+        except PackageNotFoundError:  # a source tree that was never installed
+            value = "0+unknown"
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY, "__version__"})
 
 
 def load_scene(path_or_name: str):
@@ -95,6 +118,7 @@ def render(
     (rtpy.io.preview.preview_target).
     """
     from .io.preview import preview_target
+    from .renderer import Renderer
 
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {backend!r}")

@@ -25,7 +25,6 @@ from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
-from tqdm.auto import tqdm  # a notebook widget in Jupyter, else text
 
 from .camera import Camera
 from .integrators import make_integrator
@@ -291,6 +290,16 @@ def make_backend(name: str, scene: Scene, camera: Camera, settings: RenderSettin
     raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {name!r}")
 
 
+class _NoBar:
+    """The progress bar of a quiet render: tqdm is not even imported."""
+
+    def update(self, n: int) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
 class Renderer:
     """Renders a scene with a camera and settings.
 
@@ -335,15 +344,7 @@ class Renderer:
         units = backend.plan_units(camera.width, camera.height, spp)
         results = PixelSums(camera.width, camera.height)
         total_paths = camera.width * camera.height * spp
-        bar = tqdm(
-            total=total_paths,
-            unit="path",
-            unit_scale=True,
-            file=sys.stderr,
-            disable=self.quiet,
-            desc=f"{self.scene.name} ({settings.integrator}, {backend.name})",
-            dynamic_ncols=True,
-        )
+        bar = _NoBar() if self.quiet else self._progress_bar(total_paths)
         start = last_preview = time.perf_counter()
         interrupted = False
         work = self._run(units)
@@ -366,6 +367,18 @@ class Renderer:
             bar.close()
         seconds = time.perf_counter() - start
         return self._assemble(results, spp, interrupted, seconds)
+
+    def _progress_bar(self, total_paths: int):
+        from tqdm.auto import tqdm  # a notebook widget in Jupyter, else text
+
+        return tqdm(
+            total=total_paths,
+            unit="path",
+            unit_scale=True,
+            file=sys.stderr,
+            desc=f"{self.scene.name} ({self.settings.integrator}, {self.backend.name})",
+            dynamic_ncols=True,
+        )
 
     def _run(self, units: list[Unit]):
         workers = min(self.workers, len(units))

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from .hit_info import HitInfo
 from .vec3 import Color
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class Texture:
@@ -48,6 +50,8 @@ class CheckerTexture(Texture):
 
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:
     """The sRGB transfer curve inverted: 8-bit file values (as 0..1) to linear."""
+    import numpy as np  # here: the scalar renderer's textures need no numpy
+
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
 
 
@@ -57,6 +61,8 @@ class ImageTexture(Texture):
     PNG/JPEG pixels are sRGB-encoded and decoded to linear RGB on load."""
 
     def __init__(self, pixels: np.ndarray) -> None:
+        import numpy as np
+
         pixels = np.asarray(pixels, dtype=np.float64)
         if pixels.ndim != 3 or pixels.shape[2] != 3 or pixels.shape[0] < 1 or pixels.shape[1] < 1:
             raise ValueError(f"image texture needs an (H, W, 3) array, got shape {pixels.shape}")
@@ -68,6 +74,7 @@ class ImageTexture(Texture):
 
     @classmethod
     def from_file(cls, path: str | Path) -> ImageTexture:
+        import numpy as np
         from PIL import Image
 
         with Image.open(path) as im:

@@ -22,11 +22,11 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from .plugins import PLUGINS, load_listed_plugins
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from .renderer import Backend, Unit
 
 _render_one: Callable[[Unit], np.ndarray] | None = None

@@ -124,6 +124,7 @@ def render_course(course_dir: str, width: int, spp: int, max_depth: int, seed: i
 def render_rtpy(width: int, spp: int, max_depth: int, seed: int) -> dict:
     """Render with the rtpy on sys.path, scalar backend, one process."""
     import rtpy
+    import rtpy.renderer  # noqa: F401  (imported on first use: not part of the render's time)
     from rtpy.materials import DiffuseLight, Lambertian, Phong
 
     scene = rtpy.Scene(background=rtpy.Color(*BACKGROUND))
@@ -160,17 +161,49 @@ def timed(render, count_paths) -> dict:
     return {"seconds": wall, "cpu_seconds": cpu, "paths": count_paths(result)}
 
 
-def run_child(kind: str, args: argparse.Namespace, rtpy_dir: str | None = None) -> dict:
+def run_child(
+    kind: str, width: int, spp: int, max_depth: int, course_dir: str | None, rtpy_dir=None
+) -> dict:
     """One render in a fresh Python process; its result."""
-    command = [sys.executable, __file__, "--child", kind, "--width", str(args.width)]
-    command += ["--spp", str(args.spp), "--max-depth", str(args.max_depth)]
+    command = [sys.executable, __file__, "--child", kind, "--width", str(width)]
+    command += ["--spp", str(spp), "--max-depth", str(max_depth)]
     if kind == "course":
-        command.append(args.course_dir)
+        command.append(course_dir)
     env = dict(os.environ)
     if rtpy_dir is not None:
         env["PYTHONPATH"] = os.pathsep.join(filter(None, [rtpy_dir, env.get("PYTHONPATH")]))
     out = subprocess.run(command, env=env, check=True, capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
+
+
+def has_course(course_dir: str | None) -> bool:
+    return bool(course_dir) and (Path(course_dir) / "RT_material.py").is_file()
+
+
+def measure(
+    course_dir: str | None,
+    width: int,
+    spp: int,
+    max_depth: int,
+    repeat: int,
+    others: tuple[str, ...] = (),
+) -> dict[str, dict]:
+    """The fastest of `repeat` alternating runs of each renderer: label -> its result
+    (paths_per_second per CPU second), "course" only with a checkout at course_dir,
+    "rtpy DIR" for each other rtpy checkout."""
+    rows: list[tuple[str, str, str | None]] = []  # (label, kind, rtpy dir)
+    if has_course(course_dir):
+        rows.append(("course", "course", None))
+    rows.append(("rtpy", "rtpy", None))
+    rows += [(f"rtpy {d}", "rtpy", str(Path(d).resolve())) for d in others]
+    best: dict[str, dict] = {}
+    for _ in range(max(1, repeat)):
+        for label, kind, rtpy_dir in rows:
+            r = run_child(kind, width, spp, max_depth, course_dir, rtpy_dir)
+            r["paths_per_second"] = r["paths"] / r["cpu_seconds"]
+            if label not in best or r["paths_per_second"] > best[label]["paths_per_second"]:
+                best[label] = r
+    return best
 
 
 def main() -> None:
@@ -193,20 +226,11 @@ def main() -> None:
         print(json.dumps(result))
         return
 
-    rows: list[tuple[str, str, str | None]] = []  # (label, kind, rtpy dir)
-    if args.course_dir and (Path(args.course_dir) / "RT_material.py").is_file():
-        rows.append(("course", "course", None))
-    else:
+    if not has_course(args.course_dir):
         print(f"no course checkout at {args.course_dir!r}: skipping the course's row")
-    rows.append(("rtpy", "rtpy", None))
-    rows += [(f"rtpy {d}", "rtpy", str(Path(d).resolve())) for d in args.rtpy]
-    best: dict[str, dict] = {}
-    for _ in range(max(1, args.repeat)):
-        for label, kind, rtpy_dir in rows:
-            r = run_child(kind, args, rtpy_dir)
-            r["paths_per_second"] = r["paths"] / r["cpu_seconds"]
-            if label not in best or r["paths_per_second"] > best[label]["paths_per_second"]:
-                best[label] = r
+    best = measure(
+        args.course_dir, args.width, args.spp, args.max_depth, args.repeat, tuple(args.rtpy)
+    )
     print(
         f"course's week-8 scene, width {args.width}, {args.spp} spp, max_depth {args.max_depth}, "
         f"best of {max(1, args.repeat)}:"

@@ -33,3 +33,19 @@ def read_until(proc: subprocess.Popen, done, timeout: float = 120) -> str:
         if done(seen):
             return seen
     raise AssertionError(f"not seen within {timeout} s: {seen}")
+
+
+def modules_imported_by(code: str) -> set[str]:
+    """The top-level modules and rtpy subpackages that `code`, run in a fresh
+    interpreter, imports beyond what the interpreter starts with."""
+    script = (
+        "import sys\n"
+        "before = set(sys.modules)\n"
+        f"{code}\n"
+        "print(' '.join(sorted(set(sys.modules) - before)))\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=120
+    )
+    assert result.returncode == 0, result.stderr
+    return set(result.stdout.split())

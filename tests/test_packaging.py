@@ -12,6 +12,8 @@ import pytest
 
 from rtpy.grading.assignment import TEST_WEEKS_FILE
 
+from .commands import modules_imported_by
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -167,3 +169,10 @@ def test_the_command_line_starts_without_the_test_extras():
     )
     assert result.returncode == 0, result.stderr
     assert "--preview" in result.stdout
+
+
+def test_import_rtpy_loads_neither_numpy_nor_pillow_nor_tqdm():
+    """They are for rendering and writing images; the scene classes do without."""
+    loaded = modules_imported_by("import rtpy")
+    assert "rtpy.vec3" in loaded
+    assert not loaded & {"numpy", "PIL", "tqdm", "importlib.metadata", "rtpy.renderer"}

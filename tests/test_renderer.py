@@ -197,7 +197,10 @@ def test_progress_bar_only_when_asked_for(capsys, options, shown):
 def test_the_bar_is_tqdms_notebook_aware_one():
     import tqdm.auto
 
-    assert rtpy.renderer.tqdm is tqdm.auto.tqdm
+    scene, camera = small_scene()
+    bar = rtpy.Renderer(scene, camera, scene.settings or rtpy.RenderSettings())._progress_bar(4)
+    bar.close()
+    assert isinstance(bar, tqdm.auto.tqdm)
 
 
 @pytest.mark.parametrize(

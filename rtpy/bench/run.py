@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import renderer  # noqa: F401  (rtpy loads it on first use: here, before any timing)
 from ..testing.reference import DEFAULT_REFERENCE_SPP, Reference
 from ..testing.statistics import peak_memory_mb, reset_peak_memory
 from .convergence import (

@@ -79,17 +79,26 @@ def add_setting_options(r: argparse.ArgumentParser) -> None:
     )
 
 
-def build_parser(prog: str = "rtpy") -> argparse.ArgumentParser:
-    """The command line's parser; `prog` is the program as it was run (usage lines and
-    argparse's errors name it)."""
-    from .. import __version__
+class _Version(argparse.Action):
+    """--version: the installed version, looked up only when asked for."""
 
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        from .. import __version__
+
+        print(f"{parser.prog} {__version__}")
+        parser.exit()
+
+
+def build_parser(prog: str = "rtpy", every_command: bool = True) -> argparse.ArgumentParser:
+    """The command line's parser; `prog` is the program as it was run (usage lines and
+    argparse's errors name it). every_command=False leaves out the bench and
+    assignment commands, whose options import their modules (a render starts sooner)."""
     parser = argparse.ArgumentParser(
         prog=prog,
         description="rtpy: a teaching ray tracer in Python.",
         epilog=f"'{prog} COMMAND --help' shows a command's options.",
     )
-    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     r = sub.add_parser(
@@ -147,7 +156,8 @@ def build_parser(prog: str = "rtpy") -> argparse.ArgumentParser:
     )
 
     sub.add_parser("scenes", help="list the bundled scenes")
-
+    if not every_command:
+        return parser
     from ..bench.command import add_parser as add_bench_parser
 
     add_bench_parser(sub)
@@ -381,8 +391,8 @@ def _render(args: argparse.Namespace) -> int:
 def main(argv: list[str] | None = None, prog: str = "rtpy") -> int:
     """Run the command line `argv` (default sys.argv[1:]); `prog` names the program in
     usage lines and errors (`python -m rtpy` passes its own). Returns the exit status."""
-    parser = build_parser(prog)
     argv = sys.argv[1:] if argv is None else argv
+    parser = build_parser(prog, every_command=argv[:1] not in (["render"], ["scenes"]))
     if not argv:
         parser.print_help()
         return 0

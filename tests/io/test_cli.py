@@ -25,7 +25,7 @@ from rtpy.io.image import read_pfm
 from rtpy.materials import MATERIALS
 from rtpy.render_settings import SETTINGS
 
-from ..commands import read_until, rtpy_command, run_cli
+from ..commands import modules_imported_by, read_until, rtpy_command, run_cli
 from ..tiers import slow_except
 
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
@@ -693,3 +693,10 @@ def test_a_preview_that_cannot_be_written_stops_the_render_in_one_line(
         f"rtpy: error: cannot write '{preview}': {os.strerror(errno.EIO)}\n"
     )
     assert list(tmp_path.iterdir()) == []
+def test_a_quiet_render_loads_no_progress_bar_and_no_other_command(tmp_path):
+    out = tmp_path / "out.png"
+    argv = ["render", "cornell", "--width", "4", "--spp", "1", "-j", "1", "-q", "-o", str(out)]
+    loaded = modules_imported_by(f"from rtpy.io.cli import main\nmain({argv!r})")
+    assert out.exists() and "numpy" in loaded
+    unneeded = {"tqdm", "rtpy.bench", "rtpy.grading", "importlib.metadata"}
+    assert not loaded & unneeded
