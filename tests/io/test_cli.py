@@ -693,6 +693,8 @@ def test_a_preview_that_cannot_be_written_stops_the_render_in_one_line(
         f"rtpy: error: cannot write '{preview}': {os.strerror(errno.EIO)}\n"
     )
     assert list(tmp_path.iterdir()) == []
+
+
 def test_a_quiet_render_loads_no_progress_bar_and_no_other_command(tmp_path):
     out = tmp_path / "out.png"
     argv = ["render", "cornell", "--width", "4", "--spp", "1", "-j", "1", "-q", "-o", str(out)]
