@@ -342,26 +342,33 @@ def components(v: Any) -> Any:
     return v
 
 
+def _checked_as(cls: type, name: str, check: Callable[..., Any], v: Any, *args: Any) -> Any:
+    """v itself when it is a cls already, else a new cls of its three numbers; either
+    after check(its components, *args) (TypeError or ValueError naming the parameter)."""
+    xyz = checked(name, check, components(v), *args)
+    return v if type(v) is cls else cls(*xyz)
+
+
 def checked_vector(name: str, v: Any, rng: Range = ANY) -> Vec3:
     """A Vec3 from a Vec3 or 3 numbers (a tuple, a list, a numpy array), each in rng."""
-    return Vec3(*checked(name, triple, components(v), rng))
+    return _checked_as(Vec3, name, triple, v, rng)
 
 
 def checked_point(name: str, v: Any) -> Vec3:
     """A point whose components lie in COORDINATE."""
-    return Vec3(*checked(name, point, components(v)))
+    return _checked_as(Vec3, name, point, v)
 
 
 def checked_edge(name: str, v: Any) -> Vec3:
     """A vector whose length lies in LENGTH (see edge)."""
-    return Vec3(*checked(name, edge, components(v)))
+    return _checked_as(Vec3, name, edge, v)
 
 
 def checked_scales(name: str, v: Any) -> Vec3:
     """Scale factors along x, y, z (see scales)."""
-    return Vec3(*checked(name, scales, components(v)))
+    return _checked_as(Vec3, name, scales, v)
 
 
 def checked_color(name: str, v: Any, rng: Range = UNIT) -> Color:
     """A Color from a Color or 3 numbers, each in rng (UNIT for reflectances)."""
-    return Color(*checked(name, triple, components(v), rng))
+    return _checked_as(Color, name, triple, v, rng)

@@ -92,7 +92,7 @@ def test_out_of_range(text, table, key):
 def test_negative_radius_is_refused():
     err = error_of(MINIMAL.replace("radius = 0.5", "radius = -0.5"))
     assert_names(err, "[[objects]] #1", "radius")
-    assert "> 0" in str(err)
+    assert "expected a number in [1e-06, 1000000], found -0.5" in str(err)
 
 
 # --- the checks on their own -----------------------------------------------------------------
