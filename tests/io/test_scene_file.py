@@ -692,7 +692,7 @@ def _key_cases() -> list[tuple]:
 KEY_CASES = _key_cases()
 # Examples per key in the slow tier (log-uniform magnitudes and special values), on
 # top of SPECIAL_FLOATS in the fast tier.
-KEY_EXAMPLES = 15
+KEY_EXAMPLES = 12
 
 
 @pytest.fixture(scope="module")

@@ -190,7 +190,7 @@ def test_describe_and_ranges():
 GREY = (0.5, 0.5, 0.5)
 # Examples per constructor parameter in the slow tier (log-uniform magnitudes
 # and special values), on top of SPECIAL_FLOATS in the fast tier.
-API_EXAMPLES = 30
+API_EXAMPLES = 25
 
 
 def _inside(rng: Range):
