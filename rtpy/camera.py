@@ -95,15 +95,15 @@ class Camera:
         view = look_from - look_at
         if view.length() not in LENGTH:
             raise ValueError(
-                f"look_at: the distance from look_from to look_at must be {LENGTH.text()}, "
+                f"look_at: expected a distance from look_from {LENGTH.text()}, "
                 f"found {view.length():.3g}"
             )
         self.w = unit_vector(view)  # points backward, away from the scene
         side = cross(vup, self.w)
         if not side.length() >= MIN_SINE * vup.length():
             raise ValueError(
-                "vup: it is parallel to the view direction (look_at - look_from); "
-                f"the sine of the angle between them must be >= {MIN_SINE:g}"
+                "vup: expected an up vector across the view direction (look_at - look_from), "
+                f"the sine of the angle between them >= {MIN_SINE:g}; found it parallel"
             )
         self.u = unit_vector(side)  # camera right
         self.v = cross(self.w, self.u)  # camera up

@@ -176,7 +176,7 @@ class _Loader(TableReader):
         try:
             return Camera(look_from, look_at, vup, vfov, aspect, width, defocus, focus)
         except (ValueError, ArithmeticError) as e:
-            raise self.fail(w, _guess_key(str(e), CAMERA_KEYS), str(e)) from None
+            raise self.fail(w, *_blame(str(e), CAMERA_KEYS)) from None
 
     def aspect_ratio(self, w: Where, v: Any) -> float:
         what = 'a number > 0 or a string "W:H" (such as "16:9")'
@@ -258,7 +258,7 @@ class _Loader(TableReader):
         try:
             return cls(**kwargs)
         except (ValueError, TypeError, ArithmeticError) as e:
-            raise self.fail(w, _guess_key(str(e), params), str(e)) from None
+            raise self.fail(w, *_blame(str(e), params)) from None
 
     def material_value(self, w: Where, p: Param, v: Any) -> Any:
         rng = MATERIAL_RANGES.get(p.name, ANY)
@@ -406,17 +406,18 @@ class _Loader(TableReader):
         return PointLight(position, intensity)
 
 
-def _guess_key(message: str, keys: Iterable[str]) -> str | None:
-    """The key a constructor's error message talks about, if it names one (first the
-    parameter that starts it, "key: ...")."""
+def _blame(message: str, keys: Iterable[str]) -> tuple[str | None, str]:
+    """The key a constructor's error message talks about, if it names one, and the
+    message: a parameter that starts it ("key: ...") is that key, and is then left
+    out of the message (the SceneError names it)."""
     keys = list(keys)
-    first = re.match(r"(\w+):", message)
+    first = re.match(r"(\w+): ", message)
     if first and first.group(1) in keys:
-        return first.group(1)
+        return first.group(1), message[first.end() :]
     for key in keys:
         if re.search(rf"\b{re.escape(key)}\b", message):
-            return key
-    return None
+            return key, message
+    return None, message
 
 
 # --------------------------------------------------------------------------- entry points

@@ -732,6 +732,20 @@ def check_key_value(directory, path, key, component, ok, names, x) -> None:
         label = f"[{'.'.join(path)}]"
     assert err.file == str(file) and err.table == label and err.key in names, str(err)
     assert f"{label} {err.key}:" in str(err) and "\n" not in str(err)
+    assert f"{err.key}: {err.key}:" not in str(err)  # the key is named once
+
+
+@pytest.mark.parametrize(
+    ("camera", "key", "words"),
+    [
+        ("look_at = [0, 0, 0]", "look_at", "expected a distance from look_from in [1e-06, "),
+        ("vup = [0, 0, 2]", "vup", "expected an up vector across the view direction"),
+    ],
+)
+def test_a_camera_that_sees_nothing_is_refused_naming_the_key_once(camera, key, words):
+    err = error_of(f"[camera]\n{camera}\n")
+    assert_names(err, "[camera]", key)
+    assert f"[camera] {key}: {words}" in str(err)
 
 
 @pytest.mark.parametrize(
