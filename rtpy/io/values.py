@@ -17,6 +17,7 @@ one out of range, both naming the parameter.
 from __future__ import annotations
 
 import difflib
+import functools
 import json
 import math
 from collections.abc import Callable, Iterable
@@ -99,6 +100,9 @@ def suggest(word: str, choices: Iterable[str]) -> str | None:
 
 
 def is_number(v: Any) -> bool:
+    kind = type(v)
+    if kind is float or kind is int:  # the common case, without the abstract class
+        return True
     return isinstance(v, Real) and not isinstance(v, bool)
 
 
@@ -159,6 +163,7 @@ class Range:
             return False
         return not (self.hi is not None and (x >= self.hi if self.hi_open else x > self.hi))
 
+    @functools.cache  # noqa: B019 (ranges are few and live as long as the program)
     def text(self) -> str:
         lo = None if self.lo is None else num_text(self.lo)
         hi = None if self.hi is None else num_text(self.hi)
