@@ -118,8 +118,14 @@ def render(
     (rtpy.io.preview.preview_target).
     """
     from .io.preview import preview_target
+    from .io.values import Range, checked, integer
     from .renderer import Renderer
 
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene: expected a Scene, found a {type(scene).__name__}")
+    if camera is not None and not isinstance(camera, Camera):
+        raise TypeError(f"camera: expected a Camera or None, found a {type(camera).__name__}")
+    workers = checked("workers", integer, workers, Range(1))
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {', '.join(BACKENDS)}; got {backend!r}")
     show_progress = _show_progress(progress, quiet)

@@ -9,7 +9,18 @@ from __future__ import annotations
 
 import math
 
+from .io.values import (
+    ASPECT_RATIO,
+    DEFOCUS_ANGLE,
+    LENGTH,
+    MIN_SINE,
+    VFOV,
+    checked_edge,
+    checked_number,
+    checked_point,
+)
 from .ray import Ray
+from .render_settings import SETTINGS
 from .sampling import generator, random_in_unit_disk
 from .vec3 import Vec3, cross, unit_vector
 
@@ -55,22 +66,22 @@ class Camera:
         defocus_angle: float = 0.0,
         focus_distance: float = 10.0,
     ) -> None:
+        look_from = checked_point("look_from", look_from)
+        look_at = checked_point("look_at", look_at)
+        vup = checked_edge("vup", vup)
         self.look_from, self.look_at, self.vup = look_from, look_at, vup
-        self.vfov = float(vfov)
-        self.aspect_ratio = parse_aspect_ratio(aspect_ratio)
-        self.width = int(width)
-        self.defocus_angle = float(defocus_angle)
-        self.focus_distance = float(focus_distance)
-        if not 0.0 < self.vfov < 180.0:
-            raise ValueError(f"vfov must be between 0 and 180 degrees, got {vfov}")
-        if not self.aspect_ratio > 0.0 or not math.isfinite(self.aspect_ratio):
-            raise ValueError(f"aspect_ratio must be > 0, got {aspect_ratio}")
-        if self.width < 1:
-            raise ValueError(f"width must be >= 1, got {width}")
-        if not self.focus_distance > 0.0:
-            raise ValueError(f"focus_distance must be > 0, got {focus_distance}")
-        if not 0.0 <= self.defocus_angle < 180.0:
-            raise ValueError(f"defocus_angle must be in [0, 180), got {defocus_angle}")
+        self.vfov = checked_number("vfov", vfov, VFOV)
+        if isinstance(aspect_ratio, str):
+            try:
+                aspect_ratio = parse_aspect_ratio(aspect_ratio)
+            except ValueError:
+                raise ValueError(
+                    f'aspect_ratio: expected a number or "W:H", found {aspect_ratio!r}'
+                ) from None
+        self.aspect_ratio = checked_number("aspect_ratio", aspect_ratio, ASPECT_RATIO)
+        self.width = SETTINGS["width"].check(width)
+        self.defocus_angle = checked_number("defocus_angle", defocus_angle, DEFOCUS_ANGLE)
+        self.focus_distance = checked_number("focus_distance", focus_distance, LENGTH)
         height = self.width / self.aspect_ratio
         if not height < 1e9:
             raise ValueError(f"aspect_ratio {aspect_ratio} makes the image {height} pixels high")
@@ -82,12 +93,18 @@ class Camera:
             )
 
         view = look_from - look_at
-        if view.length_squared() == 0.0:
-            raise ValueError("look_from and look_at are the same point")
+        if view.length() not in LENGTH:
+            raise ValueError(
+                f"look_at: expected a distance from look_from {LENGTH.text()}, "
+                f"found {view.length():.3g}"
+            )
         self.w = unit_vector(view)  # points backward, away from the scene
         side = cross(vup, self.w)
-        if not side.length() > 1e-9 * vup.length():
-            raise ValueError("vup is zero or parallel to the view direction")
+        if not side.length() >= MIN_SINE * vup.length():
+            raise ValueError(
+                "vup: expected an up vector across the view direction (look_at - look_from), "
+                f"the sine of the angle between them >= {MIN_SINE:g}; found it parallel"
+            )
         self.u = unit_vector(side)  # camera right
         self.v = cross(self.w, self.u)  # camera up
 

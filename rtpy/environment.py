@@ -15,7 +15,10 @@ import math
 
 import numpy as np
 
+from .io.values import RADIANCE, Range, checked_color, checked_number
 from .vec3 import Color, Vec3
+
+POLAR_ANGLE = Range(0, 180)  # degrees from the zenith
 
 
 class Environment:
@@ -41,12 +44,13 @@ class SkyBand(Environment):
     E = radiance * pi * (sin^2 theta_max - sin^2 theta_min)."""
 
     def __init__(self, radiance: Color, theta_min: float, theta_max: float) -> None:
-        if not 0.0 <= theta_min < theta_max <= 180.0:
+        self.value = checked_color("radiance", radiance, RADIANCE)
+        self.theta_min = checked_number("theta_min", theta_min, POLAR_ANGLE)
+        self.theta_max = checked_number("theta_max", theta_max, POLAR_ANGLE)
+        if not self.theta_min < self.theta_max:
             raise ValueError(
-                f"need 0 <= theta_min < theta_max <= 180 degrees, got {theta_min}, {theta_max}"
+                f"theta_max: expected more than theta_min = {theta_min}, found {theta_max}"
             )
-        self.value = radiance
-        self.theta_min, self.theta_max = float(theta_min), float(theta_max)
         self._cos_hi = math.cos(math.radians(self.theta_min))  # cos falls as theta grows
         self._cos_lo = math.cos(math.radians(self.theta_max))
 

@@ -14,6 +14,7 @@ import math
 
 from .hit_info import HitInfo
 from .hittable import Hittable
+from .io.values import RADIANCE, checked_color, checked_point
 from .sampling import generator
 from .vec3 import Color, Vec3
 
@@ -53,8 +54,8 @@ class PointLight(Light):
     is_delta = True
 
     def __init__(self, position: Vec3, intensity: Color) -> None:
-        self.position = position
-        self.intensity = intensity
+        self.position = checked_point("position", position)
+        self.intensity = checked_color("intensity", intensity, RADIANCE)
 
     def sample(self, p: Vec3) -> LightSample | None:
         """The light seen from p: the unit direction from p toward the light, the

@@ -11,6 +11,7 @@ import math
 from collections.abc import Sequence
 
 from .hit_info import HitInfo
+from .io.values import ANGLE, checked, checked_point, checked_scales, checked_vector, point
 from .ray import Ray
 from .triangle import Triangle
 from .vec3 import Vec3, dot, unit_vector
@@ -73,9 +74,9 @@ class Transform:
         rotate: Vec3 = Vec3(0.0, 0.0, 0.0),
         scale: Vec3 = Vec3(1.0, 1.0, 1.0),
     ) -> None:
-        if not all(math.isfinite(s) and s != 0.0 for s in scale):
-            raise ValueError(f"scale must be finite and non-zero on every axis, found {scale}")
-        self.translate, self.scale = translate, scale
+        self.translate = checked_point("translate", translate)
+        self.scale = checked_scales("scale", scale)
+        rotate = checked_vector("rotate", rotate, ANGLE)
         rows = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
         for axis, degrees in enumerate(rotate):
             rows = _matmul(_rotation(axis, math.radians(degrees)), rows)
@@ -136,6 +137,8 @@ class Mesh:
     ) -> None:
         transform = transform or Transform()
         points = [transform.point(Vec3(*p)) for p in positions]
+        for k, p in enumerate(points):
+            checked(f"vertex {k + 1} (after the transform)", point, p.tolist())
         shading = [transform.normal(Vec3(*n)) for n in normals]
         self.triangles: list[Triangle] = []
         self.skipped = 0

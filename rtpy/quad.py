@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import math
-
 from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import FlatShape
+from .io.values import MIN_AREA, checked_edge, checked_point
 from .ray import Ray
 from .vec3 import Vec3, cross, dot
 
@@ -15,12 +14,15 @@ class Quad(FlatShape):
     """Front face normal = normalize(u x v); surface coordinates (u, v) = (a, b)."""
 
     def __init__(self, q: Vec3, u: Vec3, v: Vec3, material) -> None:
+        q = checked_point("q", q)
+        u = checked_edge("u", u)
+        v = checked_edge("v", v)
         n = cross(u, v)
         n_len = n.length()
-        if not math.isfinite(n_len):
-            raise ValueError("quad is too large: the area |u x v| overflows")
-        if not n_len > 0.0:
-            raise ValueError("quad is degenerate: u and v are parallel or zero")
+        if not n_len >= MIN_AREA:
+            raise ValueError(
+                f"quad is degenerate: u and v are parallel (|u x v| = {n_len:.3g} < {MIN_AREA:g})"
+            )
         self.q, self.u, self.v = q, u, v
         self.material = material
         self.normal = n / n_len

@@ -15,12 +15,14 @@ from dataclasses import dataclass, fields, replace
 from typing import Any
 
 from .io.values import (
+    GAMMA,
     NON_NEGATIVE,
-    POSITIVE,
     RADIANCE,
+    SEED,
     Invalid,
     Range,
     boolean,
+    components,
     describe,
     integer,
     is_number,
@@ -118,9 +120,7 @@ class Setting:
                     what = f'a number {self.range.text()} or "srgb"'
                     raise Invalid(f"expected {what}, found {describe(value)}", wrong_type=True)
                 return number(value, self.range)
-            if isinstance(value, Color):
-                value = value.tolist()
-            return Color(*triple(value, self.range))
+            return Color(*triple(components(value), self.range))
         except Invalid as e:
             error = SettingTypeError if e.wrong_type else SettingValueError
             raise error(self.name, e.detail, e.suggestion) from None
@@ -172,7 +172,7 @@ SETTINGS: dict[str, Setting] = {
             "segment index after which paths may end at random; 0 = off",
             NON_NEGATIVE,
         ),
-        Setting("seed", "int", 0, "random seed", NON_NEGATIVE, flag=True),
+        Setting("seed", "int", 0, "random seed", SEED, flag=True),
         Setting(
             "background",
             "color",
@@ -194,7 +194,7 @@ SETTINGS: dict[str, Setting] = {
             2.0,
             "display transform of 8-bit output: a number > 0, x^(1/gamma) (the course's "
             '2.0), or "srgb", the sRGB curve; a PNG records which (gAMA or sRGB chunk)',
-            POSITIVE,
+            GAMMA,
             choices=("srgb",),
         ),
         Setting(

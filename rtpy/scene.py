@@ -3,22 +3,20 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import Any
 
 from .bvh import BVH
+from .camera import Camera
+from .environment import Environment
 from .hit_info import HitInfo
 from .hittable import Hittable
 from .interval import Interval
+from .io.values import checked, string
 from .light import AreaLight, Light, PointLight
 from .ray import Ray
+from .render_settings import SETTINGS, RenderSettings
 from .vec3 import Color
-
-if TYPE_CHECKING:
-    from pathlib import Path
-
-    from .camera import Camera
-    from .environment import Environment
-    from .render_settings import RenderSettings
 
 
 class Scene:
@@ -55,14 +53,14 @@ class Scene:
         name: str = "scene",
         environment: Environment | None = None,
     ) -> None:
-        self.objects: list[Hittable] = list(objects or [])
-        self.point_lights: list[PointLight] = list(point_lights or [])
-        self.background = background
-        self.sky = sky
-        self.camera = camera
-        self.settings = settings
-        self.name = name
-        self.environment = environment
+        self.objects: list[Hittable] = _items("objects", objects, Hittable)
+        self.point_lights: list[PointLight] = _items("point_lights", point_lights, Light)
+        self.background = SETTINGS["background"].check(background)
+        self.sky = SETTINGS["sky"].check(sky)
+        self.camera = _optional("camera", camera, Camera)
+        self.settings = _optional("settings", settings, RenderSettings)
+        self.name = checked("name", string, name)
+        self.environment = _optional("environment", environment, Environment)
         self.files: tuple[Path, ...] = ()
         self.area_lights: list[AreaLight] = []
         self.lights: list[Light] = []
@@ -163,3 +161,21 @@ class Scene:
         # direction's y component.
         a = 0.5 * (direction.e1 / math.sqrt(direction.length_squared()) + 1.0)
         return Color(1.0 - 0.5 * a, 1.0 - 0.3 * a, 1.0)
+
+
+def _items(name: str, items: Any, kind: type) -> list:
+    """A list of the items (None: empty), or TypeError naming the parameter."""
+    items = list(items or [])
+    for k, item in enumerate(items):
+        if not isinstance(item, kind):
+            found = type(item).__name__
+            raise TypeError(f"{name}[{k}]: expected a {kind.__name__}, found a {found}")
+    return items
+
+
+def _optional(name: str, value: Any, kind: type) -> Any:
+    """value, None or a kind, or TypeError naming the parameter."""
+    if value is not None and not isinstance(value, kind):
+        found = type(value).__name__
+        raise TypeError(f"{name}: expected a {kind.__name__} or None, found a {found}")
+    return value

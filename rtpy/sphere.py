@@ -7,6 +7,7 @@ import math
 from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import Hittable
+from .io.values import LENGTH, checked_number, checked_point
 from .onb import local_to_world
 from .ray import Ray
 from .sampling import uniform_sphere
@@ -15,10 +16,8 @@ from .vec3 import Vec3, dot, unit_vector
 
 class Sphere(Hittable):
     def __init__(self, center: Vec3, radius: float, material) -> None:
-        if not radius > 0.0:
-            raise ValueError(f"sphere radius must be > 0, got {radius}")
-        self.center = center
-        self.radius = radius
+        self.center = checked_point("center", center)
+        self.radius = checked_number("radius", radius, LENGTH)
         self.material = material
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .hit_info import HitInfo
+from .io.values import LENGTH, UNIT, checked_color, checked_number
 from .vec3 import Color
 
 if TYPE_CHECKING:
@@ -22,7 +23,7 @@ class SolidColor(Texture):
     """The same colour everywhere."""
 
     def __init__(self, color: Color) -> None:
-        self.color = color
+        self.color = checked_color("color", color)
 
     def value(self, hit: HitInfo) -> Color:
         return self.color
@@ -34,11 +35,9 @@ class CheckerTexture(Texture):
     Solid cells, so it needs no (u, v)."""
 
     def __init__(self, scale: float, even: Color, odd: Color) -> None:
-        if not scale > 0.0:
-            raise ValueError(f"checker scale must be > 0, got {scale}")
-        self.inv_scale = 1.0 / scale
-        self.even = even
-        self.odd = odd
+        self.inv_scale = 1.0 / checked_number("scale", scale, LENGTH)
+        self.even = checked_color("even", even)
+        self.odd = checked_color("odd", odd)
 
     def value(self, hit: HitInfo) -> Color:
         # BEGIN SOLUTION week07: 3-D checker cells
@@ -66,6 +65,8 @@ class ImageTexture(Texture):
         pixels = np.asarray(pixels, dtype=np.float64)
         if pixels.ndim != 3 or pixels.shape[2] != 3 or pixels.shape[0] < 1 or pixels.shape[1] < 1:
             raise ValueError(f"image texture needs an (H, W, 3) array, got shape {pixels.shape}")
+        if not np.all((pixels >= 0.0) & (pixels <= 1.0)):  # also refuses NaN
+            raise ValueError(f"pixels: expected linear colours, each component {UNIT.text()}")
         self.pixels = pixels  # linear RGB, row 0 at the top
         self.height, self.width = pixels.shape[:2]
         # Rows as lists of Colors: the scalar renderer reads one texel at a time,

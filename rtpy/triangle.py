@@ -7,6 +7,7 @@ import math
 from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import FlatShape
+from .io.values import MIN_AREA, checked_point
 from .ray import Ray
 from .vec3 import Vec3, cross, dot
 
@@ -27,15 +28,16 @@ class Triangle(FlatShape):
     """
 
     def __init__(self, a: Vec3, b: Vec3, c: Vec3, material) -> None:
+        a, b, c = checked_point("a", a), checked_point("b", b), checked_point("c", c)
         self.a, self.b, self.c = a, b, c
         self.e1 = b - a
         self.e2 = c - a
         n = cross(self.e1, self.e2)
-        n_len = n.length()
-        if not math.isfinite(n_len):
-            raise ValueError("triangle is too large: its area overflows")
-        if not n_len > 0.0:
-            raise ValueError("triangle is degenerate: its vertices are collinear")
+        n_len = n.length()  # twice the area
+        if not n_len >= MIN_AREA:
+            raise ValueError(
+                f"triangle a, b, c is degenerate: twice its area is {n_len:.3g} < {MIN_AREA:g}"
+            )
         self.normal = n / n_len
         self.material = material
         self._area = 0.5 * n_len

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rtpy.interval import Interval
+from rtpy.io.values import MIN_AREA
 from rtpy.materials import Lambertian
 from rtpy.quad import Quad
 from rtpy.ray import Ray
@@ -137,6 +138,13 @@ def test_oblique_quad_miss_outside(a, b):
 def test_degenerate_quad_raises(u, v):
     with pytest.raises(ValueError):
         Quad(V(0, 0, 0), V(*u), V(*v), MAT)
+
+
+def test_a_quad_of_area_below_min_area_is_degenerate():
+    # u x v = (0, 0, t): the area is t exactly, and both edges are long enough.
+    assert Quad(V(0, 0, 0), V(1, 0, 0), V(1, MIN_AREA, 0), MAT)._area == MIN_AREA
+    with pytest.raises(ValueError, match="quad is degenerate"):
+        Quad(V(0, 0, 0), V(1, 0, 0), V(1, MIN_AREA / 2, 0), MAT)
 
 
 def test_area():

@@ -52,7 +52,9 @@ def test_wrong_types_are_type_errors_and_wrong_values_value_errors_naming_the_se
         RenderSettings(spp=0)
     with pytest.raises(ValueError, match=r"^integrator: .* — did you mean 'path'\?$"):
         RenderSettings(integrator="pth")
-    with pytest.raises(TypeError, match=r'^gamma: expected a number > 0 or "srgb", found true$'):
+    with pytest.raises(
+        TypeError, match=r'^gamma: expected a number in \(0, 100\] or "srgb", found true$'
+    ):
         RenderSettings(gamma=True)
     with pytest.raises(ValueError, match=r'^gamma: expected one of "srgb", found .*"linear"$'):
         RenderSettings(gamma="linear")

@@ -119,6 +119,14 @@ def test_image_rejects_bad_shapes(shape):
         ImageTexture(np.zeros(shape))
 
 
+@pytest.mark.parametrize("value", [-0.1, 1.5, np.nan, np.inf])
+def test_image_refuses_pixels_outside_0_1(value):
+    pixels = np.full((2, 2, 3), 0.5)
+    pixels[1, 0, 2] = value
+    with pytest.raises(ValueError, match=r"^pixels: .*in \[0, 1\]"):
+        ImageTexture(pixels)
+
+
 def srgb_decode(value: int) -> float:
     c = value / 255.0
     return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4

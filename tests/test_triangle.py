@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rtpy.interval import Interval
+from rtpy.io.values import MIN_AREA
 from rtpy.materials import Lambertian
 from rtpy.ray import Ray
 from rtpy.testing import chi2_sf
@@ -127,6 +128,13 @@ def test_general_triangle_miss_outside(wb, wc):
 def test_degenerate_triangle_raises(a, b, c):
     with pytest.raises(ValueError):
         Triangle(V(*a), V(*b), V(*c), MAT)
+
+
+def test_a_triangle_of_twice_its_area_below_min_area_is_degenerate():
+    # (b - a) x (c - a) = (0, 0, t): twice the area is t exactly.
+    assert Triangle(V(0, 0, 0), V(1, 0, 0), V(1, MIN_AREA, 0), MAT)._area == MIN_AREA / 2
+    with pytest.raises(ValueError, match="triangle a, b, c is degenerate"):
+        Triangle(V(0, 0, 0), V(1, 0, 0), V(1, MIN_AREA / 2, 0), MAT)
 
 
 def test_area():

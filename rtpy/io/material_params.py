@@ -14,25 +14,27 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..vec3 import Vec3
-from .values import NON_NEGATIVE, POSITIVE, RADIANCE, UNIT, Range
+from .values import EXPONENT, FUZZ, IOR, RADIANCE, ROUGHNESS, SIGMA, UNIT, Range
 
 __all__ = ["MATERIAL_RANGES", "Param", "material_parameters"]
 
 # Ranges of material parameters by name, for numbers and for each colour component.
-# Constructors may check more; their ValueErrors become SceneErrors too.
+# The scene loader and the materials' constructors (rtpy.materials.material's
+# material_number and material_color) check against these; a constructor's
+# ValueError becomes a SceneError too.
 MATERIAL_RANGES: dict[str, Range] = {
     "albedo": UNIT,
     "f0": UNIT,
     "emit": RADIANCE,
-    "ior": POSITIVE,
-    "fuzz": NON_NEGATIVE,
+    "ior": IOR,
+    "fuzz": FUZZ,
     "kd": UNIT,
     "ks": UNIT,
-    "exponent": NON_NEGATIVE,
-    "roughness": POSITIVE,
-    "alpha_x": POSITIVE,
-    "alpha_y": POSITIVE,
-    "sigma": NON_NEGATIVE,
+    "exponent": EXPONENT,
+    "roughness": ROUGHNESS,
+    "alpha_x": ROUGHNESS,
+    "alpha_y": ROUGHNESS,
+    "sigma": SIGMA,
     "tint": UNIT,
 }
 

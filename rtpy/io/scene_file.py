@@ -47,13 +47,24 @@ from ..scene import Scene
 from ..sphere import Sphere
 from ..texture import CheckerTexture, ImageTexture, SolidColor, Texture
 from ..triangle import Triangle
-from ..vec3 import Color, Vec3, cross
+from ..vec3 import Color, Vec3
 from . import values
 from .material_params import MATERIAL_RANGES, Param, material_parameters
 from .obj import ObjError, read_obj
 from .scene_tables import SceneError, SceneWarning, TableReader
 from .toml_lines import TomlLines, Where, quote_key
-from .values import ANY, MAX_RADIANCE, POSITIVE, RADIANCE, UNIT, Range, describe, suggest
+from .values import (
+    ANY,
+    ASPECT_RATIO,
+    DEFOCUS_ANGLE,
+    LENGTH,
+    MAX_RADIANCE,
+    RADIANCE,
+    UNIT,
+    VFOV,
+    describe,
+    suggest,
+)
 
 __all__ = [
     "MAX_HEIGHT",
@@ -149,14 +160,12 @@ class _Loader(TableReader):
         self.check_keys(w, t, CAMERA_KEYS)
         look_from = self.vec3(w, "look_from", t.get("look_from", [0, 0, 0]))
         look_at = self.vec3(w, "look_at", t.get("look_at", [0, 0, -1]))
-        vup = self.vec3(w, "vup", t.get("vup", [0, 1, 0]))
-        vfov = self.number(w, "vfov", t.get("vfov", 90), Range(0, 180, True, True))
+        vup = self.vec3(w, "vup", t.get("vup", [0, 1, 0]), values.edge)
+        vfov = self.number(w, "vfov", t.get("vfov", 90), VFOV)
         aspect = self.aspect_ratio(w, t.get("aspect_ratio", 16.0 / 9.0))
         width = self.setting(w, "width", t.get("width", SETTINGS["width"].default))
-        defocus = self.number(
-            w, "defocus_angle", t.get("defocus_angle", 0), Range(0, 180, False, True)
-        )
-        focus = self.number(w, "focus_distance", t.get("focus_distance", 10), POSITIVE)
+        defocus = self.number(w, "defocus_angle", t.get("defocus_angle", 0), DEFOCUS_ANGLE)
+        focus = self.number(w, "focus_distance", t.get("focus_distance", 10), LENGTH)
 
         height = width / aspect
         if not height < MAX_HEIGHT + 1:
@@ -167,29 +176,10 @@ class _Loader(TableReader):
                 f"{values.num_text(int(height)) if math.isfinite(height) else 'inf'} pixels; "
                 f"the most is {MAX_HEIGHT}",
             )
-        view = look_from - look_at
-        if view.is_black():
-            raise self.fail(
-                w,
-                "look_at",
-                f"look_at must differ from look_from (both are {describe(list(look_from))})",
-            )
-        if not math.isfinite(view.length()):
-            raise self.fail(w, "look_at", "look_from and look_at are too far apart")
-        if vup.is_black() or not math.isfinite(vup.length()):
-            raise self.fail(w, "vup", f"expected a non-zero up vector, found {describe(list(vup))}")
-        side = cross(vup, view / view.length())
-        if not side.length() >= 1e-9 * vup.length():
-            raise self.fail(
-                w,
-                "vup",
-                f"vup {describe(list(vup))} is parallel to the view direction "
-                "(look_at - look_from); choose an up vector across it",
-            )
         try:
             return Camera(look_from, look_at, vup, vfov, aspect, width, defocus, focus)
         except (ValueError, ArithmeticError) as e:
-            raise self.fail(w, _guess_key(str(e), CAMERA_KEYS), str(e)) from None
+            raise self.fail(w, *_blame(str(e), CAMERA_KEYS)) from None
 
     def aspect_ratio(self, w: Where, v: Any) -> float:
         what = 'a number > 0 or a string "W:H" (such as "16:9")'
@@ -203,13 +193,10 @@ class _Loader(TableReader):
                     pass
             if not (math.isfinite(a) and math.isfinite(b) and a > 0 and b > 0):
                 raise self.expected(w, "aspect_ratio", what, v)
-            ratio = a / b
-            if not (math.isfinite(ratio) and ratio > 0):
-                raise self.expected(w, "aspect_ratio", what, v)
-            return ratio
-        if not values.is_number(v):
+            v = a / b
+        elif not values.is_number(v):
             raise self.expected(w, "aspect_ratio", what, v)
-        return self.number(w, "aspect_ratio", v, POSITIVE)
+        return self.number(w, "aspect_ratio", v, ASPECT_RATIO)
 
     def render(self, t: dict) -> tuple[RenderSettings, Color, bool]:
         """The settings, the background and sky of a [render] table."""
@@ -226,7 +213,7 @@ class _Loader(TableReader):
         if kind == "solid":
             return SolidColor(self.color(w, "color", self.require(w, t, "color", "a colour"), UNIT))
         if kind == "checker":
-            scale = self.number(w, "scale", t.get("scale", 1), POSITIVE)
+            scale = self.number(w, "scale", t.get("scale", 1), LENGTH)
             even = self.color(w, "even", self.require(w, t, "even", "a colour"), UNIT)
             odd = self.color(w, "odd", self.require(w, t, "odd", "a colour"), UNIT)
             return CheckerTexture(scale, even, odd)
@@ -275,7 +262,7 @@ class _Loader(TableReader):
         try:
             return cls(**kwargs)
         except (ValueError, TypeError, ArithmeticError) as e:
-            raise self.fail(w, _guess_key(str(e), params), str(e)) from None
+            raise self.fail(w, *_blame(str(e), params)) from None
 
     def material_value(self, w: Where, p: Param, v: Any) -> Any:
         rng = MATERIAL_RANGES.get(p.name, ANY)
@@ -333,12 +320,13 @@ class _Loader(TableReader):
         self.check_keys(w, t, OBJECT_KEYS[kind], f'type "{kind}"')
 
         def point(key: str) -> Vec3:
-            return self.vec3(w, key, self.require(w, t, key, "an array of 3 numbers"))
+            check = values.edge if key in ("u", "v") else values.point
+            return self.vec3(w, key, self.require(w, t, key, "an array of 3 numbers"), check)
 
         if kind == "sphere":
             center = point("center")
-            radius = self.require(w, t, "radius", "a number > 0")
-            radius = self.number(w, "radius", radius, POSITIVE)
+            radius = self.require(w, t, "radius", f"a number {LENGTH.text()}")
+            radius = self.number(w, "radius", radius, LENGTH)
             material = self.reference(w, t)
             return self.build(w, "radius", lambda m: Sphere(center, radius, m), material)
         # A quad (q, u, v) or a triangle (a, b, c); a degenerate one is blamed on u or a.
@@ -359,17 +347,13 @@ class _Loader(TableReader):
         if not isinstance(rel, str) or not rel:
             raise self.expected(w, "path", what, rel)
         translate = self.vec3(w, "translate", t.get("translate", [0, 0, 0]))
-        rotate = self.vec3(w, "rotate", t.get("rotate", [0, 0, 0]))
+        rotate = self.vec3(w, "rotate", t.get("rotate", [0, 0, 0]), values.angles)
         scale = t.get("scale", 1)
         if values.is_number(scale):
             scale = [scale] * 3
         elif not isinstance(scale, list):
-            raise self.expected(w, "scale", "a number or an array of 3 numbers, none 0", scale)
-        scale = self.vec3(w, "scale", scale)
-        if any(s == 0.0 for s in scale):
-            raise self.fail(
-                w, "scale", f"a scale of 0 flattens the mesh, found {describe(list(scale))}"
-            )
+            raise self.expected(w, "scale", "a number or an array of 3 numbers", scale)
+        scale = self.vec3(w, "scale", scale, values.scales)
         material = self.reference(w, t)
         resolved = self.path.parent / rel
         self.files.append(resolved)
@@ -421,18 +405,24 @@ class _Loader(TableReader):
         intensity = self.color(
             w,
             "intensity",
-            self.require(w, t, "intensity", f"a colour, each component in [0, {MAX_RADIANCE:g}]"),
+            self.require(w, t, "intensity", f"a colour, each component {RADIANCE.text()}"),
             RADIANCE,
         )
         return PointLight(position, intensity)
 
 
-def _guess_key(message: str, keys: Iterable[str]) -> str | None:
-    """The key a constructor's error message talks about, if it names one."""
+def _blame(message: str, keys: Iterable[str]) -> tuple[str | None, str]:
+    """The key a constructor's error message talks about, if it names one, and the
+    message: a parameter that starts it ("key: ...") is that key, and is then left
+    out of the message (the SceneError names it)."""
+    keys = list(keys)
+    first = re.match(r"(\w+): ", message)
+    if first and first.group(1) in keys:
+        return first.group(1), message[first.end() :]
     for key in keys:
         if re.search(rf"\b{re.escape(key)}\b", message):
-            return key
-    return None
+            return key, message
+    return None, message
 
 
 # --------------------------------------------------------------------------- entry points

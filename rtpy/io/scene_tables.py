@@ -148,8 +148,9 @@ class TableReader:
     def string(self, where: Where, key: str, v: Any, choices: tuple[str, ...] = ()) -> str:
         return self.checked(where, key, values.string, v, choices)
 
-    def vec3(self, where: Where, key: str, v: Any) -> Vec3:
-        return Vec3(*self.checked(where, key, values.triple, v))
+    def vec3(self, where: Where, key: str, v: Any, check: Callable = values.point) -> Vec3:
+        """A vector checked by check (a point, an edge, scales, ...)."""
+        return Vec3(*self.checked(where, key, check, v))
 
     def color(self, where: Where, key: str, v: Any, rng: Range = ANY) -> Color:
         return Color(*self.checked(where, key, values.triple, v, rng))

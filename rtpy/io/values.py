@@ -6,33 +6,72 @@ was found in the words of a scene file ("expected an integer in [1, 1000000],
 found 0"); the caller adds where (file, table and key, or the parameter name).
 Booleans are not numbers, NaN and infinities are refused, and a float is not
 taken for an integer.
+
+The ranges of the scene-file contract are named here once (COORDINATE, LENGTH,
+RADIANCE, ...); the scene loader and the constructors of the Python API check
+against the same ones. The Python API's checks (checked_number, checked_point,
+checked_color, ...) raise TypeError for a value of the wrong type and ValueError for
+one out of range, both naming the parameter.
 """
 
 from __future__ import annotations
 
 import difflib
+import functools
 import json
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from numbers import Integral, Real
 from typing import Any
 
+from ..vec3 import Color, Vec3
+
 __all__ = [
+    "ANGLE",
     "ANY",
+    "ASPECT_RATIO",
+    "COORDINATE",
+    "DEFOCUS_ANGLE",
+    "EXPONENT",
+    "FUZZ",
+    "GAMMA",
+    "IOR",
+    "LENGTH",
+    "MAX_COORDINATE",
+    "MAX_LENGTH",
     "MAX_RADIANCE",
+    "MIN_AREA",
+    "MIN_LENGTH",
+    "MIN_SINE",
     "NON_NEGATIVE",
     "POSITIVE",
     "RADIANCE",
+    "ROUGHNESS",
+    "SEED",
+    "SIGMA",
     "UNIT",
+    "VFOV",
     "Invalid",
     "Range",
+    "angles",
     "boolean",
+    "checked",
+    "checked_color",
+    "checked_edge",
+    "checked_number",
+    "checked_point",
+    "checked_scales",
+    "checked_vector",
+    "components",
     "describe",
+    "edge",
     "integer",
     "is_number",
     "num_text",
     "number",
+    "point",
+    "scales",
     "string",
     "suggest",
     "triple",
@@ -61,6 +100,9 @@ def suggest(word: str, choices: Iterable[str]) -> str | None:
 
 
 def is_number(v: Any) -> bool:
+    kind = type(v)
+    if kind is float or kind is int:  # the common case, without the abstract class
+        return True
     return isinstance(v, Real) and not isinstance(v, bool)
 
 
@@ -121,6 +163,7 @@ class Range:
             return False
         return not (self.hi is not None and (x >= self.hi if self.hi_open else x > self.hi))
 
+    @functools.cache  # noqa: B019 (ranges are few and live as long as the program)
     def text(self) -> str:
         lo = None if self.lo is None else num_text(self.lo)
         hi = None if self.hi is None else num_text(self.hi)
@@ -136,12 +179,32 @@ class Range:
 ANY = Range()
 POSITIVE = Range(0, None, lo_open=True)
 NON_NEGATIVE = Range(0)
-# Radiance (emit, intensity, background) and the kd / ks weights are bounded so that
-# no sum of samples can overflow: a path's weight grows at most about 2x a bounce
-# with kd, ks <= 1, so even 10^6 samples of 500 bounces stay below 1e30 * 1e157.
-MAX_RADIANCE = 1e30
-RADIANCE = Range(0, MAX_RADIANCE)
-UNIT = Range(0, 1)
+UNIT = Range(0, 1)  # reflectances: albedo, kd, ks, f0, tint
+
+# The contract's ranges. Inside them no product a render forms overflows float64 and
+# the linear image fits float32 (EXR), with margin: a scene spans at most about 1e6
+# units and resolves about 1e-6, and radiance stays below 1e9.
+MAX_COORDINATE = 1e6
+MIN_LENGTH, MAX_LENGTH = 1e-6, 1e6
+COORDINATE = Range(-MAX_COORDINATE, MAX_COORDINATE)  # each component of a point
+LENGTH = Range(MIN_LENGTH, MAX_LENGTH)  # radii, edges, distances, scales
+# A quad with |u x v| below this, or a triangle with twice its area below it, is
+# degenerate; and a camera's vup must make at least this sine with the view.
+MIN_AREA = 1e-12
+MIN_SINE = 1e-6
+MAX_RADIANCE = 1e9
+RADIANCE = Range(0, MAX_RADIANCE)  # emit, background, point-light intensity
+VFOV = Range(1e-3, 179)  # degrees
+DEFOCUS_ANGLE = Range(0, 179)  # degrees
+ASPECT_RATIO = Range(1e-6, 1e6)
+ANGLE = Range(-360, 360)  # a mesh's rotation about each axis, degrees
+EXPONENT = Range(0, 1e6)  # Phong and Blinn-Phong
+ROUGHNESS = Range(1e-4, 1)  # roughness, alpha_x, alpha_y
+IOR = Range(1e-2, 100)
+FUZZ = Range(0, 1e6)
+SIGMA = Range(0, 90, hi_open=True)  # Oren-Nayar, degrees: tan(sigma) at 90 is infinite
+GAMMA = Range(0, 100, lo_open=True)
+SEED = Range(0, 2**63 - 1)
 
 
 # --- the checks ------------------------------------------------------------------------------
@@ -220,3 +283,97 @@ def triple(v: Any, rng: Range = ANY) -> tuple[float, float, float]:
             )
         out.append(f)
     return (out[0], out[1], out[2])
+
+
+def point(v: Any) -> tuple[float, float, float]:
+    """A point: 3 numbers, each in COORDINATE."""
+    return triple(v, COORDINATE)
+
+
+def edge(v: Any) -> tuple[float, float, float]:
+    """A vector whose length lies in LENGTH (a quad's edge, a camera's vup), each
+    component in COORDINATE."""
+    x, y, z = triple(v, COORDINATE)
+    length = math.sqrt(x * x + y * y + z * z)
+    if length not in LENGTH:
+        raise Invalid(
+            f"expected a vector of length {LENGTH.text()}, found {describe(v)} "
+            f"(length {num_text(length)})"
+        )
+    return (x, y, z)
+
+
+def angles(v: Any) -> tuple[float, float, float]:
+    """Rotation angles about x, y, z in degrees, each in ANGLE."""
+    return triple(v, ANGLE)
+
+
+def scales(v: Any) -> tuple[float, float, float]:
+    """Scale factors along x, y, z: each of size in LENGTH (a negative one mirrors)."""
+    sizes = Range(-MAX_LENGTH, MAX_LENGTH)
+    x, y, z = triple(v, sizes)
+    for i, s in enumerate((x, y, z)):
+        if abs(s) < MIN_LENGTH:
+            raise Invalid(
+                f"expected 3 numbers, each in {sizes.text()[3:]} and of size >= "
+                f"{num_text(MIN_LENGTH)}, found {describe(v)} (component {i + 1} is {describe(s)})"
+            )
+    return (x, y, z)
+
+
+# --- the Python API's checks -------------------------------------------------------------------
+
+
+def checked(name: str, check: Callable[..., Any], v: Any, *args: Any) -> Any:
+    """check(v, *args) for a parameter of the Python API: its Invalid as a TypeError
+    (wrong type) or ValueError (out of range) that names the parameter."""
+    try:
+        return check(v, *args)
+    except Invalid as e:
+        error = TypeError if e.wrong_type else ValueError
+        raise error(f"{name}: {e.detail}") from None
+
+
+def checked_number(name: str, v: Any, rng: Range = ANY) -> float:
+    """A finite number in rng, as a float."""
+    return checked(name, number, v, rng)
+
+
+def components(v: Any) -> Any:
+    """What triple checks: a Vec3 or a numpy array of shape (3,) as a list of its
+    components; anything else as it is."""
+    if isinstance(v, Vec3) or (hasattr(v, "tolist") and getattr(v, "ndim", None) == 1):
+        return list(v.tolist())
+    return v
+
+
+def _checked_as(cls: type, name: str, check: Callable[..., Any], v: Any, *args: Any) -> Any:
+    """v itself when it is a cls already, else a new cls of its three numbers; either
+    after check(its components, *args) (TypeError or ValueError naming the parameter)."""
+    xyz = checked(name, check, components(v), *args)
+    return v if type(v) is cls else cls(*xyz)
+
+
+def checked_vector(name: str, v: Any, rng: Range = ANY) -> Vec3:
+    """A Vec3 from a Vec3 or 3 numbers (a tuple, a list, a numpy array), each in rng."""
+    return _checked_as(Vec3, name, triple, v, rng)
+
+
+def checked_point(name: str, v: Any) -> Vec3:
+    """A point whose components lie in COORDINATE."""
+    return _checked_as(Vec3, name, point, v)
+
+
+def checked_edge(name: str, v: Any) -> Vec3:
+    """A vector whose length lies in LENGTH (see edge)."""
+    return _checked_as(Vec3, name, edge, v)
+
+
+def checked_scales(name: str, v: Any) -> Vec3:
+    """Scale factors along x, y, z (see scales)."""
+    return _checked_as(Vec3, name, scales, v)
+
+
+def checked_color(name: str, v: Any, rng: Range = UNIT) -> Color:
+    """A Color from a Color or 3 numbers, each in rng (UNIT for reflectances)."""
+    return _checked_as(Color, name, triple, v, rng)

@@ -50,6 +50,7 @@ import math
 from typing import Literal
 
 from ..hit_info import HitInfo
+from ..io.values import checked, string
 from ..onb import ONB
 from ..ray import Ray
 from ..sampling import generator, random_cosine_direction
@@ -57,12 +58,11 @@ from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, Vec3, cross, dot, halfvector, reflect
 from .glossy import INV_PI, diffuse_probability, mixture_pdf, reflected_density, weighted_sample
-from .material import Material, as_texture, check_strengths
+from .material import Material, as_texture, check_strengths, material_color, material_number
 
 INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
 
 DISTRIBUTIONS = ("ggx", "beckmann")
-MAX_ROUGHNESS = 1.0
 # Widths below this are computed as this (a mirror to every practical purpose):
 # D's peak 1 / (pi alpha^2) would overflow for alpha near 1e-154, and long
 # before that single rays would carry absurd weights.
@@ -115,25 +115,12 @@ class CookTorrance(Material):
     ) -> None:
         self.albedo = as_texture(albedo)
         self.kd, self.ks = check_strengths(kd, ks)
-        if not (isinstance(roughness, int | float) and 0.0 < roughness <= MAX_ROUGHNESS):
-            raise ValueError(
-                f"roughness must be a number in (0, {MAX_ROUGHNESS:g}], got {roughness!r}"
-            )
-        if distribution not in DISTRIBUTIONS:
-            raise ValueError(f'distribution must be "ggx" or "beckmann", got {distribution!r}')
-        if not (isinstance(ior, int | float) and ior > 0.0 and math.isfinite(ior)):
-            raise ValueError(f"ior must be a finite number > 0, got {ior!r}")
-        if f0 is not None:
-            components = list(f0)
-            if len(components) != 3 or not all(
-                isinstance(c, int | float) and 0.0 <= c <= 1.0 for c in components
-            ):
-                raise ValueError(f"f0 components must lie in [0, 1], got {components!r}")
-            f0 = Color(*(float(c) for c in components))
-        self.roughness = float(roughness)
+        self.roughness = material_number("roughness", roughness)
         self.alpha = max(self.roughness, MIN_ALPHA)
-        self.distribution = distribution
-        self.ior = float(ior)
+        self.distribution = checked("distribution", string, distribution, DISTRIBUTIONS)
+        self.ior = material_number("ior", ior)
+        if f0 is not None:
+            f0 = material_color("f0", f0)
         if f0 is None:
             r0 = f0_from_ior(self.ior)
             f0 = Color(r0, r0, r0)

@@ -10,7 +10,7 @@ from ..sampling import random_double
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import Color, dot, reflect, refract
-from .material import Material, as_texture
+from .material import Material, as_texture, material_number
 
 
 def schlick(cosine: float, ior_ratio: float) -> float:
@@ -35,9 +35,7 @@ class Dielectric(Material):
     is_specular = True
 
     def __init__(self, ior: float = 1.5, albedo: Color | Texture = Color(1.0, 1.0, 1.0)) -> None:
-        if not ior > 0.0:
-            raise ValueError(f"dielectric ior must be > 0, got {ior}")
-        self.ior = ior
+        self.ior = material_number("ior", ior)
         self.albedo = as_texture(albedo)
 
     def _split(self, ray_in: Ray, hit: HitInfo) -> tuple[float, Ray, Ray | None]:

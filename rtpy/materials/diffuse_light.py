@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from ..hit_info import HitInfo
+from ..io.values import boolean, checked
 from ..vec3 import BLACK, Color
-from .material import Material
+from .material import Material, material_color
 
 
 class DiffuseLight(Material):
@@ -15,8 +16,8 @@ class DiffuseLight(Material):
     is_emitter = True
 
     def __init__(self, emit: Color, two_sided: bool = False) -> None:
-        self.emit = emit
-        self.two_sided = two_sided
+        self.emit = material_color("emit", emit)
+        self.two_sided = checked("two_sided", boolean, two_sided)
 
     def emitting(self, hit: HitInfo) -> Color:
         if hit.front_face or self.two_sided:

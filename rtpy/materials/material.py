@@ -22,25 +22,37 @@ scattering() returns and never sample lights at them.
 
 from __future__ import annotations
 
-import math
-
 from ..hit_info import HitInfo
+from ..io.material_params import MATERIAL_RANGES
+from ..io.values import checked_color, checked_number
 from ..ray import Ray
 from ..scatter_info import ScatterInfo
 from ..texture import SolidColor, Texture
 from ..vec3 import BLACK, WHITE, Color
 
 
-def as_texture(albedo: Color | Texture) -> Texture:
-    return albedo if isinstance(albedo, Texture) else SolidColor(albedo)
+def material_number(name: str, value: float) -> float:
+    """A material's number parameter as a float, in its range (MATERIAL_RANGES);
+    TypeError or ValueError naming it."""
+    return checked_number(name, value, MATERIAL_RANGES[name])
+
+
+def material_color(name: str, value: Color) -> Color:
+    """A material's colour parameter (a Color or 3 numbers), each component in its
+    range (MATERIAL_RANGES); TypeError or ValueError naming it."""
+    return checked_color(name, value, MATERIAL_RANGES[name])
+
+
+def as_texture(albedo: Color | Texture, name: str = "albedo") -> Texture:
+    """A texture as it is, a colour (a Color or 3 numbers in [0, 1]) as a SolidColor."""
+    if isinstance(albedo, Texture):
+        return albedo
+    return SolidColor(material_color(name, albedo))
 
 
 def check_strengths(kd: float, ks: float) -> tuple[float, float]:
-    """(kd, ks) as floats, or ValueError unless both are finite numbers >= 0."""
-    for name, value in (("kd", kd), ("ks", ks)):
-        if not (isinstance(value, int | float) and value >= 0.0 and math.isfinite(value)):
-            raise ValueError(f"{name} must be a finite number >= 0, got {value}")
-    return float(kd), float(ks)
+    """(kd, ks) as floats, or ValueError unless both lie in [0, 1]."""
+    return material_number("kd", kd), material_number("ks", ks)
 
 
 class Material:

@@ -8,7 +8,7 @@ from ..sampling import random_unit_vector
 from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import Color, dot, reflect, unit_vector
-from .material import Material, as_texture
+from .material import Material, as_texture, material_number
 
 
 class Metal(Material):
@@ -23,10 +23,8 @@ class Metal(Material):
     is_specular = True
 
     def __init__(self, albedo: Color | Texture = Color(0.5, 0.5, 0.5), fuzz: float = 0.0) -> None:
-        if not fuzz >= 0.0:
-            raise ValueError(f"metal fuzz must be >= 0, got {fuzz}")
         self.albedo = as_texture(albedo)
-        self.fuzz = fuzz
+        self.fuzz = material_number("fuzz", fuzz)
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
         # BEGIN SOLUTION week07: reflection plus fuzz * random unit vector

@@ -30,7 +30,7 @@ from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import BLACK, Color, dot
 from .lambertian import Lambertian
-from .material import Material, as_texture
+from .material import Material, as_texture, material_number
 
 INV_PI = 1.0 / math.pi
 
@@ -52,12 +52,8 @@ class OrenNayar(Material):
     """
 
     def __init__(self, albedo: Color | Texture = Color(0.5, 0.5, 0.5), sigma: float = 20.0) -> None:
-        if isinstance(sigma, bool) or not isinstance(sigma, int | float):
-            raise ValueError(f"sigma must be a number of degrees in [0, 90), got {sigma!r}")
-        if not 0.0 <= sigma < 90.0:  # also refuses NaN
-            raise ValueError(f"sigma must be a number of degrees in [0, 90), got {sigma}")
         self.albedo = as_texture(albedo)
-        self.sigma = float(sigma)
+        self.sigma = material_number("sigma", sigma)  # degrees
         s2 = math.radians(self.sigma) ** 2
         self.A = 1.0 - 0.5 * s2 / (s2 + 0.33)
         self.B = 0.45 * s2 / (s2 + 0.09)

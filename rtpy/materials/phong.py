@@ -22,18 +22,15 @@ from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, Vec3, dot, reflect
 from .glossy import INV_PI, diffuse_probability, mixture_pdf, weighted_sample
-from .material import Material, as_texture, check_strengths
+from .material import Material, as_texture, check_strengths, material_number
 
 INV_TWO_PI = 0.5 / math.pi
 
 
 def check_exponent(exponent: float) -> float:
-    """The exponent as a float, or ValueError if it is not a finite number >= 0."""
-    if isinstance(exponent, bool) or not isinstance(exponent, int | float):
-        raise ValueError(f"exponent must be a finite number >= 0, got {exponent!r}")
-    if not (exponent >= 0.0 and math.isfinite(exponent)):
-        raise ValueError(f"exponent must be a finite number >= 0, got {exponent}")
-    return float(exponent)
+    """The exponent as a float in its range (MATERIAL_RANGES), or TypeError or
+    ValueError naming it."""
+    return material_number("exponent", exponent)
 
 
 def sample_cosine_power(exponent: float, r1: float, r2: float) -> Vec3:

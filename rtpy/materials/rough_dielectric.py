@@ -91,7 +91,7 @@ from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, Vec3, dot, halfvector, reflect, refract, unit_vector
 from .cook_torrance import CookTorrance
 from .glossy import MAX_PDF
-from .material import Material, as_texture
+from .material import Material, as_texture, material_number
 
 # An ior closer to 1 than this is computed as 1 +- this (see RoughDielectric).
 MIN_IOR_GAP = 1e-6
@@ -135,8 +135,7 @@ class RoughDielectric(Material):
         distribution: Literal["ggx", "beckmann"] = "ggx",
         tint: Color | Texture = Color(1.0, 1.0, 1.0),
     ) -> None:
-        if not (isinstance(ior, int | float) and ior > 0.0 and math.isfinite(ior)):
-            raise ValueError(f"ior must be a finite number > 0, got {ior!r}")
+        ior = material_number("ior", ior)
         # The facets' D, G1 and sampling are Cook-Torrance's (which checks roughness
         # and distribution).
         self.facets = CookTorrance(kd=0.0, ks=1.0, roughness=roughness, distribution=distribution)
@@ -144,7 +143,7 @@ class RoughDielectric(Material):
         self.roughness = self.facets.roughness
         self.alpha = self.facets.alpha
         self.distribution = distribution
-        self.tint = as_texture(tint)
+        self.tint = as_texture(tint, "tint")
         if abs(self.ior - 1.0) < MIN_IOR_GAP:
             self.inside_ior = 1.0 + math.copysign(MIN_IOR_GAP, self.ior - 1.0)
         else:

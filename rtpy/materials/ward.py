@@ -48,9 +48,8 @@ from ..scatter_info import ScatterInfo
 from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, Vec3, dot, halfvector, reflect
 from .glossy import INV_PI, diffuse_probability, mixture_pdf, reflected_density, weighted_sample
-from .material import Material, as_texture, check_strengths
+from .material import Material, as_texture, check_strengths, material_number
 
-MAX_ALPHA = 1.0
 # Widths below this are computed as this (a mirror to every practical purpose):
 # the lobe's peak 1 / (4 pi alpha_x alpha_y) and the exponent's 1 / alpha^2 would
 # overflow for widths near 1e-154.
@@ -61,12 +60,6 @@ MAX_EXPONENT = 700.0
 # 1 / sqrt(cos cos) finite (at most 1e100) when both directions graze the surface
 # to within 1e-100 radians, and changes nothing anywhere else.
 MIN_COS_PRODUCT = 1e-200
-
-
-def _check_alpha(name: str, value: float) -> float:
-    if not (isinstance(value, int | float) and 0.0 < value <= MAX_ALPHA):
-        raise ValueError(f"{name} must be a number in (0, {MAX_ALPHA:g}], got {value!r}")
-    return float(value)
 
 
 class Ward(Material):
@@ -96,8 +89,8 @@ class Ward(Material):
     ) -> None:
         self.albedo = as_texture(albedo)
         self.kd, self.ks = check_strengths(kd, ks)
-        self.alpha_x = _check_alpha("alpha_x", alpha_x)
-        self.alpha_y = self.alpha_x if alpha_y is None else _check_alpha("alpha_y", alpha_y)
+        self.alpha_x = material_number("alpha_x", alpha_x)
+        self.alpha_y = self.alpha_x if alpha_y is None else material_number("alpha_y", alpha_y)
         # The widths the formulas use (see MIN_ALPHA).
         self.ax = max(self.alpha_x, MIN_ALPHA)
         self.ay = max(self.alpha_y, MIN_ALPHA)

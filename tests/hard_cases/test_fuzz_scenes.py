@@ -23,6 +23,7 @@ from PIL import Image
 
 import rtpy
 from rtpy.io.scene_file import SceneError, load_scene_text
+from rtpy.io.values import MAX_RADIANCE
 from tests.io.scene_text import to_toml
 
 from .scene_strategies import fuzz_settings, random_scene, seeds
@@ -117,19 +118,19 @@ def test_largest_radiances_and_weights_sum_without_overflow(scene_dir, integrato
     """Found while testing the fuzzer's limits: emit = 1e308 is finite and >= 0, as
     the contract asks, but the sum of two samples is inf, so the pixel was Inf (and
     kd = 1e300 overflows a path's weight). Radiances (emit, intensity, background)
-    are now at most 1e30 and kd, ks at most 1; a closed, over-bright scene at those
+    are now at most MAX_RADIANCE and kd, ks at most 1; a closed, over-bright scene at those
     limits renders finite pixels on both backends."""
-    text = LIMIT_SCENE.format(big="1e30")
+    text = LIMIT_SCENE.format(big=repr(MAX_RADIANCE))
     text = text.replace("[render]", f'[render]\nintegrator = "{integrator}"')
     scene = load_scene_text(text, scene_dir / "limit.toml")
     for backend in rtpy.BACKENDS:
         image = rtpy.render(scene, backend=backend).linear
         assert not bad_pixels(image), backend
-        assert image.max() > 1e29
+        assert image.max() > 0.1 * MAX_RADIANCE
     for before, after in [
-        ("emit = [1e30", "emit = [1e308"),
-        ("background = [1e30", "background = [1e31"),
-        ("intensity = [1e30", "intensity = [1e31"),
+        ("emit = [1000000000.0", "emit = [1e308"),
+        ("background = [1000000000.0", "background = [1000000000.5"),
+        ("intensity = [1000000000.0", "intensity = [1000000000.5"),
         ("kd = 1\n", "kd = 1.5\n"),
         ("ks = 1\n", "ks = 1e300\n"),
     ]:

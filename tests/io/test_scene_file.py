@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import copy
+import math
+
 import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
 from rtpy.camera import MAX_PIXELS, Camera
+from rtpy.io import values
+from rtpy.io.material_params import MATERIAL_RANGES, material_parameters
 from rtpy.io.scene_file import (
     MAX_HEIGHT,
     MAX_SPP,
@@ -15,8 +20,9 @@ from rtpy.io.scene_file import (
     SceneError,
     load_scene,
 )
+from rtpy.io.values import COORDINATE, LENGTH, RADIANCE, UNIT, Range
 from rtpy.light import PointLight
-from rtpy.materials import Dielectric, DiffuseLight, Lambertian
+from rtpy.materials import MATERIALS, Dielectric, DiffuseLight, Lambertian
 from rtpy.quad import Quad
 from rtpy.render_settings import RenderSettings
 from rtpy.scene import Scene
@@ -25,6 +31,7 @@ from rtpy.texture import CheckerTexture, ImageTexture, SolidColor
 from rtpy.triangle import Triangle
 from rtpy.vec3 import Color, Vec3
 
+from ..strategies import SPECIAL_FLOATS, extreme_floats
 from .scene_text import FILE, MINIMAL, VALUES, assert_names, error_of, line_of, load, to_toml
 
 GREY = Color(0.5, 0.5, 0.5)
@@ -586,8 +593,8 @@ def test_a_mesh_is_its_triangles_placed_by_scale_rotate_translate(tmp_path):
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 x\n", "", "path", "m.obj line 4: expected an integer"),
         ("v 0 0 0\n", "", "path", "empty mesh"),
         ("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "", "path", "all 1 faces are degenerate"),
-        (TETRA, "scale = 0\n", "scale", "a scale of 0 flattens the mesh"),
-        (TETRA, "scale = [1, 0, 1]\n", "scale", "a scale of 0"),
+        (TETRA, "scale = 0\n", "scale", "of size >= 1e-06, found [0, 0, 0]"),
+        (TETRA, "scale = [1, 0, 1]\n", "scale", "(component 2 is 0.0)"),
         (TETRA, 'scale = "big"\n', "scale", "expected a number or an array of 3 numbers"),
         (TETRA, "rotate = [0, 90]\n", "rotate", "expected"),
         (TETRA, "translate = 1\n", "translate", "expected"),
@@ -618,3 +625,161 @@ def test_degenerate_faces_are_skipped_and_counted_in_one_warning(tmp_path):
     assert len(scene.objects) == 4 and len(record) == 1
     (message,) = str(record[0].message).splitlines()
     assert message.startswith(f"{tmp_path / 's.toml'}: [[objects]] #1 path: skipped 2 degenerate")
+
+
+# --- every numeric key over every magnitude ---------------------------------------------------
+
+
+def _inside(rng: Range):
+    return lambda x: math.isfinite(x) and x in rng
+
+
+def _size_inside(rng: Range):
+    return lambda x: math.isfinite(x) and abs(x) in rng
+
+
+def _offset_ok(x: float) -> bool:
+    """x as one component of a point 1 away from another: both in range, and apart by a length."""
+    return math.isfinite(x) and x in COORDINATE and math.hypot(x, 1.0) in LENGTH
+
+
+GREY = [0.5, 0.5, 0.5]
+KEY_SCENE = {
+    "camera": {"look_from": [0, 0, 0], "look_at": [0, 0, -1], "vup": [0, 1, 0], "width": 4},
+    "render": {"background": [0, 0, 0]},
+    "textures": {"t": {"type": "checker", "scale": 1, "even": GREY, "odd": GREY}},
+    "materials": {"m": {"type": "lambertian"}},
+    "objects": [
+        {"type": "sphere", "center": [0, 0, -1], "radius": 0.5, "material": "m"},
+        {"type": "quad", "q": [0, 0, -2], "u": [1, 0, 0], "v": [0, 1, 0], "material": "m"},
+        {"type": "triangle", "a": [0, 0, -3], "b": [1, 0, -3], "c": [0, 1, -3], "material": "m"},
+        {"type": "mesh", "path": "tetra.obj", "material": "m"},
+    ],
+    "lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1]}],
+}
+
+
+def _key_cases() -> list[tuple]:
+    """(label, table path, key, component or None, x accepted?, keys its errors may name)
+    for every number and one component of every array of numbers of KEY_SCENE's tables,
+    and every number and colour parameter of every material."""
+    cam, obj = ("camera",), ("objects",)
+    cases = [
+        (cam, "look_from", 0, _offset_ok, ("look_from", "look_at")),
+        (cam, "look_at", 0, _offset_ok, ("look_at",)),
+        (cam, "vup", 0, _offset_ok, ("vup",)),
+        (cam, "vfov", None, _inside(values.VFOV), ()),
+        (
+            cam,
+            "aspect_ratio",
+            None,
+            lambda x: _inside(values.ASPECT_RATIO)(x) and 4 / x < MAX_HEIGHT + 1,
+            (),
+        ),
+        (cam, "defocus_angle", None, _inside(values.DEFOCUS_ANGLE), ()),
+        (cam, "focus_distance", None, _inside(LENGTH), ()),
+        (("render",), "gamma", None, _inside(values.GAMMA), ()),
+        (("render",), "background", 1, _inside(RADIANCE), ()),
+        (("textures", "t"), "scale", None, _inside(LENGTH), ()),
+        (("textures", "t"), "odd", 2, _inside(UNIT), ()),
+        ((*obj, 0), "center", 1, _inside(COORDINATE), ()),
+        ((*obj, 0), "radius", None, _inside(LENGTH), ()),
+        ((*obj, 1), "q", 0, _inside(COORDINATE), ()),
+        ((*obj, 1), "u", 0, _size_inside(LENGTH), ()),
+        ((*obj, 1), "v", 2, _offset_ok, ()),
+        ((*obj, 2), "a", 2, _inside(COORDINATE), ()),
+        ((*obj, 3), "translate", 1, lambda x: _inside(COORDINATE)(x) and x + 1 in COORDINATE, ()),
+        ((*obj, 3), "rotate", 2, _inside(values.ANGLE), ()),
+        ((*obj, 3), "scale", None, _size_inside(LENGTH), ()),
+        (("lights", 0), "position", 2, _inside(COORDINATE), ()),
+        (("lights", 0), "intensity", 0, _inside(RADIANCE), ()),
+    ]
+    for kind, cls in MATERIALS.items():
+        for p in material_parameters(cls).values():
+            rng = MATERIAL_RANGES.get(p.name)
+            if rng is not None and p.kind in ("float", "color", "albedo"):
+                component = None if p.kind == "float" else 1
+                cases.append((("materials", kind), p.name, component, _inside(rng), ()))
+    return [
+        (f"{'.'.join(map(str, path))} {key}", path, key, component, ok, (key, *also))
+        for path, key, component, ok, also in cases
+    ]
+
+
+KEY_CASES = _key_cases()
+# Examples per key in the slow tier (log-uniform magnitudes and special values), on
+# top of SPECIAL_FLOATS in the fast tier.
+KEY_EXAMPLES = 12
+
+
+@pytest.fixture(scope="module")
+def key_scene_dir(tmp_path_factory):
+    path = tmp_path_factory.mktemp("keys")
+    (path / "tetra.obj").write_text(TETRA)
+    return path
+
+
+def check_key_value(directory, path, key, component, ok, names, x) -> None:
+    """The scene with x at the key loads exactly when ok(x), else its SceneError names
+    the file, the table and the key, on one line."""
+    data = copy.deepcopy(KEY_SCENE)
+    if path[0] == "materials":
+        kind = path[1]
+        m = {"type": kind, "emit": [1, 1, 1]} if kind == "diffuse_light" else {"type": kind}
+        data["materials"] = {"m": m}
+        path = ("materials", "m")
+    table = data
+    for step in path:
+        table = table[step]
+    if component is None:
+        table[key] = x
+    else:
+        table[key] = list(table.get(key, [0.5, 0.5, 0.5]))
+        table[key][component] = x
+    file = directory / "keys.toml"
+    if ok(x):
+        load(to_toml(data), file)
+        return
+    with pytest.raises(SceneError) as info:
+        load(to_toml(data), file)
+    err = info.value
+    if len(path) == 2 and isinstance(path[1], int):
+        label = f"[[{path[0]}]] #{path[1] + 1}"
+    else:
+        label = f"[{'.'.join(path)}]"
+    assert err.file == str(file) and err.table == label and err.key in names, str(err)
+    assert f"{label} {err.key}:" in str(err) and "\n" not in str(err)
+    assert f"{err.key}: {err.key}:" not in str(err)  # the key is named once
+
+
+@pytest.mark.parametrize(
+    ("camera", "key", "words"),
+    [
+        ("look_at = [0, 0, 0]", "look_at", "expected a distance from look_from in [1e-06, "),
+        ("vup = [0, 0, 2]", "vup", "expected an up vector across the view direction"),
+    ],
+)
+def test_a_camera_that_sees_nothing_is_refused_naming_the_key_once(camera, key, words):
+    err = error_of(f"[camera]\n{camera}\n")
+    assert_names(err, "[camera]", key)
+    assert f"[camera] {key}: {words}" in str(err)
+
+
+@pytest.mark.parametrize(
+    ("label", "path", "key", "component", "ok", "names"), KEY_CASES, ids=[c[0] for c in KEY_CASES]
+)
+def test_every_key_takes_its_range_and_refuses_the_rest(
+    key_scene_dir, label, path, key, component, ok, names
+):
+    for x in SPECIAL_FLOATS:
+        check_key_value(key_scene_dir, path, key, component, ok, names, x)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("label", "path", "key", "component", "ok", "names"), KEY_CASES, ids=[c[0] for c in KEY_CASES]
+)
+@settings(max_examples=KEY_EXAMPLES, deadline=None)
+@given(x=extreme_floats())
+def test_every_key_over_every_magnitude(key_scene_dir, label, path, key, component, ok, names, x):
+    check_key_value(key_scene_dir, path, key, component, ok, names, x)

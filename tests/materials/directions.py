@@ -43,10 +43,11 @@ weights = st.floats(0.0, 1.0)
 
 # Strengths every glossy model refuses, with the start of its message.
 BAD_STRENGTHS = [
-    ({"kd": -0.1}, "kd must be a finite number >= 0"),
-    ({"ks": -1.0}, "ks must be a finite number >= 0"),
-    ({"ks": math.inf}, "ks must be a finite number >= 0"),
-    ({"ks": math.nan}, "ks must be a finite number >= 0"),
+    ({"kd": -0.1}, r"kd: expected a number in \[0, 1\], found -0.1"),
+    ({"ks": -1.0}, r"ks: expected a number in \[0, 1\]"),
+    ({"ks": 1.5}, r"ks: expected a number in \[0, 1\], found 1.5"),
+    ({"ks": math.inf}, r"ks: expected a finite number in \[0, 1\]"),
+    ({"ks": math.nan}, r"ks: expected a finite number in \[0, 1\]"),
 ]
 
 

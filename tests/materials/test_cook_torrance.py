@@ -26,6 +26,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
+from rtpy.io.values import ROUGHNESS
 from rtpy.materials import CookTorrance
 from rtpy.vec3 import Color, Vec3
 
@@ -143,8 +144,8 @@ f0s = st.one_of(st.none(), st.tuples(*[st.floats(0.0, 1.0)] * 3))
 
 
 @given(
-    st.floats(0.0, 2.0),
-    st.floats(0.0, 2.0),
+    st.floats(0.0, 1.0),
+    st.floats(0.0, 1.0),
     st.sampled_from(DISTRIBUTIONS),
     widths,
     st.floats(1.01, 3.0),
@@ -193,7 +194,7 @@ def test_zero_below_the_surface(dist, a, to, po, ti, pi_):
     azimuths,
 )
 def test_reciprocity(dist, a, f0, ta, pa, tb, pb):
-    m = CookTorrance(Color(*ALBEDO), 0.7, 1.3, a, dist, f0=None if f0 is None else Color(*f0))
+    m = CookTorrance(Color(*ALBEDO), 0.3, 1.0, a, dist, f0=None if f0 is None else Color(*f0))
     wa, wb = direction(ta, pa), direction(tb, pb)
     assert brdf(m, wa, wb) == pytest.approx(brdf(m, wb, wa), rel=1e-12, abs=1e-300)
 
@@ -357,7 +358,7 @@ def test_the_half_vector_sampler_inverts_the_cdf_of_D_cos(dist, a):
 
 
 @pytest.mark.parametrize("dist", DISTRIBUTIONS)
-@pytest.mark.parametrize("a", [1e-9, 0.001, 0.01, 1.0])
+@pytest.mark.parametrize("a", [ROUGHNESS.lo, 0.001, 0.01, 1.0])
 def test_tiny_roughness_and_grazing_angles_give_finite_values(dist, a):
     m = CookTorrance(Color(*ALBEDO), 0.2, 1.0, a, dist)
     check_finite(m, extreme_pairs((0.0, 0.3, math.pi - 1e-7, math.pi)), 50)
@@ -420,7 +421,7 @@ def test_defaults_and_registration():
     ],
 )
 def test_constructor_refuses_bad_parameters(kwargs, message):
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises((TypeError, ValueError), match=message):
         CookTorrance(**kwargs)
 
 
@@ -447,8 +448,8 @@ def test_the_loader_reads_cook_torrance_with_and_without_optional_keys():
     "keys, words",
     [
         ('distribution = "beckman"', ["distribution", "did you mean 'beckmann'"]),
-        ("roughness = 0", ["roughness", "> 0"]),
-        ("roughness = 2", ["roughness", "(0, 1]"]),
+        ("roughness = 0", ["roughness", "in [0.0001, 1]"]),
+        ("roughness = 2", ["roughness", "in [0.0001, 1]"]),
         ("f0 = [1.5, 0.5, 0.5]", ["f0"]),
         ("f0 = 0.5", ["f0"]),
         ("ior = -1", ["ior"]),

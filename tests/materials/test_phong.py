@@ -270,15 +270,15 @@ def test_defaults_and_registration():
     "kwargs, message",
     [
         *BAD_STRENGTHS,
-        ({"exponent": -1.0}, "exponent must be a finite number >= 0, got -1.0"),
-        ({"exponent": math.nan}, "exponent must be a finite number >= 0"),
-        ({"exponent": math.inf}, "exponent must be a finite number >= 0"),
-        ({"exponent": "10"}, "exponent must be a finite number >= 0"),
-        ({"exponent": True}, "exponent must be a finite number >= 0"),
+        ({"exponent": -1.0}, r"exponent: expected a number in \[0, 1000000\], found -1.0"),
+        ({"exponent": math.nan}, "exponent: expected a"),
+        ({"exponent": math.inf}, "exponent: expected a"),
+        ({"exponent": "10"}, "exponent: expected a"),
+        ({"exponent": True}, "exponent: expected a"),
     ],
 )
 def test_constructor_refuses_bad_parameters(kwargs, message):
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises((TypeError, ValueError), match=message):
         Phong(Color(*ALBEDO), **kwargs)
 
 
@@ -295,7 +295,7 @@ def test_the_loader_accepts_a_phong_material():
 def test_the_loader_uses_the_defaults_and_refuses_bad_values():
     m = load_material(SHINY.replace("kd = 0.6\nks = 0.4\nexponent = 8", ""))
     assert (m.kd, m.ks, m.exponent) == (1.0, 0.0, 1.0)
-    with pytest.raises(SceneError, match=r"\[materials.shiny\] exponent: .*>= 0"):
+    with pytest.raises(SceneError, match=r"\[materials.shiny\] exponent: .*in \[0, 1000000\]"):
         load_material(SHINY.replace("exponent = 8", "exponent = -2"))
     with pytest.raises(SceneError, match=r"\[materials.shiny\] shininess: unknown key"):
         load_material(SHINY.replace("exponent = 8", "shininess = 8"))

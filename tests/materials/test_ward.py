@@ -27,6 +27,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
+from rtpy.io.values import ROUGHNESS
 from rtpy.materials import Ward
 from rtpy.onb import ONB
 from rtpy.vec3 import Color, Vec3
@@ -127,8 +128,8 @@ widths = st.floats(0.01, 1.0)
 
 
 @given(
-    st.floats(0.0, 2.0),
-    st.floats(0.0, 2.0),
+    st.floats(0.0, 1.0),
+    st.floats(0.0, 1.0),
     widths,
     st.one_of(st.none(), widths),
     polar,
@@ -195,7 +196,7 @@ def test_zero_below_the_surface(ax, ay, to, po, ti, pi_):
 
 @given(widths, widths, polar, azimuths, polar, azimuths)
 def test_reciprocity(ax, ay, ta, pa, tb, pb):
-    m = Ward(Color(*ALBEDO), 0.7, 1.3, ax, ay)
+    m = Ward(Color(*ALBEDO), 0.3, 1.0, ax, ay)
     wa, wb = direction(ta, pa), direction(tb, pb)
     assert brdf(m, wa, wb) == pytest.approx(brdf(m, wb, wa), rel=1e-12, abs=1e-300)
 
@@ -291,7 +292,9 @@ def test_mean_sample_weight_is_the_albedo_by_quadrature(ax, ay, theta_o_deg, phi
 # --- numerics at the extremes --------------------------------------------------------------
 
 
-@pytest.mark.parametrize("ax, ay", [(1e-9, 1e-9), (0.001, 0.001), (0.001, 1.0), (1.0, 1.0)])
+@pytest.mark.parametrize(
+    "ax, ay", [(ROUGHNESS.lo, ROUGHNESS.lo), (0.001, 0.001), (0.001, 1.0), (1.0, 1.0)]
+)
 def test_tiny_widths_and_grazing_angles_give_finite_values(ax, ay):
     m = Ward(Color(*ALBEDO), 0.2, 1.0, ax, ay)
     pairs = directions.extreme_pairs(
@@ -371,7 +374,7 @@ def test_defaults_and_registration():
     ],
 )
 def test_constructor_refuses_bad_parameters(kwargs, message):
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises((TypeError, ValueError), match=message):
         Ward(**kwargs)
 
 
@@ -392,9 +395,9 @@ def test_the_loader_reads_ward_with_and_without_alpha_y():
 @pytest.mark.parametrize(
     "keys, words",
     [
-        ("alpha_x = 0", ["alpha_x", "> 0"]),
-        ("alpha_y = -0.1", ["alpha_y", "> 0"]),
-        ("alpha_y = 3", ["alpha_y", "(0, 1]"]),
+        ("alpha_x = 0", ["alpha_x", "in [0.0001, 1]"]),
+        ("alpha_y = -0.1", ["alpha_y", "in [0.0001, 1]"]),
+        ("alpha_y = 3", ["alpha_y", "in [0.0001, 1]"]),
         ('alpha_y = "x"', ["alpha_y"]),
         ("alpha = 0.1", ["did you mean"]),
         ("roughness = 0.1", ["unknown key"]),

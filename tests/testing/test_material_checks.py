@@ -64,7 +64,9 @@ def test_check_energy_accepts_correct_materials():
 
 
 def test_check_energy_catches_an_albedo_above_one():
-    result = check_energy(Lambertian(Color(1.3, 1.3, 1.3)), 30.0, n_samples=2000)
+    too_bright = Lambertian()
+    too_bright.albedo.color = Color(1.3, 1.3, 1.3)  # beyond what the constructor takes
+    result = check_energy(too_bright, 30.0, n_samples=2000)
     assert not result and "> 1" in result.detail
 
 
