@@ -12,11 +12,13 @@ scene (not necessarily unit length); world y is up.
 from __future__ import annotations
 
 import math
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from .io.values import RADIANCE, Range, checked_color, checked_number
 from .vec3 import Color, Vec3
+
+if TYPE_CHECKING:
+    import numpy as np
 
 POLAR_ANGLE = Range(0, 180)  # degrees from the zenith
 
@@ -30,6 +32,8 @@ class Environment:
         raise NotImplementedError
 
     def radiance_array(self, d: np.ndarray) -> np.ndarray:
+        import numpy as np  # the numpy backend's; the scalar renderer needs no numpy
+
         out = np.empty((len(d), 3))
         for k, row in enumerate(d):
             c = self.radiance(Vec3(*row))
@@ -68,6 +72,8 @@ class SkyBand(Environment):
         return Color(0.0, 0.0, 0.0)
 
     def radiance_array(self, d: np.ndarray) -> np.ndarray:
+        import numpy as np
+
         cos_theta = d[:, 1] / np.sqrt(np.einsum("ij,ij->i", d, d))
         inside = (cos_theta >= self._cos_lo) & (cos_theta <= self._cos_hi)
         value = np.array([self.value.e0, self.value.e1, self.value.e2])
