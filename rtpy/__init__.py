@@ -13,6 +13,11 @@ each name of the course's code is; docs/scene-format.md is the scene-file format
 
 from __future__ import annotations
 
+from . import signals
+
+if signals.starting_the_command_line():
+    signals.defer()  # before the imports below: see rtpy/signals.py
+
 from importlib.metadata import PackageNotFoundError, version
 
 from .camera import Camera

@@ -136,13 +136,13 @@ class PixelSums:
     Each region's batches are added in batch order (a unit that arrives before an
     earlier batch of its region waits), so every pixel's sum is the same for any
     order of arrival, that is for any number of workers, and memory holds one
-    image, not every unit of the render. Every pixel of a region has had the same
-    samples, so the sample counts are kept per region.
+    image, not every unit of the render. Each pixel's count of samples is a fourth
+    channel beside its sums, added with them in one array operation: a Ctrl-C that
+    interrupts an addition anywhere leaves every sum with its own count.
     """
 
     def __init__(self, width: int, height: int) -> None:
-        self.total = np.zeros((height, width, 3))
-        self._samples: dict[int, tuple[Unit, int]] = {}  # region -> (a unit of it, spp)
+        self.total = np.zeros((height, width, 4))  # r, g, b sums and the samples they hold
         self._next_batch: dict[int, int] = {}  # region -> the batch to add next
         self._waiting: dict[tuple[int, int], tuple[Unit, np.ndarray]] = {}
 
@@ -160,29 +160,23 @@ class PixelSums:
             self._add(*self._waiting.pop(key))
 
     def _add(self, unit: Unit, sums: np.ndarray) -> None:
-        self.total[unit.y0 : unit.y1, unit.x0 : unit.x1] += sums
-        samples = self._samples.get(unit.region, (unit, 0))[1]
-        self._samples[unit.region] = (unit, samples + unit.spp)
+        counted = np.concatenate([sums, np.full((*sums.shape[:2], 1), float(unit.spp))], axis=2)
+        self.total[unit.y0 : unit.y1, unit.x0 : unit.x1] += counted
 
     @property
     def counts(self) -> np.ndarray:
         """Samples added per pixel, an array (height, width)."""
-        counts = np.zeros(self.total.shape[:2], dtype=np.int64)
-        for unit, samples in self._samples.values():
-            counts[unit.y0 : unit.y1, unit.x0 : unit.x1] = samples
-        return counts
+        return self.total[..., 3].astype(np.int64)
 
     @property
     def paths(self) -> int:
         """Samples added over all pixels."""
-        return sum(n * (u.x1 - u.x0) * (u.y1 - u.y0) for u, n in self._samples.values())
+        return int(self.counts.sum())
 
     def samples_range(self) -> tuple[int, int]:
         """The fewest and the most samples a pixel has."""
-        pixels = sum((u.x1 - u.x0) * (u.y1 - u.y0) for u, _ in self._samples.values())
-        samples = [n for _, n in self._samples.values()]
-        fewest = min(samples) if samples and pixels == self.total[..., 0].size else 0
-        return fewest, max(samples, default=0)
+        counts = self.counts
+        return int(counts.min()), int(counts.max())
 
     def snapshot(self) -> np.ndarray:
         """The mean of each pixel's samples added so far, as a new array (the sums are
@@ -195,10 +189,11 @@ class PixelSums:
         self.finish()
         return self._divide(self.total)
 
-    def _divide(self, sums: np.ndarray) -> np.ndarray:
-        """sums (the image of sums or a copy) divided, in place, by each region's samples."""
-        for unit, samples in self._samples.values():
-            sums[unit.y0 : unit.y1, unit.x0 : unit.x1] /= samples
+    def _divide(self, total: np.ndarray) -> np.ndarray:
+        """The sums of `total` (the image of sums and counts, or a copy) divided, in
+        place, by their counts; black where there are none."""
+        sums, counts = total[..., :3], total[..., 3:]
+        np.divide(sums, counts, out=sums, where=counts > 0)
         return sums
 
 
