@@ -136,28 +136,44 @@ class PixelSums:
     Each region's batches are added in batch order (a unit that arrives before an
     earlier batch of its region waits), so every pixel's sum is the same for any
     order of arrival, that is for any number of workers, and memory holds one
-    image, not every unit of the render. Each pixel's count of samples is a fourth
-    channel beside its sums, added with them in one array operation: a Ctrl-C that
-    interrupts an addition anywhere leaves every sum with its own count.
+    image, not every unit of the render. A batch is a pass over the image, and no
+    region is added more than one pass ahead of the passes every region has
+    finished (a unit further ahead, from a worker that ran ahead of one still busy,
+    waits too), so every pixel has the same samples, give or take one pass, at any
+    moment. Each pixel's count of samples is a fourth channel beside its sums, added
+    with them in one array operation: a Ctrl-C that interrupts an addition anywhere
+    leaves every sum with its own count.
     """
 
-    def __init__(self, width: int, height: int) -> None:
+    def __init__(self, width: int, height: int, regions: int) -> None:
         self.total = np.zeros((height, width, 4))  # r, g, b sums and the samples they hold
+        self.passes = 0  # the batches every one of the `regions` regions has added
+        self._regions = regions
         self._next_batch: dict[int, int] = {}  # region -> the batch to add next
+        self._added: dict[int, int] = {}  # batch -> the regions that have added it
         self._waiting: dict[tuple[int, int], tuple[Unit, np.ndarray]] = {}
 
     def add(self, unit: Unit, sums: np.ndarray) -> None:
         self._waiting[(unit.region, unit.batch)] = (unit, sums)
-        batch = self._next_batch.get(unit.region, 0)
-        while (unit.region, batch) in self._waiting:
-            self._add(*self._waiting.pop((unit.region, batch)))
-            batch += 1
-        self._next_batch[unit.region] = batch
+        ready = [(unit.region, unit.batch)]
+        while ready:
+            region, batch = key = ready.pop()
+            if key not in self._waiting or batch != self._next_batch.get(region, 0):
+                continue
+            if batch > self.passes:  # more than one pass ahead
+                continue
+            self._add(*self._waiting.pop(key))
+            self._next_batch[region] = batch + 1
+            self._added[batch] = self._added.get(batch, 0) + 1
+            ready.append((region, batch + 1))
+            if batch == self.passes and self._added[batch] == self._regions:
+                self.passes += 1  # the units of the next pass may be added now
+                ready.extend(k for k in self._waiting if k[1] == self.passes)
 
     def finish(self) -> None:
-        """Add the units still waiting for an earlier batch (after Ctrl-C)."""
-        for key in sorted(self._waiting):
-            self._add(*self._waiting.pop(key))
+        """Drop the units still waiting (after Ctrl-C): each is more than one pass
+        ahead of the passes finished, or waits for such a unit."""
+        self._waiting.clear()
 
     def _add(self, unit: Unit, sums: np.ndarray) -> None:
         counted = np.concatenate([sums, np.full((*sums.shape[:2], 1), float(unit.spp))], axis=2)
@@ -304,7 +320,7 @@ class Renderer:
         settings, camera, backend = self.settings, self.camera, self.backend
         spp = 1 if backend.uses_center_ray() else settings.spp
         units = backend.plan_units(camera.width, camera.height, spp)
-        results = PixelSums(camera.width, camera.height)
+        results = PixelSums(camera.width, camera.height, len({u.region for u in units}))
         total_paths = camera.width * camera.height * spp
         bar = tqdm(
             total=total_paths,

@@ -259,14 +259,15 @@ def test_second_ctrl_c_exits_at_once(tmp_path, workers):
 
     After the first Ctrl-C the command says on stderr that it writes the partial
     image; the second SIGINT is sent when that line is read, while this 3000x3000
-    image (PNG and .npy, seconds to write) is being written. The naive handling
-    (Python's default KeyboardInterrupt, or SIG_DFL set once the render returns)
-    either prints a traceback from wherever the second signal lands, or dies inside
-    the write and leaves its temporary file behind; waiting for the write would
-    leave the complete files."""
+    image (PNG and .npy, seconds to write) is being written; its first pass (1 spp,
+    depth 1: cheap paths) must have finished for anything to be written. The naive
+    handling (Python's default KeyboardInterrupt, or SIG_DFL set once the render
+    returns) either prints a traceback from wherever the second signal lands, or dies
+    inside the write and leaves its temporary file behind; waiting for the write
+    would leave the complete files."""
     out = tmp_path / "big.png"
     proc = start_render(
-        "cornell", "--width", "3000", "--spp", "8", "--backend", "numpy",
+        "cornell", "--width", "3000", "--spp", "8", "--max-depth", "1", "--backend", "numpy",
         "--workers", workers, "-o", str(out), "--linear", str(tmp_path / "big.npy"),
     )  # fmt: skip
     read_until(proc, lambda text: percent_done(text) >= 13)  # a pass of 1 spp finished
