@@ -74,17 +74,21 @@ def stop_on_signals() -> Iterator[None]:
     """Within: the first SIGINT or SIGTERM raises KeyboardInterrupt (at once if one was
     recorded while starting), a second one ends the process at once (`end_now`). The
     previous handlers are restored after."""
-    previous = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
-    if previous[signal.SIGINT] not in (_record, _raise):
+    if signal.getsignal(signal.SIGINT) not in (_record, _raise):
         _received.clear()  # a new command in this process
-    _install(_raise)
-    try:
+    with _handled_by(_raise):
         if _received:
             raise KeyboardInterrupt  # received while starting
         yield
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+
+
+@contextmanager
+def finishing() -> Iterator[None]:
+    """Within (inside `stop_on_signals`): a first signal is recorded, not raised, for
+    work that is better finished than undone (writing a finished image); the
+    command then ends with its status. A second one ends the process at once."""
+    with _handled_by(_record):
+        yield
 
 
 @contextmanager
@@ -98,17 +102,28 @@ def held() -> Iterator[None]:
         yield  # only the main thread handles signals
         return
     caught: list[int] = []
+    try:
+        with _handled_by(lambda signum, frame: caught.append(signum)):
+            _block(True)
+            try:
+                yield
+            finally:
+                _block(False)  # a signal pending meanwhile is caught now
+    finally:
+        for signum in caught:
+            signal.raise_signal(signum)
+
+
+@contextmanager
+def _handled_by(handler) -> Iterator[None]:
+    """Within: `handler` handles SIGINT and SIGTERM; the previous handlers after."""
     previous = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
-    _install(lambda signum, frame: caught.append(signum))
-    _block(True)
+    _install(handler)
     try:
         yield
     finally:
-        _block(False)
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
-        for signum in caught:
-            signal.raise_signal(signum)
+        for signum, before in previous.items():
+            signal.signal(signum, before)
 
 
 def _block(block: bool) -> None:
@@ -142,9 +157,9 @@ def _raise(signum: int, frame) -> None:
 def end_now() -> None:
     """End the process at once, without unwinding: kill the worker processes, remove
     the temporary files of writes in progress (their targets are untouched), say so."""
-    # Only what is imported already: this may run in the middle of an import.
-    multiprocessing = sys.modules.get("multiprocessing")
-    children = multiprocessing.active_children() if multiprocessing else []
+    # Only what is imported already, and whole: this may run in the middle of an import.
+    active_children = getattr(sys.modules.get("multiprocessing"), "active_children", list)
+    children = active_children()
     for child in children:
         child.kill()
     for child in children:

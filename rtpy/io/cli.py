@@ -17,6 +17,7 @@ from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
 from ..signals import (
     NOTHING_WRITTEN,
     caused_by_interrupt,
+    finishing,
     received,
     stop_on_signals,
     stopped,
@@ -372,16 +373,10 @@ def _render(args: argparse.Namespace) -> int:
             flush=True,
         )
 
-    # A signal while the image is written leaves no file half-written: writes are
-    # atomic. After a first signal, a second one ends at once (rtpy.signals).
-    written = []
-    try:
-        for path in (output, linear):
-            if path is not None:
-                written.append(image.save(path))
-    except KeyboardInterrupt:
-        kept = f"interrupted while writing: wrote {written[0]} only" if written else ""
-        return stopped(kept or NOTHING_WRITTEN)
+    # The image in hand is written whole, even after a signal (a second one ends at
+    # once, leaving no file half-written: rtpy.signals).
+    with finishing():
+        written = [image.save(path) for path in (output, linear) if path is not None]
     stats = image.stats
     files = ", ".join(str(p) for p in written)
     if image.interrupted:
@@ -389,6 +384,8 @@ def _render(args: argparse.Namespace) -> int:
             f"interrupted: wrote {files} holding {image.samples_min}-{image.samples_max} "
             f"of {image.spp} samples per pixel"
         )
+    if received() is not None:  # while writing the finished image
+        return stopped(f"interrupted while writing: wrote {files}, complete")
     print(
         f"rtpy: wrote {files}: {image.width}x{image.height}, {image.spp} spp, "
         f"{stats['seconds']:.2f} s, {stats['paths_per_second']:,.0f} paths/s",
