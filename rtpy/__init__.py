@@ -15,6 +15,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from . import signals
+
+if signals.starting_the_command_line():
+    signals.defer()  # before the imports below: see rtpy/signals.py
+
 from .camera import Camera
 from .hit_info import HitInfo
 from .interval import Interval

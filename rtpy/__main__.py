@@ -1,7 +1,29 @@
-"""`python -m rtpy`: see rtpy.io.cli."""
+"""`python -m rtpy`: see rtpy.io.cli; signals from start-up to exit: rtpy.signals."""
 
+import os
 import sys
 
-from .io.cli import main
+from . import signals
 
-sys.exit(main(prog="python -m rtpy"))
+signals.defer()  # rtpy/__init__.py did it already when run as `python -m rtpy`
+
+from .io.cli import main  # noqa: E402 (imported with the signals deferred)
+
+
+def end(status: int) -> None:
+    """Exit with `status`. After a signal, without the interpreter's finalization: a
+    KeyboardInterrupt that ended code run by exec of a string (as dataclasses does)
+    makes `python -m` exit as if killed by SIGINT, whatever the status."""
+    if signals.received() is None:
+        sys.exit(status)
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe or stream: nothing more to say
+            pass
+    os._exit(status)
+
+
+if signals.received() is not None:  # while starting: stop before doing anything
+    end(signals.stopped(signals.NOTHING_WRITTEN))
+end(main(prog="python -m rtpy"))

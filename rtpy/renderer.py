@@ -151,53 +151,63 @@ class PixelSums:
     Each region's batches are added in batch order (a unit that arrives before an
     earlier batch of its region waits), so every pixel's sum is the same for any
     order of arrival, that is for any number of workers, and memory holds one
-    image, not every unit of the render. Every pixel of a region has had the same
-    samples, so the sample counts are kept per region.
+    image, not every unit of the render. A batch is a pass over the image, and no
+    region is added more than one pass ahead of the passes every region has
+    finished (a unit further ahead, from a worker that ran ahead of one still busy,
+    waits too), so every pixel has the same samples, give or take one pass, at any
+    moment. Each pixel's count of samples is a fourth channel beside its sums, added
+    with them in one array operation: a Ctrl-C that interrupts an addition anywhere
+    leaves every sum with its own count.
     """
 
-    def __init__(self, width: int, height: int) -> None:
-        self.total = np.zeros((height, width, 3))
-        self._samples: dict[int, tuple[Unit, int]] = {}  # region -> (a unit of it, spp)
+    def __init__(self, width: int, height: int, regions: int) -> None:
+        self.total = np.zeros((height, width, 4))  # r, g, b sums and the samples they hold
+        self.passes = 0  # the batches every one of the `regions` regions has added
+        self._regions = regions
         self._next_batch: dict[int, int] = {}  # region -> the batch to add next
+        self._added: dict[int, int] = {}  # batch -> the regions that have added it
         self._waiting: dict[tuple[int, int], tuple[Unit, np.ndarray]] = {}
 
     def add(self, unit: Unit, sums: np.ndarray) -> None:
         self._waiting[(unit.region, unit.batch)] = (unit, sums)
-        batch = self._next_batch.get(unit.region, 0)
-        while (unit.region, batch) in self._waiting:
-            self._add(*self._waiting.pop((unit.region, batch)))
-            batch += 1
-        self._next_batch[unit.region] = batch
+        ready = [(unit.region, unit.batch)]
+        while ready:
+            region, batch = key = ready.pop()
+            if key not in self._waiting or batch != self._next_batch.get(region, 0):
+                continue
+            if batch > self.passes:  # more than one pass ahead
+                continue
+            self._add(*self._waiting.pop(key))
+            self._next_batch[region] = batch + 1
+            self._added[batch] = self._added.get(batch, 0) + 1
+            ready.append((region, batch + 1))
+            if batch == self.passes and self._added[batch] == self._regions:
+                self.passes += 1  # the units of the next pass may be added now
+                ready.extend(k for k in self._waiting if k[1] == self.passes)
 
     def finish(self) -> None:
-        """Add the units still waiting for an earlier batch (after Ctrl-C)."""
-        for key in sorted(self._waiting):
-            self._add(*self._waiting.pop(key))
+        """Drop the units still waiting (after Ctrl-C): each is more than one pass
+        ahead of the passes finished, or waits for such a unit."""
+        self._waiting.clear()
 
     def _add(self, unit: Unit, sums: np.ndarray) -> None:
-        self.total[unit.y0 : unit.y1, unit.x0 : unit.x1] += sums
-        samples = self._samples.get(unit.region, (unit, 0))[1]
-        self._samples[unit.region] = (unit, samples + unit.spp)
+        counted = np.concatenate([sums, np.full((*sums.shape[:2], 1), float(unit.spp))], axis=2)
+        self.total[unit.y0 : unit.y1, unit.x0 : unit.x1] += counted
 
     @property
     def counts(self) -> np.ndarray:
         """Samples added per pixel, an array (height, width)."""
-        counts = np.zeros(self.total.shape[:2], dtype=np.int64)
-        for unit, samples in self._samples.values():
-            counts[unit.y0 : unit.y1, unit.x0 : unit.x1] = samples
-        return counts
+        return self.total[..., 3].astype(np.int64)
 
     @property
     def paths(self) -> int:
         """Samples added over all pixels."""
-        return sum(n * (u.x1 - u.x0) * (u.y1 - u.y0) for u, n in self._samples.values())
+        return int(self.counts.sum())
 
     def samples_range(self) -> tuple[int, int]:
         """The fewest and the most samples a pixel has."""
-        pixels = sum((u.x1 - u.x0) * (u.y1 - u.y0) for u, _ in self._samples.values())
-        samples = [n for _, n in self._samples.values()]
-        fewest = min(samples) if samples and pixels == self.total[..., 0].size else 0
-        return fewest, max(samples, default=0)
+        counts = self.counts
+        return int(counts.min()), int(counts.max())
 
     def snapshot(self) -> np.ndarray:
         """The mean of each pixel's samples added so far, as a new array (the sums are
@@ -210,10 +220,11 @@ class PixelSums:
         self.finish()
         return self._divide(self.total)
 
-    def _divide(self, sums: np.ndarray) -> np.ndarray:
-        """sums (the image of sums or a copy) divided, in place, by each region's samples."""
-        for unit, samples in self._samples.values():
-            sums[unit.y0 : unit.y1, unit.x0 : unit.x1] /= samples
+    def _divide(self, total: np.ndarray) -> np.ndarray:
+        """The sums of `total` (the image of sums and counts, or a copy) divided, in
+        place, by their counts; black where there are none."""
+        sums, counts = total[..., :3], total[..., 3:]
+        np.divide(sums, counts, out=sums, where=counts > 0)
         return sums
 
 
@@ -342,7 +353,7 @@ class Renderer:
         settings, camera, backend = self.settings, self.camera, self.backend
         spp = 1 if backend.uses_center_ray() else settings.spp
         units = backend.plan_units(camera.width, camera.height, spp)
-        results = PixelSums(camera.width, camera.height)
+        results = PixelSums(camera.width, camera.height, len({u.region for u in units}))
         total_paths = camera.width * camera.height * spp
         bar = _NoBar() if self.quiet else self._progress_bar(total_paths)
         start = last_preview = time.perf_counter()

@@ -22,6 +22,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from typing import TYPE_CHECKING
 
+from . import signals
 from .plugins import PLUGINS, load_listed_plugins
 
 if TYPE_CHECKING:
@@ -71,7 +72,13 @@ def cannot_rebuild(reason: str, method: str) -> WorkerError:
 
 def _init_worker(plugins: dict[str, str], backend: Backend | bytes) -> None:
     global _render_one, _start_error
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
+    # The parent handles Ctrl-C (the terminal sends it to every process of the
+    # group); SIGTERM ends a worker at once and quietly, as the parent's
+    # _stop_workers does (a handler inherited from the parent by fork would raise
+    # KeyboardInterrupt and print its traceback).
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signals.unblock()  # born with them blocked (signals.held)
     try:
         load_listed_plugins(plugins)
         if isinstance(backend, bytes):
@@ -111,11 +118,24 @@ def run_on_workers(backend: Backend, units: list[Unit], workers: int):
         raise cannot_rebuild(f"{type(err).__name__}: {err}", method) from None
     if sys.platform == "win32":
         workers = min(workers, WINDOWS_MAX_WORKERS)
-    executor = ProcessPoolExecutor(
-        workers, mp_context=context, initializer=_init_worker, initargs=(dict(PLUGINS), payload)
-    )
+    if method == "forkserver":  # started now, not with the signals blocked below
+        from multiprocessing import forkserver
+
+        forkserver.ensure_running()
+    before = set(multiprocessing.active_children())
+    executor = None
     try:
-        for future in as_completed([executor.submit(_run_unit, unit) for unit in units]):
+        # A signal while the processes start waits until they all are in the
+        # executor's table, so that stopping the pool stops every one of them.
+        with signals.held():
+            executor = ProcessPoolExecutor(
+                workers,
+                mp_context=context,
+                initializer=_init_worker,
+                initargs=(dict(PLUGINS), payload),
+            )
+            futures = [executor.submit(_run_unit, unit) for unit in units]
+        for future in as_completed(futures):
             yield future.result()
     except WorkerError as err:
         _stop_workers(executor)
@@ -126,7 +146,18 @@ def run_on_workers(backend: Backend, units: list[Unit], workers: int):
             f"ran out of memory or failed while starting (its error is above). {START_ADVICE}"
         ) from None
     except BaseException:
-        _stop_workers(executor)  # at once on Ctrl-C or an error
+        if executor is not None:
+            _stop_workers(executor)  # at once on Ctrl-C or an error
         raise
     finally:
-        executor.shutdown(wait=True, cancel_futures=True)
+        if executor is not None:
+            executor.shutdown(wait=True, cancel_futures=True)
+        _end_processes(before)
+
+
+def _end_processes(before: set) -> None:
+    """End and join the child processes started since the children `before` were
+    (those the executor did not: one it was starting when it failed or was stopped)."""
+    for process in set(multiprocessing.active_children()) - before:
+        process.terminate()
+        process.join()

@@ -4,6 +4,7 @@ one loop that drives any backend."""
 from __future__ import annotations
 
 import re
+import sys
 
 import numpy as np
 import pytest
@@ -143,11 +144,13 @@ def test_ctrl_c_keeps_finished_samples():
 def test_pixel_sums_do_not_depend_on_the_order_units_arrive_in():
     """Workers finish units in any order; PixelSums adds each tile's batches in batch
     order, so the image is bit for bit the same (adding in arrival order is not:
-    float addition is not associative), and a unit is kept only until it is added."""
+    float addition is not associative), and a unit is kept only until it is added.
+    At every moment each pixel has the same samples, give or take one pass (a batch
+    of 1 spp here)."""
     units = plan_units(40, 20, 6)
     rng = np.random.default_rng(1)
     sums = [rng.random((u.y1 - u.y0, u.x1 - u.x0, 3)) * 10.0 ** rng.integers(-8, 8) for u in units]
-    in_order, shuffled = PixelSums(40, 20), PixelSums(40, 20)
+    in_order, shuffled = PixelSums(40, 20, 6), PixelSums(40, 20, 6)  # 6 tiles
     naive = np.zeros((20, 40, 3))
     for unit, s in zip(units, sums, strict=True):
         in_order.add(unit, s)
@@ -155,21 +158,78 @@ def test_pixel_sums_do_not_depend_on_the_order_units_arrive_in():
         shuffled.add(units[i], sums[i])
         u = units[i]
         naive[u.y0 : u.y1, u.x0 : u.x1] += sums[i]
+        assert shuffled.counts.max() - shuffled.counts.min() <= 1
     assert not shuffled._waiting and not in_order._waiting  # everything added
     np.testing.assert_array_equal(shuffled.total, in_order.total)
     np.testing.assert_array_equal(shuffled.counts, np.full((20, 40), 6))
-    assert not np.array_equal(naive, in_order.total)
+    assert not np.array_equal(naive, in_order.total[..., :3])
 
 
-def test_pixel_sums_after_ctrl_c_add_the_units_that_wait_for_an_earlier_batch():
-    units = plan_units(16, 16, 3)  # one tile, batches 0, 1, 2
-    acc = PixelSums(16, 16)
-    acc.add(units[0], np.ones((16, 16, 3)))
-    acc.add(units[2], np.full((16, 16, 3), 4.0))  # batch 1 never finished
-    assert acc.counts.max() == 1
+def test_pixel_sums_after_ctrl_c_drop_the_units_that_wait():
+    """A unit waits for an earlier batch of its region, or while it would put its
+    region more than a pass ahead of another; after Ctrl-C they are dropped."""
+    units = plan_units(32, 16, 3)  # two tiles, batches 0, 1, 2
+    acc = PixelSums(32, 16, 2)
+    ones = np.ones((16, 16, 3))
+    acc.add(units[0], ones)  # tile 0, batch 0
+    acc.add(units[2], ones)  # tile 0, batch 1: two passes ahead of tile 1: waits
+    acc.add(units[5], ones)  # tile 1, batch 2: its batches 0 and 1 are not there
+    assert acc.passes == 0 and len(acc._waiting) == 2
+    acc.add(units[1], ones)  # tile 1, batch 0: pass 0 finished, tile 0's batch 1 added
+    assert acc.passes == 1 and list(acc._waiting) == [(1, 2)]
     acc.finish()
-    np.testing.assert_array_equal(acc.total, 5.0)
-    np.testing.assert_array_equal(acc.counts, 2)
+    assert not acc._waiting
+    np.testing.assert_array_equal(acc.counts[:, :16], 2)
+    np.testing.assert_array_equal(acc.counts[:, 16:], 1)
+
+
+def interrupt_at(opcode: int):
+    """A tracer raising KeyboardInterrupt (a Ctrl-C's) before the opcode-th bytecode
+    that PixelSums' own methods execute, counting from 1."""
+    seen = 0
+
+    def tracer(frame, event, arg):
+        nonlocal seen
+        if event == "call":
+            if frame.f_code.co_qualname.split(".")[0] != "PixelSums":
+                return None
+            frame.f_trace_opcodes = True
+            return tracer
+        if event == "opcode":
+            seen += 1
+            if seen == opcode:
+                raise KeyboardInterrupt
+        return tracer
+
+    return tracer
+
+
+def test_pixel_sums_keep_every_sum_with_its_count_whatever_bytecode_ctrl_c_cuts():
+    """Ctrl-C raises KeyboardInterrupt between any two bytecodes, also inside
+    PixelSums.add; after it, each pixel's sum must be that of as many batches as its
+    count says, and every count within a pass of the others. Batch b of 1 spp adds
+    2**b, so a sum names the batches in it."""
+    units = plan_units(32, 16, 3)  # 2 tiles x batches 0, 1, 2
+    order = [units[i] for i in (0, 3, 1, 5, 4, 2)]  # tile 0: batch 2 before batch 1
+    for opcode in range(1, 10_000):
+        acc = PixelSums(32, 16, 2)
+        sys.settrace(interrupt_at(opcode))
+        try:
+            for unit in order:
+                acc.add(unit, np.full((unit.y1 - unit.y0, unit.x1 - unit.x0, 3), 2.0**unit.batch))
+        except KeyboardInterrupt:
+            interrupted = True
+        else:
+            interrupted = False
+        finally:
+            sys.settrace(None)
+        acc.finish()
+        counts = [[int(b).bit_count() for b in row] for row in acc.total[..., 0]]
+        np.testing.assert_array_equal(acc.counts, counts, err_msg=f"cut at bytecode {opcode}")
+        assert acc.counts.max() - acc.counts.min() <= 1, f"cut at bytecode {opcode}"
+        if not interrupted:
+            assert opcode > 100 and (acc.counts == 3).all()  # every cut was tried
+            break
 
 
 def test_more_workers_than_units_start_no_idle_process(monkeypatch):

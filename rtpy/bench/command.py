@@ -12,6 +12,7 @@ from ..io.outputs import check_folder
 from ..io.scene_file import SceneError
 from ..render_settings import SETTINGS, SettingError
 from ..sampler import SAMPLERS
+from ..signals import exit_status
 from ..testing.analytic_scenes import ANALYTIC_SCENES
 from ..testing.reference import DEFAULT_REFERENCE_SPP
 from .report import format_sampler_efficiency, format_series, format_table, plot, write_outputs
@@ -137,8 +138,8 @@ def _options(args: argparse.Namespace) -> dict:
 
 def command_bench(args: argparse.Namespace) -> int:
     """Run the bench, print its tables, write its files; 2 for bad options (nothing
-    written), 1 when a file cannot be written, 130 when Ctrl-C stopped it (what was
-    measured is written)."""
+    written), 1 when a file cannot be written, 130 when Ctrl-C stopped it and 143
+    when SIGTERM did (what was measured is written)."""
 
     def log(msg: str) -> None:
         print(msg, file=sys.stderr)
@@ -149,10 +150,7 @@ def command_bench(args: argparse.Namespace) -> int:
     except (BenchUsageError, SceneError) as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return 2
-    if result.interrupted:
-        import signal
-
-        signal.signal(signal.SIGINT, signal.SIG_DFL)  # a second Ctrl-C ends at once
+    if result.interrupted:  # a second signal ends at once (rtpy.signals)
         log(f"rtpy bench: interrupted: keeping the {len(result.levels)} levels measured")
     if result.levels:
         print(format_table(result))
@@ -175,4 +173,4 @@ def command_bench(args: argparse.Namespace) -> int:
     else:
         files.append(png)
     log("rtpy bench: wrote " + ", ".join(str(p) for p in files))
-    return 130 if result.interrupted else 0
+    return exit_status() if result.interrupted else 0

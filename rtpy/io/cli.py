@@ -4,19 +4,27 @@ other commands are in rtpy.io.cli_assignment and rtpy.bench.command.
 Exit status: 0 done, 1 the work failed: the worker processes (nothing is written) or
 writing an output (disk full, file too large, I/O error: one line naming the file; an
 output that was there is untouched), 2 bad input (scene file, option or output path;
-nothing is written), 130 interrupted by Ctrl-C (what was finished is written first).
+nothing is written), 130 interrupted by Ctrl-C (SIGINT) and 143 by SIGTERM (the
+passes finished are written first; rtpy.signals).
 """
 
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
 import tomllib
 import warnings
 from pathlib import Path
 
 from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
+from ..signals import (
+    NOTHING_WRITTEN,
+    caused_by_interrupt,
+    finishing,
+    received,
+    stop_on_signals,
+    stopped,
+)
 from ..workers import WorkerError, available_cpus
 from .cli_assignment import add_assignment_commands
 from .image import OutputError, WriteError, check_image_path, check_linear_path
@@ -25,7 +33,6 @@ from .outputs import check_output
 EXIT_WORKERS_FAILED = 1
 EXIT_WRITE_FAILED = 1
 EXIT_BAD_INPUT = 2
-EXIT_INTERRUPTED = 130
 
 
 MAX_WORKERS = 256  # more processes than that only exhaust the machine
@@ -261,38 +268,13 @@ def command_scenes() -> int:
     return 0
 
 
-def _first_ctrl_c(signum, frame) -> None:
-    """Ctrl-C: stop the render (the renderer keeps what is finished); a second one
-    exits at once."""
-    signal.signal(signal.SIGINT, _second_ctrl_c)
-    raise KeyboardInterrupt
-
-
-def _second_ctrl_c(signum, frame) -> None:
-    """A second Ctrl-C exits at once, without waiting for the partial image to be
-    written: worker processes are killed, temporary files removed (an output file
-    is either complete or not there)."""
-    import multiprocessing
-    import os
-
-    from .image import remove_temporary_files
-
-    for child in multiprocessing.active_children():
-        child.kill()
-    remove_temporary_files()
-    os.write(2, b"\nrtpy: interrupted again: stopped at once\n")
-    os._exit(EXIT_INTERRUPTED)
-
-
 def command_render(args: argparse.Namespace) -> int:
-    previous = signal.signal(signal.SIGINT, _first_ctrl_c)
     try:
         return _render(args)
-    except KeyboardInterrupt:  # before or after the render, while loading or writing
-        print("rtpy: interrupted (no file is left half-written)", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    finally:
-        signal.signal(signal.SIGINT, previous)
+    except BaseException as err:  # while loading, or before the render started
+        if not caused_by_interrupt(err):
+            raise
+        return stopped(NOTHING_WRITTEN)
 
 
 def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
@@ -349,11 +331,15 @@ def _render(args: argparse.Namespace) -> int:
             **overrides,
         )
     except WorkerError as err:
+        if received() is not None:  # the signal ended the workers too
+            raise KeyboardInterrupt from None
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_WORKERS_FAILED
     except WriteError as err:  # a preview
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_WRITE_FAILED
+    if image.interrupted and image.samples_min == 0:
+        return stopped("interrupted before a pass over the image finished: nothing was written")
     if image.interrupted:
         print(
             "rtpy: interrupted: writing the samples finished so far "
@@ -362,24 +348,23 @@ def _render(args: argparse.Namespace) -> int:
             flush=True,
         )
 
-    # A Ctrl-C while the image is written (after a complete render) leaves no file:
-    # writes are atomic. After a first Ctrl-C, a second one ends at once.
+    # The image in hand is written whole, even after a signal (a second one ends at
+    # once, leaving no file half-written: rtpy.signals).
     try:
-        written = [image.save(output)]
-        if linear is not None:
-            written.append(image.save(linear))
+        with finishing():
+            written = [image.save(path) for path in (output, linear) if path is not None]
     except WriteError as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_WRITE_FAILED
     stats = image.stats
     files = ", ".join(str(p) for p in written)
     if image.interrupted:
-        print(
-            f"rtpy: interrupted: wrote {files} holding {image.samples_min}-{image.samples_max} "
-            f"of {image.spp} samples per pixel",
-            file=sys.stderr,
+        return stopped(
+            f"interrupted: wrote {files} holding {image.samples_min}-{image.samples_max} "
+            f"of {image.spp} samples per pixel"
         )
-        return EXIT_INTERRUPTED
+    if received() is not None:  # while writing the finished image
+        return stopped(f"interrupted while writing: wrote {files}, complete")
     print(
         f"rtpy: wrote {files}: {image.width}x{image.height}, {image.spp} spp, "
         f"{stats['seconds']:.2f} s, {stats['paths_per_second']:,.0f} paths/s",
@@ -390,13 +375,27 @@ def _render(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None, prog: str = "rtpy") -> int:
     """Run the command line `argv` (default sys.argv[1:]); `prog` names the program in
-    usage lines and errors (`python -m rtpy` passes its own). Returns the exit status."""
+    usage lines and errors (`python -m rtpy` passes its own). Returns the exit status.
+    SIGINT and SIGTERM stop the command (rtpy.signals)."""
     argv = sys.argv[1:] if argv is None else argv
     parser = build_parser(prog, every_command=argv[:1] not in (["render"], ["scenes"]))
     if not argv:
         parser.print_help()
         return 0
     args = parser.parse_args(argv)  # usage errors exit with status 2
+    try:
+        with stop_on_signals():
+            return _run_command(args)
+    except Exception as err:
+        if not caused_by_interrupt(err):
+            raise
+        return stopped("interrupted")
+    except KeyboardInterrupt:  # in a command that does not handle it
+        return stopped(NOTHING_WRITTEN if args.command in ("render", "scenes") else "interrupted")
+
+
+def _run_command(args: argparse.Namespace) -> int:
+    """Run the command `args` holds (parsed by build_parser's parser)."""
     if args.command == "scenes":
         return command_scenes()
     if args.command == "bench":

@@ -162,7 +162,7 @@ def _new_temporary_file(target: Path) -> Path:
             return tmp
         except FileExistsError:
             _temporary_files.discard(tmp)
-        except BaseException:
+        except OSError:  # not created (on a KeyboardInterrupt it may be: it stays listed)
             _temporary_files.discard(tmp)
             raise
 

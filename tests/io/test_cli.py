@@ -211,11 +211,10 @@ def start_render(*args: str) -> subprocess.Popen:
     return subprocess.Popen(rtpy_command("render", *args), stderr=subprocess.PIPE, text=True)
 
 
-def some_paths_done(seen: str) -> bool:
-    """The progress bar shows at least 1% of the samples finished: more than the first
-    units, which may cover only the image's top row (black in the Cornell box)."""
+def percent_done(seen: str) -> int:
+    """The share of the samples the progress bar shows finished, in percent."""
     done = re.findall(r"(\d+)%\|", seen.rsplit("\r", 1)[-1])
-    return "path" in seen and bool(done) and int(done[-1]) >= 1
+    return int(done[-1]) if "path" in seen and done else 0
 
 
 def wait_for_exit(pid: int, timeout: float = 60) -> bool:
@@ -239,12 +238,13 @@ def test_ctrl_c_writes_the_finished_samples(tmp_path, workers, backend):
     """SIGINT to a real render once samples are finished: it stops, writes a valid
     image of the samples finished so far, says how many, and exits with 130."""
     out = tmp_path / "partial.png"
-    spp = "256" if backend == "scalar" else "20000"
+    spp = "16" if backend == "scalar" else "20000"  # scalar: 8 passes of 2 spp
     proc = start_render(
         "cornell", "--width", "48", "--spp", spp, "--workers", workers, "--backend", backend,
         "-o", str(out),
     )  # fmt: skip
-    seen = read_until(proc, some_paths_done)
+    # two passes of the scalar's 8; 1% of 20000 spp is 7 of the numpy's passes of 28
+    seen = read_until(proc, lambda text: percent_done(text) >= (25 if spp == "16" else 1))
     proc.send_signal(signal.SIGINT)
     _, rest = proc.communicate(timeout=60)
     assert proc.returncode == 130, seen + rest
@@ -264,17 +264,18 @@ def test_second_ctrl_c_exits_at_once(tmp_path, workers):
 
     After the first Ctrl-C the command says on stderr that it writes the partial
     image; the second SIGINT is sent when that line is read, while this 3000x3000
-    image (PNG and .npy, seconds to write) is being written. The naive handling
-    (Python's default KeyboardInterrupt, or SIG_DFL set once the render returns)
-    either prints a traceback from wherever the second signal lands, or dies inside
-    the write and leaves its temporary file behind; waiting for the write would
-    leave the complete files."""
+    image (PNG and .npy, seconds to write) is being written; its first pass (1 spp,
+    depth 1: cheap paths) must have finished for anything to be written. The naive
+    handling (Python's default KeyboardInterrupt, or SIG_DFL set once the render
+    returns) either prints a traceback from wherever the second signal lands, or dies
+    inside the write and leaves its temporary file behind; waiting for the write
+    would leave the complete files."""
     out = tmp_path / "big.png"
     proc = start_render(
-        "cornell", "--width", "3000", "--spp", "64", "--backend", "numpy",
+        "cornell", "--width", "3000", "--spp", "8", "--max-depth", "1", "--backend", "numpy",
         "--workers", workers, "-o", str(out), "--linear", str(tmp_path / "big.npy"),
     )  # fmt: skip
-    read_until(proc, some_paths_done)
+    read_until(proc, lambda text: percent_done(text) >= 13)  # a pass of 1 spp finished
     ps = subprocess.run(["ps", "-o", "pid=", "--ppid", str(proc.pid)], capture_output=True)
     workers_pids = [int(p) for p in ps.stdout.split()]
     assert len(workers_pids) == (2 if workers == "2" else 0)
