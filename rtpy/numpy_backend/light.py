@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..hittable import MIN_LIGHT_DISTANCE2
 from .arrays import dot, put_rows, rows, where_rows
 from .materials.diffuse_light import DiffuseLightKernel
 from .vec3 import rows_of
@@ -142,8 +143,9 @@ class LightTable:
         q = self.point_position[choice[idx]]
         dv = q - p[idx]
         dist2 = dot(dv, dv)
-        ok = dist2 != 0.0
-        with np.errstate(divide="ignore", invalid="ignore"):
+        ok = dist2 >= MIN_LIGHT_DISTANCE2
+        # Rows too near the light (not ok) may divide by ~0 here; they stay invalid.
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             dist = np.sqrt(dist2)
             out.direction[idx] = dv / dist[:, None]
             out.radiance[idx] = self.point_intensity[choice[idx]] * (1.0 / dist2)[:, None]
