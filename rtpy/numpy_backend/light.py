@@ -144,12 +144,12 @@ class LightTable:
         dv = q - p[idx]
         dist2 = dot(dv, dv)
         ok = dist2 >= MIN_LIGHT_DISTANCE2
-        # Rows too near the light (not ok) may divide by ~0 here; they stay invalid.
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            dist = np.sqrt(dist2)
-            out.direction[idx] = dv / dist[:, None]
-            out.radiance[idx] = self.point_intensity[choice[idx]] * (1.0 / dist2)[:, None]
-        out.distance[idx] = dist
+        # Rows too near the light divide by 1 instead of ~0: they stay invalid, with
+        # finite numbers (NaN or inf there would spread through the masked arithmetic).
+        safe2 = np.where(ok, dist2, 1.0)
+        out.direction[idx] = dv / np.sqrt(safe2)[:, None]
+        out.radiance[idx] = self.point_intensity[choice[idx]] * (1.0 / safe2)[:, None]
+        out.distance[idx] = np.sqrt(dist2)
         out.pdf[idx] = 1.0
         out.point[idx] = q
         out.valid[idx] = ok
