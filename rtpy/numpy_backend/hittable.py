@@ -179,7 +179,8 @@ def area_direction(
     dv = point - p
     dist2 = dot(dv, dv)
     valid = dist2 >= MIN_LIGHT_DISTANCE2
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # Invalid rows (too near, grazing) may divide by ~0 here; np.where discards them.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         k = 1.0 / np.sqrt(dist2)
         direction = scale(dv, k)
         cos_light = np.abs(dot(direction, normal))

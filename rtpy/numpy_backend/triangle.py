@@ -54,9 +54,9 @@ class TriangleSet(PlanarSet):
         return np.stack([self.a, self.a + self.e1, self.a + self.e2], 1)
 
     def _finish(self, det, parallel, u_num, v_num, t_num, t_min, t_max):
-        # det = 0 (parallel rays) makes u, v, t inf or NaN, and u + v inf - inf; the
-        # parallel test below discards those rows.
-        with np.errstate(divide="ignore", invalid="ignore"):
+        # det = 0 or subnormal (parallel rays) makes u, v, t inf or NaN, and u + v
+        # inf - inf; the parallel test below discards those rows.
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             inv = 1.0 / det
             u = u_num * inv
             v = v_num * inv

@@ -24,6 +24,7 @@ moved to the ends of the ranges.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -38,11 +39,15 @@ from rtpy import (
     Dielectric,
     DiffuseLight,
     Lambertian,
+    Mesh,
     Metal,
     PointLight,
     Quad,
     Scene,
+    SolidColor,
     Sphere,
+    Texture,
+    Transform,
     Triangle,
     Vec3,
 )
@@ -81,6 +86,14 @@ def directions(draw) -> list[float]:
     return [x / length for x in v] if length > 1e-3 else [0.0, 0.0, -1.0]
 
 
+def across(v: list[float]) -> list[float]:
+    """A unit vector perpendicular to v."""
+    axis = [0.0, 0.0, 0.0]
+    axis[min(range(3), key=lambda i: abs(v[i]))] = 1.0  # the axis most across v
+    w = cross(v, axis)
+    return scaled(w, 1.0 / norm(w))
+
+
 def offset(p: list[float], v: list[float]) -> list[float]:
     """p + v, each component of v turned toward 0 where p + v would leave the range."""
     out = []
@@ -104,10 +117,7 @@ def cameras(draw) -> dict:
     view = add(look_at, look_from, -1.0)
     vup = scaled(draw(directions()), draw(LENGTH))
     if not norm(cross(vup, view)) >= 2e-6 * norm(vup) * norm(view):
-        axis = [0.0, 0.0, 0.0]
-        axis[min(range(3), key=lambda i: abs(view[i]))] = 1.0  # the axis most across view
-        vup = cross(view, axis)
-        vup = scaled(vup, 1.0 / norm(vup))
+        vup = across(view)
     camera = {"look_from": look_from, "look_at": look_at, "vup": vup, "vfov": draw(VFOV)}
     camera |= {"aspect_ratio": 1.0, "width": 4}
     if draw(st.booleans()):
@@ -158,13 +168,49 @@ def fit_edges(q: list[float], edges: list[list[float]]) -> tuple[list[float], li
     return [min(hi[i], max(lo[i], q[i])) for i in range(3)], edges
 
 
+# A tetrahedron with vertex normals in the unit cube: the mesh the scenes place.
+TETRAHEDRON = """\
+v 0 0 0
+v 1 0 0
+v 0 1 0
+v 0 0 1
+vn -1 -1 -1
+vn 1 0 0
+vn 0 1 0
+vn 0 0 1
+f 1//1 3//3 2//2
+f 1//1 2//2 4//4
+f 1//1 4//4 3//3
+f 2//2 3//3 4//4
+"""
+MESH_SCALE = 5e5  # the tetrahedron scaled by this turned any way fits in 2e6 (< sqrt(3) e6)
+
+
+@st.composite
+def meshes(draw, at: list[float], material: str) -> dict:
+    """The tetrahedron scaled by [1e-6, 5e5] on each axis, mirrored or not, turned any
+    way, with its corner moved to `at` (toward 0 where the mesh would leave the range)."""
+    signed_scale = extreme_floats(1e-6, MESH_SCALE, signed=True)
+    scale = [draw(signed_scale) for _ in range(3)]
+    rotate = draw(triple(st.floats(-360.0, 360.0)))
+    room = MAX_COORD - math.sqrt(3.0) * max(abs(x) for x in scale)
+    translate = [min(room, max(-room, x)) for x in at]
+    table = {"type": "mesh", "path": "tetrahedron.obj", "material": material}
+    return table | {"translate": translate, "rotate": rotate, "scale": scale}
+
+
 @st.composite
 def shapes(draw, anchor: list[float], material: str) -> dict:
-    """A sphere, quad or triangle at (or at any distance from) the anchor."""
+    """A sphere, quad, triangle or mesh at (or at any distance from) the anchor."""
     at = offset(anchor, scaled(draw(directions()), draw(SPAN))) if draw(st.booleans()) else anchor
-    kind = draw(st.sampled_from(["sphere", "quad", "triangle"]))
+    kind = draw(st.sampled_from(["sphere", "quad", "triangle", "mesh"]))
+    if kind == "mesh":
+        return draw(meshes(at, material))
     if kind != "sphere":
-        edges = [scaled(draw(directions()), draw(LENGTH)) for _ in range(2)]
+        du, dv = draw(directions()), draw(directions())
+        if not norm(cross(du, dv)) > 1e-3:  # parallel, as extreme directions often are
+            dv = across(du)
+        edges = [scaled(du, draw(LENGTH)), scaled(dv, draw(LENGTH))]
         q, (u, v) = fit_edges(at, edges)
         if kind == "quad" and norm(cross(u, v)) >= 2e-12 and min(norm(u), norm(v)) >= 1e-6:
             return {"type": "quad", "q": q, "u": u, "v": v, "material": material}
@@ -179,7 +225,7 @@ def scene_files(draw) -> dict:
     """A parsed scene file with every number at the extremes of its range."""
     camera = draw(cameras())
     anchors = [camera["look_from"], camera["look_at"], draw(triple(COORD))]
-    textures = {}
+    textures = {"plain": {"type": "solid", "color": draw(triple(REFLECTANCE))}}
     if draw(st.booleans()):
         even, odd = draw(triple(REFLECTANCE)), draw(triple(REFLECTANCE))
         textures["board"] = {"type": "checker", "scale": draw(LENGTH), "even": even, "odd": odd}
@@ -200,14 +246,32 @@ def scene_files(draw) -> dict:
     }
     render |= {"sky": True} if draw(st.booleans()) else {"background": draw(triple(RADIANCE))}
     data = {"camera": camera, "render": render, "materials": mats, "objects": objects}
-    if textures:
-        data["textures"] = textures
+    data["textures"] = textures
     if lights:
         data["lights"] = lights
     return data
 
 
-def build(data: dict) -> Scene:
+def texture(table: dict) -> Texture:
+    if table["type"] == "solid":
+        return SolidColor(Color(*table["color"]))
+    return CheckerTexture(table["scale"], Color(*table["even"]), Color(*table["odd"]))
+
+
+def shape(table: dict, material, folder: Path) -> list:
+    """The objects of an [[objects]] table, built through the Python API."""
+    V = Vec3
+    if table["type"] == "sphere":
+        return [Sphere(V(*table["center"]), table["radius"], material)]
+    if table["type"] == "quad":
+        return [Quad(V(*table["q"]), V(*table["u"]), V(*table["v"]), material)]
+    if table["type"] == "triangle":
+        return [Triangle(V(*table["a"]), V(*table["b"]), V(*table["c"]), material)]
+    place = Transform(*(V(*table[k]) for k in ("translate", "rotate", "scale")))
+    return Mesh.from_obj(folder / table["path"], material, place).triangles
+
+
+def build(data: dict, folder: Path) -> Scene:
     """The scene of a parsed scene file, built through the Python API."""
     V = Vec3
 
@@ -216,23 +280,12 @@ def build(data: dict) -> Scene:
             return textures[x]
         return Color(*x) if isinstance(x, list) else x
 
-    textures = {
-        name: CheckerTexture(t["scale"], Color(*t["even"]), Color(*t["odd"]))
-        for name, t in data.get("textures", {}).items()
-    }
+    textures = {name: texture(t) for name, t in data["textures"].items()}
     mats = {
         name: MATERIALS[t["type"]](**{k: value(x) for k, x in t.items() if k != "type"})
         for name, t in data["materials"].items()
     }
-    objects = []
-    for o in data["objects"]:
-        m = mats[o["material"]]
-        if o["type"] == "sphere":
-            objects.append(Sphere(V(*o["center"]), o["radius"], m))
-        elif o["type"] == "quad":
-            objects.append(Quad(V(*o["q"]), V(*o["u"]), V(*o["v"]), m))
-        else:
-            objects.append(Triangle(V(*o["a"]), V(*o["b"]), V(*o["c"]), m))
+    objects = [x for o in data["objects"] for x in shape(o, mats[o["material"]], folder)]
     lights = [PointLight(V(*p["position"]), Color(*p["intensity"])) for p in data.get("lights", [])]
     c = data["camera"]
     camera = Camera(
@@ -264,39 +317,47 @@ def extreme(examples: int) -> settings:
     )
 
 
-def check_scene_file(data: dict, tmp_path) -> None:
+def check_scene_file(data: dict, folder: Path) -> None:
     text = to_toml(data)
-    assert_renders_finite(load_scene_text(text, tmp_path / "extreme.toml"), text)
+    assert_renders_finite(load_scene_text(text, folder / "extreme.toml"), text)
 
 
-def check_python_api(data: dict) -> None:
-    assert_renders_finite(build(data), repr(data))
+def check_python_api(data: dict, folder: Path) -> None:
+    assert_renders_finite(build(data, folder), repr(data))
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory) -> Path:
+    """Where the scenes are: the tetrahedron's OBJ file is there."""
+    path = tmp_path_factory.mktemp("extreme")
+    (path / "tetrahedron.obj").write_text(TETRAHEDRON)
+    return path
 
 
 @extreme(20)
 @given(data=scene_files())
-def test_extreme_scene_files_render_finite_pixels(tmp_path_factory, data):
-    check_scene_file(data, tmp_path_factory.mktemp("extreme"))
+def test_extreme_scene_files_render_finite_pixels(folder, data):
+    check_scene_file(data, folder)
 
 
 @extreme(20)
 @given(data=scene_files())
-def test_extreme_scenes_built_in_python_render_finite_pixels(data):
-    check_python_api(data)
+def test_extreme_scenes_built_in_python_render_finite_pixels(folder, data):
+    check_python_api(data, folder)
 
 
 @pytest.mark.slow
 @extreme(150)
 @given(data=scene_files())
-def test_more_extreme_scene_files_render_finite_pixels(tmp_path_factory, data):
-    check_scene_file(data, tmp_path_factory.mktemp("extreme"))
+def test_more_extreme_scene_files_render_finite_pixels(folder, data):
+    check_scene_file(data, folder)
 
 
 @pytest.mark.slow
 @extreme(150)
 @given(data=scene_files())
-def test_more_extreme_scenes_built_in_python_render_finite_pixels(data):
-    check_python_api(data)
+def test_more_extreme_scenes_built_in_python_render_finite_pixels(folder, data):
+    check_python_api(data, folder)
 
 
 # --- the issue's examples, moved to the ends of the ranges -----------------------
