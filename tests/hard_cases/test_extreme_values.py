@@ -56,6 +56,7 @@ from rtpy.io.scene_file import load_scene_text
 from rtpy.materials import MATERIALS, BlinnPhong, Phong, RoughDielectric, Ward
 from rtpy.render_settings import INTEGRATOR_NAMES
 from tests.io.scene_text import to_toml
+from tests.io.test_scene_file import TETRA
 from tests.strategies import SMALLEST, extreme_floats
 
 from .scene_strategies import add, cross, norm
@@ -169,22 +170,10 @@ def fit_edges(q: list[float], edges: list[list[float]]) -> tuple[list[float], li
     return [min(hi[i], max(lo[i], q[i])) for i in range(3)], edges
 
 
-# A tetrahedron with vertex normals in the unit cube: the mesh the scenes place.
-TETRAHEDRON = """\
-v 0 0 0
-v 1 0 0
-v 0 1 0
-v 0 0 1
-vn -1 -1 -1
-vn 1 0 0
-vn 0 1 0
-vn 0 0 1
-f 1//1 3//3 2//2
-f 1//1 2//2 4//4
-f 1//1 4//4 3//3
-f 2//2 3//3 4//4
-"""
-MESH_SCALE = 5e5  # the tetrahedron scaled by this turned any way fits in 2e6 (< sqrt(3) e6)
+# The mesh the scenes place is TETRA, a tetrahedron in the unit cube with one face
+# smooth-shaded. Scaled by at most this per axis and turned any way, its vertices lie
+# within sqrt(3) * 5e5 of the translate.
+MESH_SCALE = 5e5
 
 
 @st.composite
@@ -331,7 +320,7 @@ def check_python_api(data: dict, folder: Path) -> None:
 def folder(tmp_path_factory) -> Path:
     """Where the scenes are: the tetrahedron's OBJ file is there."""
     path = tmp_path_factory.mktemp("extreme")
-    (path / "tetrahedron.obj").write_text(TETRAHEDRON)
+    (path / "tetrahedron.obj").write_text(TETRA)
     return path
 
 
