@@ -324,27 +324,27 @@ def folder(tmp_path_factory) -> Path:
     return path
 
 
-@extreme(6)
+@extreme(15)
 @given(data=scene_files())
 def test_extreme_scene_files_render_finite_pixels(folder, data):
     check_scene_file(data, folder)
 
 
-@extreme(6)
+@extreme(15)
 @given(data=scene_files())
 def test_extreme_scenes_built_in_python_render_finite_pixels(folder, data):
     check_python_api(data, folder)
 
 
 @pytest.mark.slow
-@extreme(100)
+@extreme(150)
 @given(data=scene_files())
 def test_more_extreme_scene_files_render_finite_pixels(folder, data):
     check_scene_file(data, folder)
 
 
 @pytest.mark.slow
-@extreme(100)
+@extreme(150)
 @given(data=scene_files())
 def test_more_extreme_scenes_built_in_python_render_finite_pixels(folder, data):
     check_python_api(data, folder)
@@ -457,32 +457,8 @@ def issue_examples():
 
 
 EXAMPLES = dict(issue_examples())
-# One example of each kind in the fast tier; the other models and ends in the slow one.
-FAST_EXAMPLES = {
-    "sphere light r=1e-6, emit 1e9, 1e6 away",
-    "quad light of 1e-6 edges, emit 1e9",
-    "point light 1e-6 above a floor",
-    "point light at the eye in a 1e-6 sphere",
-    "Phong at grazing angles",
-    "cook_torrance ggx at grazing angles",
-    "dielectric 100.0 seen from outside",
-    "rough_dielectric 0.01 ggx seen from inside",
-    "radius 1e-6 at coordinates 1e6",
-    "checker scale 1e-6 at coordinates 1e6",
-    "focus distance 1e-06, defocus 179",
-}
 
 
-@pytest.mark.parametrize(
-    "name",
-    [
-        name if name in FAST_EXAMPLES else pytest.param(name, marks=pytest.mark.slow)
-        for name in EXAMPLES
-    ],
-)
+@pytest.mark.parametrize("name", EXAMPLES)
 def test_issue_examples_at_the_ends_of_the_ranges_render_finite_pixels(name):
     assert_renders_finite(EXAMPLES[name], name)
-
-
-def test_every_fast_example_is_an_example():
-    assert FAST_EXAMPLES <= set(EXAMPLES)
