@@ -10,11 +10,11 @@ from .interval import Interval
 from .ray import Ray
 from .vec3 import Vec3
 
-# Light sampling skips a receiving point nearer the sampled light point than 1e-50
-# (squared 1e-100), as if it were that point: the 1 / d^2 of the light's radiance
-# (point lights) or of the sample's weight (area lights) would exceed 1e100 there, and
-# times the brightest radiance and BRDF the scene format allows it overflows; below
-# d^2 = 1e-308 it is inf outright.
+# Light sampling gives no sample to a receiving point nearer than 1e-50 (d^2 < 1e-100)
+# to the point it samples on a light, as to that point itself: there the 1 / d^2 of a
+# point light's radiance or of an area light sample's weight exceeds 1e100, which times
+# the brightest radiance and BRDF the scene format allows overflows (and below
+# d^2 ~ 1e-308 it is inf outright).
 MIN_LIGHT_DISTANCE2 = 1e-100
 
 if TYPE_CHECKING:
