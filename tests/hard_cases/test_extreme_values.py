@@ -28,7 +28,7 @@ import math
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, find, given, settings
 from hypothesis import strategies as st
 
 import rtpy
@@ -74,6 +74,26 @@ VFOV = extreme_floats(1e-3, 179.0)
 DEFOCUS = extreme_floats(SMALLEST, 179.0, zero=True)
 # Distances from an anchor to a light or an object's corner: every magnitude.
 SPAN = extreme_floats(SMALLEST, 2.0 * MAX_COORD)
+
+
+@settings(max_examples=100)
+@given(COORD, LENGTH)
+def test_extreme_floats_stay_in_their_ranges(coordinate, length):
+    assert -MAX_COORD <= coordinate <= MAX_COORD and 1e-6 <= length <= 1e6
+
+
+@pytest.mark.parametrize(
+    "wanted",
+    [
+        lambda x: 0.0 < abs(x) < 2.2e-308,
+        lambda x: 1e-200 < -x < 1e-100,
+        lambda x: x == -MAX_COORD,
+        lambda x: math.copysign(1.0, x) < 0.0 and x == 0.0,
+    ],
+    ids=["subnormal", "negative 1e-150", "the end -1e6", "-0.0"],
+)
+def test_extreme_floats_reach_every_magnitude(wanted):
+    find(COORD, wanted, settings=settings(database=None))
 
 
 def triple(values: st.SearchStrategy[float]) -> st.SearchStrategy[list[float]]:
