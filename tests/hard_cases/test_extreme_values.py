@@ -72,11 +72,12 @@ ROUGHNESS = extreme_floats(1e-4, 1.0)
 IOR = extreme_floats(1e-2, 100.0)
 VFOV = extreme_floats(1e-3, 179.0)
 DEFOCUS = extreme_floats(SMALLEST, 179.0, zero=True)
+ASPECT = extreme_floats(0.5, 4.0)  # 4 pixels wide, 1 to 8 high
 # Distances from an anchor to a light or an object's corner: every magnitude.
 SPAN = extreme_floats(SMALLEST, 2.0 * MAX_COORD)
 
 
-@settings(max_examples=100)
+@settings(max_examples=50)
 @given(COORD, LENGTH)
 def test_extreme_floats_stay_in_their_ranges(coordinate, length):
     assert -MAX_COORD <= coordinate <= MAX_COORD and 1e-6 <= length <= 1e6
@@ -141,7 +142,7 @@ def cameras(draw) -> dict:
     if not norm(cross(vup, view)) >= 2e-6 * norm(vup) * norm(view):
         vup = across(view)
     camera = {"look_from": look_from, "look_at": look_at, "vup": vup, "vfov": draw(VFOV)}
-    camera |= {"aspect_ratio": 1.0, "width": 4}
+    camera |= {"aspect_ratio": draw(ASPECT), "width": 4}
     if draw(st.booleans()):
         camera |= {"defocus_angle": draw(DEFOCUS), "focus_distance": draw(LENGTH)}
     return camera
@@ -299,8 +300,8 @@ def build(data: dict, folder: Path) -> Scene:
     lights = [PointLight(V(*p["position"]), Color(*p["intensity"])) for p in data.get("lights", [])]
     c = data["camera"]
     camera = Camera(
-        V(*c["look_from"]), V(*c["look_at"]), V(*c["vup"]), c["vfov"], 1.0, c["width"],
-        c.get("defocus_angle", 0.0), c.get("focus_distance", 10.0),
+        V(*c["look_from"]), V(*c["look_at"]), V(*c["vup"]), c["vfov"], c["aspect_ratio"],
+        c["width"], c.get("defocus_angle", 0.0), c.get("focus_distance", 10.0),
     )  # fmt: skip
     r = data["render"]
     background = Color(*r.get("background", [0.0, 0.0, 0.0]))
@@ -344,27 +345,27 @@ def folder(tmp_path_factory) -> Path:
     return path
 
 
-@extreme(15)
+@extreme(10)
 @given(data=scene_files())
 def test_extreme_scene_files_render_finite_pixels(folder, data):
     check_scene_file(data, folder)
 
 
-@extreme(15)
+@extreme(10)
 @given(data=scene_files())
 def test_extreme_scenes_built_in_python_render_finite_pixels(folder, data):
     check_python_api(data, folder)
 
 
 @pytest.mark.slow
-@extreme(150)
+@extreme(120)
 @given(data=scene_files())
 def test_more_extreme_scene_files_render_finite_pixels(folder, data):
     check_scene_file(data, folder)
 
 
 @pytest.mark.slow
-@extreme(150)
+@extreme(120)
 @given(data=scene_files())
 def test_more_extreme_scenes_built_in_python_render_finite_pixels(folder, data):
     check_python_api(data, folder)
