@@ -10,6 +10,13 @@ from .interval import Interval
 from .ray import Ray
 from .vec3 import Vec3
 
+# Light sampling gives no sample to a receiving point nearer than 1e-50 (d^2 < 1e-100)
+# to the point it samples on a light, as to that point itself: there the 1 / d^2 of a
+# point light's radiance or of an area light sample's weight exceeds 1e100, which times
+# the brightest radiance and BRDF the scene format allows overflows (and below
+# d^2 ~ 1e-308 it is inf outright).
+MIN_LIGHT_DISTANCE2 = 1e-100
+
 if TYPE_CHECKING:
     from .bvh import AABB
     from .materials.material import Material
@@ -82,7 +89,7 @@ class Hittable:
         point, normal = self.sample_point(r1, r2)
         dx, dy, dz = point.e0 - p.e0, point.e1 - p.e1, point.e2 - p.e2
         dist2 = dx * dx + dy * dy + dz * dz
-        if dist2 == 0.0:
+        if dist2 < MIN_LIGHT_DISTANCE2:
             return None
         k = 1.0 / math.sqrt(dist2)
         direction = Vec3(dx * k, dy * k, dz * k)
@@ -114,7 +121,7 @@ class Hittable:
         q, n = hit.point, hit.normal
         dx, dy, dz = q.e0 - p.e0, q.e1 - p.e1, q.e2 - p.e2
         dist2 = dx * dx + dy * dy + dz * dz
-        if dist2 == 0.0:
+        if dist2 < MIN_LIGHT_DISTANCE2:  # never sampled (sample_direction)
             return 0.0
         cos_light = abs(dx * n.e0 + dy * n.e1 + dz * n.e2) / math.sqrt(dist2)
         if cos_light < 1e-12:

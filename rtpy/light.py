@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 from .hit_info import HitInfo
-from .hittable import Hittable
+from .hittable import MIN_LIGHT_DISTANCE2, Hittable
 from .io.values import RADIANCE, checked_color, checked_point
 from .sampling import generator
 from .vec3 import Color, Vec3
@@ -61,12 +61,12 @@ class PointLight(Light):
         """The light seen from p: the unit direction from p toward the light, the
         distance d, the radiance I / d^2 arriving at p, pdf 1 and is_delta True (one
         direction only), and the light's position as the sampled point; None when p
-        is the light's position."""
+        is the light's position, or nearer it than sqrt(MIN_LIGHT_DISTANCE2)."""
         # BEGIN SOLUTION week05: direction, distance and radiance I / d^2 seen from p
         to_light = self.position - p
         dist2 = to_light.length_squared()
-        if dist2 == 0.0:
-            return None
+        if dist2 < MIN_LIGHT_DISTANCE2:
+            return None  # at the light: I / d^2 would overflow
         dist = math.sqrt(dist2)
         return LightSample(to_light / dist, dist, self.intensity / dist2, 1.0, True, self.position)
         # END SOLUTION

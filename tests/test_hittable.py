@@ -85,6 +85,20 @@ def test_light_sampling_converts_the_area_density_to_solid_angle(p):
         assert floor.direction_pdf(V(*p), hit) == pytest.approx(expected_pdf, rel=1e-12)
 
 
+def test_points_nearer_the_sampled_point_than_the_least_distance_give_no_sample():
+    """At 1e-160 from the sampled point the pdf d^2 / (|cos| area) is 1e-320, a
+    subnormal, and the sample's weight 1 / pdf inf; such points are not sampled, and
+    direction_pdf gives them density 0, as sample_direction does."""
+    floor = Floor()
+    for height in (1e-160, 1e-51):
+        p = V(1.0, height, 1.0)  # above the point that (0.5, 0.5) samples
+        assert floor.sample_direction(p, 0.5, 0.5) is None
+        hit = HitInfo(V(1.0, 0.0, 1.0), V(0, 1, 0), height, True, floor.material, floor)
+        assert floor.direction_pdf(p, hit) == 0.0
+    direction, pdf = floor.sample_direction(V(1.0, 1e-49, 1.0), 0.5, 0.5)
+    assert direction.tolist() == [0.0, -1.0, 0.0] and pdf == pytest.approx(1e-98 / 4.0)
+
+
 def test_points_in_the_lights_plane_give_no_sample():
     floor = Floor()
     assert floor.sample_direction(V(5.0, 0.0, 1.0), 0.5, 0.5) is None

@@ -47,6 +47,17 @@ def test_point_light_at_the_receiving_point_gives_nothing():
     assert PointLight(V(1, 1, 1), Color(1, 1, 1)).sample(V(1, 1, 1)) is None
 
 
+@pytest.mark.parametrize("distance", [1e-160, 1e-51])
+def test_point_light_nearer_than_the_least_distance_gives_nothing(distance):
+    """I / d^2 at d = 1e-160 is inf (d^2 underflows to a subnormal); below
+    sqrt(MIN_LIGHT_DISTANCE2) = 1e-50 the point counts as the light's position. Just
+    above it the radiance is finite and large."""
+    light = PointLight(V(0, distance, 0), Color(1e9, 1e9, 1e9))
+    assert light.sample(V(0, 0, 0)) is None
+    near = PointLight(V(0, 1e-49, 0), Color(1e9, 1e9, 1e9)).sample(V(0, 0, 0))
+    assert near.radiance.tolist() == pytest.approx([1e107] * 3, rel=1e-12)
+
+
 EMIT = Color(5.0, 4.0, 3.0)
 
 

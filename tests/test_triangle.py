@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from rtpy.hit_info import HitInfo
 from rtpy.interval import Interval
 from rtpy.io.values import MIN_AREA
 from rtpy.materials import Lambertian
@@ -106,6 +107,19 @@ def test_general_triangle_hit_has_barycentric_uv(s, t, origin):
     target = tuple(A0[i] + wb * (B0[i] - A0[i]) + wc * (C0[i] - A0[i]) for i in range(3))
     inside = wb > 1e-9 and wc > 1e-9 and wb + wc < 1 - 1e-9
     check_planar_hit(GENERAL, origin, target, cross3(sub3(B0, A0), sub3(C0, A0)), (wb, wc), inside)
+
+
+# Edges 5e5 long and 1e-6 apart at their ends: |e1|^2 |e2|^2 - (e1 . e2)^2 = 0.5
+# cancels to 0 in floating point, though the area is 0.35.
+SLIVER = Triangle(V(1, 0, 0), V(1 + 5e5, -1e-6, 0), V(1 + 5e5, 0, 1e-6), MAT)
+
+
+@pytest.mark.parametrize("wb, wc", [(0.3, 0.2), (0.0, 1.0), (1.0, 0.0), (0.5, 0.5), (0.0, 0.0)])
+def test_long_thin_triangle_has_barycentric_uv(wb, wc):
+    """The sliver's barycentric weights to ~1e-11 (the rounding of the point at 5e5)."""
+    point = SLIVER.a + SLIVER.e1 * wb + SLIVER.e2 * wc
+    hit = HitInfo(point, SLIVER.normal, 1.0, True, MAT, SLIVER)
+    assert SLIVER.surface_uv(hit) == pytest.approx((wb, wc), abs=1e-10)
 
 
 @pytest.mark.parametrize("wb, wc", [(0.6, 0.6), (-0.05, 0.5), (0.5, -0.05), (1.2, -0.1)])

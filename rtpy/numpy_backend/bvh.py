@@ -207,7 +207,7 @@ class Clusters:
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(len(o), -1, dtype=np.int64)
         oc = np.ascontiguousarray(o.T)
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", over="ignore"):  # 0 or subnormal: +-inf
             inv = 1.0 / np.ascontiguousarray(d.T)
         for p, (lo, hi, part, members) in enumerate(self.parts):
             if lo is None:
@@ -290,10 +290,11 @@ def _padded_box(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 def _enters_box(oc, inv, lo, hi, t_min: float, t_max: np.ndarray) -> np.ndarray:
     """(N,) bool: rays (origin columns oc (3, N), reciprocal direction columns inv)
     meet the box lo, hi at some t in (t_min, t_max) (slab test, one axis at a time).
-    A zero direction component gives inv = +-inf; then (lo - o) * inv is nan only for
-    an origin exactly on a slab plane, and nan comparisons count as entering."""
+    A zero (or subnormal) direction component gives inv = +-inf; then (lo - o) * inv is
+    nan only for an origin exactly on a slab plane, and nan comparisons count as
+    entering. A huge finite inv may overflow the product to +-inf likewise."""
     near = far = None
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore", over="ignore"):
         for c in range(3):
             a = (lo[c] - oc[c]) * inv[c]
             b = (hi[c] - oc[c]) * inv[c]

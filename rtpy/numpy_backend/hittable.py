@@ -22,7 +22,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..hit_info import HitInfo
-from ..hittable import Hittable
+from ..hittable import MIN_LIGHT_DISTANCE2, Hittable
 from ..ray import Ray
 from ..vec3 import Vec3
 from .arrays import at, axpy, dot, scale
@@ -178,8 +178,9 @@ def area_direction(
     direction from p to a point sampled by area, pdf = dist^2 / (|cos_light| area)."""
     dv = point - p
     dist2 = dot(dv, dv)
-    valid = dist2 != 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):
+    valid = dist2 >= MIN_LIGHT_DISTANCE2
+    # Invalid rows (too near, grazing) may divide by ~0 here; np.where discards them.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         k = 1.0 / np.sqrt(dist2)
         direction = scale(dv, k)
         cos_light = np.abs(dot(direction, normal))
@@ -197,7 +198,7 @@ def area_direction_pdf(p: np.ndarray, q: np.ndarray, n: np.ndarray, area: np.nda
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         cos_light = np.abs(dot(dv, n)) / np.sqrt(dist2)
         pdf = dist2 / (cos_light * area)
-    return np.where((dist2 == 0.0) | ~(cos_light >= 1e-12), 0.0, pdf)
+    return np.where((dist2 < MIN_LIGHT_DISTANCE2) | ~(cos_light >= 1e-12), 0.0, pdf)
 
 
 class PlanarSet(PrimitiveSet):

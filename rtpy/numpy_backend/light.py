@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..hittable import MIN_LIGHT_DISTANCE2
 from .arrays import dot, put_rows, rows, where_rows
 from .materials.diffuse_light import DiffuseLightKernel
 from .vec3 import rows_of
@@ -142,12 +143,13 @@ class LightTable:
         q = self.point_position[choice[idx]]
         dv = q - p[idx]
         dist2 = dot(dv, dv)
-        ok = dist2 != 0.0
-        with np.errstate(divide="ignore", invalid="ignore"):
-            dist = np.sqrt(dist2)
-            out.direction[idx] = dv / dist[:, None]
-            out.radiance[idx] = self.point_intensity[choice[idx]] * (1.0 / dist2)[:, None]
-        out.distance[idx] = dist
+        ok = dist2 >= MIN_LIGHT_DISTANCE2
+        # Rows too near the light divide by 1 instead of ~0: they stay invalid, with
+        # finite numbers (NaN or inf there would spread through the masked arithmetic).
+        safe2 = np.where(ok, dist2, 1.0)
+        out.direction[idx] = dv / np.sqrt(safe2)[:, None]
+        out.radiance[idx] = self.point_intensity[choice[idx]] * (1.0 / safe2)[:, None]
+        out.distance[idx] = np.sqrt(dist2)
         out.pdf[idx] = 1.0
         out.point[idx] = q
         out.valid[idx] = ok

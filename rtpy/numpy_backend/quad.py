@@ -63,7 +63,9 @@ class QuadSet(PlanarSet):
         oh = np.empty((len(o), 4))
         oh[:, :3] = o
         oh[:, 3] = 1.0
-        with np.errstate(divide="ignore", invalid="ignore"):
+        # A ray (almost) parallel to a plane meets it at t = inf or NaN (over a
+        # subnormal denominator): a miss, as every comparison below finds.
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             t = (oh @ self.Mo_n) / (d @ self.Md_n)
             if t_max is None:
                 return self._inside(oh, d, t, t_min, slice(None))
@@ -92,7 +94,7 @@ class QuadSet(PlanarSet):
     def hit_t(self, o, d, k, t_min, t_max):
         n = self.normal[k]
         A, B = self.A[k], self.B[k]
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # as in all_t
             t = (self.plane_d[k] - dot(n, o)) / dot(n, d)
             a = dot(o, A) - self.qA[k] + t * dot(d, A)
             b = dot(o, B) - self.qB[k] + t * dot(d, B)

@@ -54,12 +54,14 @@ class TriangleSet(PlanarSet):
         return np.stack([self.a, self.a + self.e1, self.a + self.e2], 1)
 
     def _finish(self, det, parallel, u_num, v_num, t_num, t_min, t_max):
-        with np.errstate(divide="ignore", invalid="ignore"):
+        # det = 0 or subnormal (parallel rays) makes u, v, t inf or NaN, and u + v
+        # inf - inf; the parallel test below discards those rows.
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             inv = 1.0 / det
             u = u_num * inv
             v = v_num * inv
             t = t_num * inv
-        ok = (det * det > parallel) & (u >= 0.0) & (u <= 1.0) & (v >= 0.0) & (u + v <= 1.0)
+            ok = (det * det > parallel) & (u >= 0.0) & (u <= 1.0) & (v >= 0.0) & (u + v <= 1.0)
         ok &= (t > t_min) & (t < t_max)
         return np.where(ok, t, INF)
 
@@ -87,14 +89,11 @@ class TriangleSet(PlanarSet):
         return self._finish(det, parallel, u_num, v_num, t_num, t_min, t_max)
 
     def surface_uv(self, k, point):
-        # Triangle.surface_uv: barycentric coordinates from dot products.
+        # Triangle.surface_uv: barycentric coordinates from cross products.
         p = point - self.a[k]
-        e1, e2 = self.e1[k], self.e2[k]
-        d00, d01, d11 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
-        d20, d21 = dot(p, e1), dot(p, e2)
-        denom = d00 * d11 - d01 * d01
-        u = (d11 * d20 - d01 * d21) / denom
-        v = (d00 * d21 - d01 * d20) / denom
+        normal, twice_area = self.normal[k], 2.0 * self._area[k]
+        u = dot(np.cross(p, self.e2[k]), normal) / twice_area
+        v = dot(np.cross(self.e1[k], p), normal) / twice_area
         return np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
 
     def shading_normal(self, k, point, geo):

@@ -780,6 +780,6 @@ def test_every_key_takes_its_range_and_refuses_the_rest(
     ("label", "path", "key", "component", "ok", "names"), KEY_CASES, ids=[c[0] for c in KEY_CASES]
 )
 @settings(max_examples=KEY_EXAMPLES, deadline=None)
-@given(x=extreme_floats())
+@given(x=extreme_floats(signed=True, zero=True, non_finite=True))
 def test_every_key_over_every_magnitude(key_scene_dir, label, path, key, component, ok, names, x):
     check_key_value(key_scene_dir, path, key, component, ok, names, x)

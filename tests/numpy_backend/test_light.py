@@ -148,6 +148,30 @@ def test_light_choice_and_point_lights():
     assert only_points.is_delta.all()
 
 
+def test_points_nearer_a_light_than_the_least_distance_give_no_sample():
+    """As the scalar PointLight.sample and Hittable.sample_direction: at 1e-160 from a
+    point light (or from the point sampled on an area light) I / d^2 and 1 / pdf are
+    inf; below 1e-50 the sample is invalid and direction_pdf 0. At 1e-49 they are
+    the scalar numbers."""
+    heights = np.array([1e-160, 1e-51, 1e-49])
+    p = np.column_stack([np.zeros(3), heights, np.zeros(3)])
+    scene = Scene([], point_lights=[PointLight(Vec3(0, 0, 0), Color(1e9, 1e9, 1e9))])
+    s = BatchScene(scene).lights.sample(p, np.random.default_rng(0))
+    np.testing.assert_array_equal(s.valid, [False, False, True])
+    ref = scene.point_lights[0].sample(V(p[2]))
+    np.testing.assert_array_equal(s.radiance[2], arr(ref.radiance))
+    quad = Quad(Vec3(-1, 0, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), LIGHT)  # (0.5, 0.5) -> origin
+    lights, _ = table(quad)
+    out = empty_samples(3)
+    half = np.full(3, 0.5)
+    lights.sample_area(p, np.zeros(3, dtype=np.int64), half, half, out, np.arange(3))
+    np.testing.assert_array_equal(out.valid, [False, False, True])
+    assert out.pdf[2] == quad.sample_direction(V(p[2]), 0.5, 0.5)[1]
+    origin, normal = np.zeros((3, 3)), np.tile([0.0, 1.0, 0.0], (3, 1))
+    pdf = lights.direction_pdf(np.zeros(3, dtype=np.int64), p, origin, normal)
+    assert pdf[0] == pdf[1] == 0.0 and pdf[2] > 0.0
+
+
 def test_one_sided_light_seen_from_behind_gives_no_radiance():
     quad = Quad(Vec3(-1, 2, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), LIGHT)  # normal -y... or +y
     lights, _ = table(quad)

@@ -8,6 +8,7 @@ import pytest
 from hypothesis import assume, given, settings
 
 from rtpy import Triangle
+from rtpy.hit_info import HitInfo
 from rtpy.io.bundled import bundled_dir
 from rtpy.io.obj import read_obj
 from rtpy.mesh import Mesh, SmoothTriangle, Transform
@@ -47,6 +48,19 @@ def teapot_scene():
     mesh = Mesh(obj.positions, obj.normals, obj.triangles, MAT, Transform(rotate=V((-90, 20, 0))))
     flat = Triangle(V((-4, -1, -4)), V((4, -1, -4)), V((0, -1, 4)), MAT)
     return Scene([*mesh.triangles, flat, Sphere(V((0, 4, 0)), 0.5, MAT)])
+
+
+def test_surface_uv_equals_scalar_on_a_long_thin_triangle():
+    """A sliver (edges 5e5 long, 1e-6 apart) whose dot-product barycentrics cancel to
+    0 / 0: the same (u, v) as Triangle.surface_uv, bit for bit."""
+    sliver = Triangle(V((1, 0, 0)), V((1 + 5e5, -1e-6, 0)), V((1 + 5e5, 0, 1e-6)), MAT)
+    weights = np.array([[0.3, 0.2], [0.0, 1.0], [1.0, 0.0], [0.5, 0.5], [0.1, 0.0]])
+    points = arr(sliver.a) + weights[:, :1] * arr(sliver.e1) + weights[:, 1:] * arr(sliver.e2)
+    u, v = TriangleSet([sliver]).surface_uv(np.zeros(len(points), dtype=np.int64), points)
+    for n, p in enumerate(points):
+        hit = HitInfo(V(p), sliver.normal, 1.0, True, MAT, sliver)
+        assert (u[n], v[n]) == sliver.surface_uv(hit)
+    np.testing.assert_allclose(np.column_stack([u, v]), weights, atol=1e-10)
 
 
 def test_smooth_triangle_hits_match_the_scalar_shading_normals():

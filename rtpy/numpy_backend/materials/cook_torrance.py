@@ -136,7 +136,8 @@ class BeckmannKernel(CookTorranceKernel):
         g[slanted[a == 0.0]] = 0.0
         near = (a != 0.0) & (a < BECKMANN_G1_ONE)
         a = a[near]
-        lam = 0.5 * (INV_SQRT_PI * np.exp(-a * a) / a - erfc(a))
+        with np.errstate(over="ignore"):  # subnormal a: lam = inf, G1 = 0 (as in Python)
+            lam = 0.5 * (INV_SQRT_PI * np.exp(-a * a) / a - erfc(a))
         g[slanted[near]] = 1.0 / (1.0 + np.maximum(0.0, lam))
         return g
 
