@@ -25,7 +25,10 @@ import json
 import os
 import subprocess
 import sys
+import threading
 import tomllib
+from collections.abc import Iterator
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -140,10 +143,14 @@ def check_regions(repo: Path, week: str) -> None:
             assert block in text, f"{r.path}: {r.function}: week {r.week} solution missing"
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("week", WEEKS)
-def test_student_repository(tmp_path, week):
-    repo = make_assignment(week, tmp_path / f"week{week}")
+# make_assignment reads the process's umask by setting it: one at a time
+MAKING = threading.Lock()
+
+
+def check_student_repository(tmp_path: Path, week: str) -> None:
+    """The week's repository as the module's docstring says, its files under tmp_path."""
+    with MAKING:
+        repo = make_assignment(week, tmp_path / f"week{week}")
     check_regions(repo, week)
     assert not (repo / "rtpy" / "numpy_backend" / "scene.py").exists()
     assert "MIT License" in (repo / "LICENSE").read_text()  # MIT asks for it in copies
@@ -180,6 +187,36 @@ def test_student_repository(tmp_path, week):
     assert graded["score"] == graded["max_score"] > 0, f"week {week} solved: {graded}"
     assert all(t["status"] == "passed" for t in graded["tests"]), graded
     assert scenes and report["renders"] == [0] * len(scenes), (scenes, proc.stderr[-3000:])
+
+
+def side_by_side(request, test_name: str, check, tmp_path_factory) -> Iterator[dict]:
+    """Generator of a module fixture: week -> the Future of check(folder, week) for the
+    weeks of `test_name` selected. The weeks run side by side, one per core (each is
+    a chain of subprocesses); each week's test takes its own outcome, so a failure is
+    reported on that week's test."""
+    weeks = [
+        item.callspec.params["week"]
+        for item in request.session.items
+        if item.originalname == test_name
+    ]
+    pool = ThreadPoolExecutor(max(1, min(len(weeks), os.cpu_count() or 1)))
+    try:
+        yield {w: pool.submit(check, tmp_path_factory.mktemp(f"week{w}-"), w) for w in weeks}
+    finally:
+        pool.shutdown(cancel_futures=True)
+
+
+@pytest.fixture(scope="module")
+def checked_repositories(request, tmp_path_factory):
+    yield from side_by_side(
+        request, "test_student_repository", check_student_repository, tmp_path_factory
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("week", WEEKS)
+def test_student_repository(checked_repositories: dict[str, Future], week):
+    checked_repositories[week].result()
 
 
 def run_driver(repo: Path, driver: str, *args: str) -> tuple[dict, subprocess.CompletedProcess]:

@@ -18,6 +18,7 @@ test_week_05_end_to_end stays in the fast tier.
 from __future__ import annotations
 
 import ast
+import functools
 import json
 import os
 import shutil
@@ -25,6 +26,7 @@ import stat
 import subprocess
 import sys
 import time
+from concurrent.futures import Future
 from pathlib import Path
 
 import pytest
@@ -33,6 +35,8 @@ from rtpy.grading.assignment import WEEKS, make_assignment
 from rtpy.grading.autograder import build_autograder, extract, task_files, task_regions
 from rtpy.io.cli import main
 
+from .test_assignment import MAKING, side_by_side
+
 ROOT = Path(__file__).resolve().parents[2]
 TEST_TIMEOUT = 2  # seconds per test in the broken runs (an endless loop costs this much)
 TOTAL_TIMEOUT = 240
@@ -40,15 +44,17 @@ TOTAL_TIMEOUT = 240
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    """week -> (its autograder zip, its untouched student repository), made once."""
+    """week -> (its autograder zip, its untouched student repository), made once, one
+    at a time (MAKING)."""
     cache: dict[str, tuple[Path, Path]] = {}
 
     def get(week: str) -> tuple[Path, Path]:
-        if week not in cache:
-            folder = tmp_path_factory.mktemp(f"week{week}")
-            zip_path = build_autograder(week, folder / f"week{week}.zip")
-            cache[week] = zip_path, make_assignment(week, folder / "student")
-        return cache[week]
+        with MAKING:
+            if week not in cache:
+                folder = tmp_path_factory.mktemp(f"week{week}")
+                zip_path = build_autograder(week, folder / f"week{week}.zip")
+                cache[week] = zip_path, make_assignment(week, folder / "student")
+            return cache[week]
 
     return get
 
@@ -185,9 +191,9 @@ def plant_faults(repo: Path, week: str) -> dict[str, tuple[str, str]]:
 
 
 # --- the tests ------------------------------------------------------------------------
-@pytest.mark.slow
-@pytest.mark.parametrize("week", WEEKS)
-def test_the_autograder_of_every_week(built, tmp_path, week):
+def check_week(built, tmp_path: Path, week: str) -> None:
+    """The autograder of `week` on the untouched, tampered, reference and broken
+    submissions (see the module's docstring), its files under tmp_path."""
     zip_path, student = built(week)
 
     untouched, _ = run_autograder(zip_path, student, tmp_path)
@@ -232,6 +238,18 @@ def test_the_autograder_of_every_week(built, tmp_path, week):
     assert f"it was in {loop_function} ({loop_file}, line" in outputs, outputs
     none_file, none_function = faults["none"]
     assert f"{none_function} ({none_file}) returned None" in outputs, outputs
+
+
+@pytest.fixture(scope="module")
+def checked_weeks(request, built, tmp_path_factory):
+    check = functools.partial(check_week, built)
+    yield from side_by_side(request, "test_the_autograder_of_every_week", check, tmp_path_factory)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("week", WEEKS)
+def test_the_autograder_of_every_week(checked_weeks: dict[str, Future], week):
+    checked_weeks[week].result()
 
 
 @pytest.mark.slow

@@ -312,6 +312,35 @@ def scalar_dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
 
 
+def unit_length_bound(
+    table: MaterialTable, ids: np.ndarray, normal: np.ndarray, tangent: np.ndarray
+) -> np.ndarray:
+    """The most | |d| - 1 | a sampled direction d may have, per row: 1e-14 (45 ulp),
+    plus, where the kernel reads the tangent (Ward's shading frame), 15 ULP / L with L
+    the length of the tangent's part perpendicular to the normal.
+
+    ONB.from_normal_tangent makes u = t - n (t . n) (Gram-Schmidt). With u = 2^-53 the
+    unit roundoff (Higham, Accuracy and Stability of Numerical Algorithms, 2002, eq.
+    3.5: a dot product of length 3 errs by at most gamma_3 = 3u times |t| |n|), the
+    computed u differs from the exact perpendicular part p by at most 3u + u + u = 5u
+    (t . n, the product n (t . n), the subtraction), and p . n = (t . n)(1 - |n|^2) is
+    at most 10u for a normal of length 1 +- 5u (a / |a|: the sum of squares, its
+    square root, the division). So the normalised u leans toward n by e <= 15u / L;
+    the frame's other products are 1 or 0 to O(u), which the 1e-14 covers as it does
+    for the frames built around the normal alone. A half vector h = x u + y v + z n
+    with x^2 + y^2 + z^2 = 1 has |h|^2 = 1 + 2 x z e, within e of 1, and its
+    reflection wi = d - 2 (d . h) h of a unit d has |wi|^2 = 1 + 4 (d . h)^2 (|h|^2 - 1):
+    | |wi| - 1 | <= 2 e = 30u / L = 15 ULP / L. Below L = 1e-9 the frame is
+    ONB(normal)'s; the margin of 1e-14 leaves the rows whose L the kernel may round to
+    the other side of 1e-9 under the bound of the Gram-Schmidt frame."""
+    reads_tangent = np.array([k.reads_tangent for k in table.kernels])[table.kind[ids]]
+    along = np.sum(tangent * normal, axis=1, keepdims=True)
+    length = np.linalg.norm(tangent - normal * along, axis=1)
+    gram_schmidt = reads_tangent & (length >= 1e-9 - 1e-14)
+    lean = 15.0 * ULP / np.maximum(length, 1e-9 - 1e-14)
+    return 1e-14 + np.where(gram_schmidt, lean, 0.0)
+
+
 def check_samples_match_brdf_and_pdf(
     table: MaterialTable, ids, hits: HitBatch, s: ScatterBatch
 ) -> None:
@@ -326,7 +355,12 @@ def check_samples_match_brdf_and_pdf(
     assert not s.attenuation[dead].any() and not s.pdf[dead].any()
     live = np.flatnonzero(s.alive)
     d = s.direction[live]
-    np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, rtol=1e-14)
+    length_error = np.abs(np.linalg.norm(d, axis=1) - 1.0)
+    bound = unit_length_bound(table, ids[live], hits.normal[live], hits.tangent[live])
+    assert (length_error <= bound).all(), (
+        f"sampled directions not unit: | |d| - 1 | up to {length_error.max():.3g}, "
+        f"{np.count_nonzero(length_error > bound)} rows beyond their bound"
+    )
     part = hits.take(live)
     f, pdf = table.BRDF(ids[live], part, d), table.pdf(ids[live], part, d)
     cos_i = np.abs(scalar_dot(d, part.normal))
