@@ -118,10 +118,12 @@ def across(v: list[float]) -> list[float]:
 
 
 def offset(p: list[float], v: list[float]) -> list[float]:
-    """p + v, each component of v turned toward 0 where p + v would leave the range."""
+    """p + v, each component of v turned toward 0 (and shortened to reach at most the
+    range's far end) where p + v would leave the range."""
     out = []
     for a, b in zip(p, v, strict=True):
-        out.append(a + b if abs(a + b) <= MAX_COORD else a - math.copysign(abs(b), a))
+        inward = math.copysign(min(abs(b), MAX_COORD + abs(a)), a)
+        out.append(a + b if abs(a + b) <= MAX_COORD else a - inward)
     return out
 
 
@@ -134,8 +136,8 @@ def cameras(draw) -> dict:
     look_from = draw(triple(COORD))
     view, distance = draw(directions()), draw(LENGTH)
     look_at = offset(look_from, scaled(view, distance))
-    while not norm(add(look_at, look_from, -1.0)) >= 1e-6:  # rounded below the least
-        distance *= 1.5
+    while not 1e-6 <= norm(add(look_at, look_from, -1.0)) <= 1e6:  # rounded out of range
+        distance *= 1.5 if distance < 1.0 else 1.0 - 1e-9
         look_at = offset(look_from, scaled(view, distance))
     view = add(look_at, look_from, -1.0)
     vup = scaled(draw(directions()), draw(LENGTH))
