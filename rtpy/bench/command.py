@@ -119,6 +119,8 @@ def _options(args: argparse.Namespace) -> dict:
             resolve_scene(name)
     try:
         check_folder(args.out, "--out")
+        if args.cache:
+            check_folder(args.cache, "--cache")
     except OutputError as err:
         raise BenchUsageError(str(err)) from None
     return {

@@ -159,6 +159,8 @@ class Range:
     hi_open: bool = False
 
     def __contains__(self, x: float) -> bool:
+        if x != x:  # NaN lies in no range
+            return False
         if self.lo is not None and (x <= self.lo if self.lo_open else x < self.lo):
             return False
         return not (self.hi is not None and (x >= self.hi if self.hi_open else x > self.hi))

@@ -119,15 +119,16 @@ def test_ctrl_c_keeps_the_levels_measured(tmp_path):
     assert doc["fits"][0]["levels"] == 4 and "relMSE" in stdout
 
 
-def test_an_out_folder_at_or_under_a_file_is_refused_before_measuring(
-    tmp_path, capsys, monkeypatch
+@pytest.mark.parametrize("option", ["--out", "--cache"])
+def test_an_output_folder_at_or_under_a_file_is_refused_before_measuring(
+    tmp_path, capsys, monkeypatch, option
 ):
     monkeypatch.setattr(command, "run_bench", lambda **kwargs: pytest.fail("measured"))
     (tmp_path / "file").write_text("")
     for out in (tmp_path / "file", tmp_path / "file" / "sub"):
-        assert main(["bench", "--quick", "--out", str(out)]) == 2
+        assert main(["bench", "--quick", option, str(out)]) == 2
         err = capsys.readouterr().err
-        assert err == f"rtpy: error: --out {out}: {tmp_path / 'file'} is not a folder\n"
+        assert err == f"rtpy: error: {option} {out}: {tmp_path / 'file'} is not a folder\n"
     assert [p.name for p in tmp_path.iterdir()] == ["file"]
 
 

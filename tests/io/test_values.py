@@ -182,6 +182,7 @@ def test_describe_and_ranges():
     assert Range(0, 1).text() == "in [0, 1]" and Range(0, None, True).text() == "> 0"
     assert Range(None, 5, hi_open=True).text() == "< 5" and values.ANY.text() == ""
     assert 0 not in Range(0, None, True) and 0 in Range(0) and 1e31 not in values.RADIANCE
+    assert math.nan not in values.ANY and math.inf in values.ANY
     assert values.suggest("lookat", ["look_at", "look_from"]) == "look_at"
 
 
