@@ -101,8 +101,16 @@ def _stop_workers(executor: ProcessPoolExecutor) -> None:
         terminate()
         return
     # Python 3.11-3.13 have no public way: the executor's own table of its processes
-    for process in list(executor._processes.values()):
+    processes = list(executor._processes.values())
+    for process in processes:
         process.terminate()
+    for process in processes:
+        process.join()
+    # A worker ended in the middle of sending its result (a large image of sums) leaves
+    # the executor's thread waiting for the rest of the message. With every writer gone,
+    # the parent's copy of the pipe's write end included, it reads end-of-file instead
+    # and the executor shuts down; otherwise shutdown() would wait forever.
+    executor._result_queue._writer.close()
 
 
 def run_on_workers(backend: Backend, units: list[Unit], workers: int):
