@@ -19,8 +19,8 @@ SEED_VARIABLE = "RTPY_GRADING_SEED"
 
 
 def grading_seed(default: int) -> int:
-    """`default`, or under the autograder a seed drawn from the run's seed and `default`
-    (two graders with different defaults get independent seeds)."""
+    """`default`, or under the autograder a seed in [0, 2**63 - 1] drawn from the run's
+    seed and `default` (two graders with different defaults get independent seeds)."""
     text = os.environ.get(SEED_VARIABLE)
     if text is None or text == "":
         return default
@@ -30,7 +30,8 @@ def grading_seed(default: int) -> int:
         raise ValueError(f"{SEED_VARIABLE}={text!r}: expected a whole number") from None
     if run < 0 or default < 0:
         raise ValueError(f"seeds must be >= 0, got {SEED_VARIABLE}={run} and default={default}")
-    return int(np.random.SeedSequence([run, default]).generate_state(1, np.uint64)[0])
+    state = int(np.random.SeedSequence([run, default]).generate_state(1, np.uint64)[0])
+    return state >> 1  # 63 bits: a render's seed is at most 2**63 - 1
 
 
 def grading_rng(default: int) -> np.random.Generator:

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from rtpy.grading.autograder_seed import SEED_VARIABLE, grading_rng, grading_seed
+from rtpy.render_settings import SETTINGS
 
 
 def test_without_the_variable_the_default_is_used(monkeypatch):
@@ -22,6 +23,13 @@ def test_each_run_and_each_grader_gets_its_own_seed(monkeypatch):
     assert a != b and a not in (501, 502) and grading_seed(501) == a  # reproducible in a run
     monkeypatch.setenv(SEED_VARIABLE, "987654321")
     assert grading_seed(501) != a
+
+
+def test_every_run_seed_is_a_seed_a_render_takes(monkeypatch):
+    """Hidden checks render with these seeds: each must lie in the seed key's range."""
+    for run in range(200):
+        monkeypatch.setenv(SEED_VARIABLE, str(run))
+        SETTINGS["seed"].check(grading_seed(run))  # SettingValueError otherwise
 
 
 def test_a_bad_seed_is_refused_naming_the_variable(monkeypatch):
