@@ -84,14 +84,18 @@ class Triangle(FlatShape):
         return HitInfo(ray.at(t), n if front_face else -n, t, front_face, self.material, self)
 
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
-        # Barycentric coordinates of the hit point: the signed areas of the
-        # sub-triangles (a, p, c) and (a, b, p) over the whole one's. Cross products,
-        # not the dot-product form |e1|^2 |e2|^2 - (e1 . e2)^2, which cancels to 0 for
-        # a long thin triangle (edges 5e5 long, 1e-6 apart).
+        # Barycentric coordinates of the hit point: p - a = u e1 + v e2, solved by the
+        # normal equations. Their determinant d00 d11 - d01^2 is |e1 x e2|^2 (Lagrange's
+        # identity), taken from the area: the difference itself cancels to 0 for a long
+        # thin triangle (edges 5e5 long, 1e-6 apart).
         p = hit.point - self.a
+        e1, e2 = self.e1, self.e2
+        d00, d01, d11 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
+        d20, d21 = dot(p, e1), dot(p, e2)
         twice_area = 2.0 * self._area
-        u = dot(cross(p, self.e2), self.normal) / twice_area
-        v = dot(cross(self.e1, p), self.normal) / twice_area
+        denom = twice_area * twice_area
+        u = (d11 * d20 - d01 * d21) / denom
+        v = (d00 * d21 - d01 * d20) / denom
         return min(1.0, max(0.0, u)), min(1.0, max(0.0, v))
 
     def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:

@@ -89,11 +89,15 @@ class TriangleSet(PlanarSet):
         return self._finish(det, parallel, u_num, v_num, t_num, t_min, t_max)
 
     def surface_uv(self, k, point):
-        # Triangle.surface_uv: barycentric coordinates from cross products.
+        # Triangle.surface_uv: the normal equations, their determinant from the area.
         p = point - self.a[k]
-        normal, twice_area = self.normal[k], 2.0 * self._area[k]
-        u = dot(np.cross(p, self.e2[k]), normal) / twice_area
-        v = dot(np.cross(self.e1[k], p), normal) / twice_area
+        e1, e2 = self.e1[k], self.e2[k]
+        d00, d01, d11 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
+        d20, d21 = dot(p, e1), dot(p, e2)
+        twice_area = 2.0 * self._area[k]
+        denom = twice_area * twice_area
+        u = (d11 * d20 - d01 * d21) / denom
+        v = (d00 * d21 - d01 * d20) / denom
         return np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
 
     def shading_normal(self, k, point, geo):
