@@ -29,7 +29,8 @@ def test_every_run_seed_is_a_seed_a_render_takes(monkeypatch):
     """Hidden checks render with these seeds: each must lie in the seed key's range."""
     for run in range(200):
         monkeypatch.setenv(SEED_VARIABLE, str(run))
-        SETTINGS["seed"].check(grading_seed(run))  # SettingValueError otherwise
+        seed = grading_seed(run)
+        assert 0 <= seed <= 2**63 - 1 and SETTINGS["seed"].check(seed) == seed
 
 
 def test_a_bad_seed_is_refused_naming_the_variable(monkeypatch):
