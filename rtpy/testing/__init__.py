@@ -5,71 +5,60 @@ statistics they rest on, scenes whose exact image is known
 
     from rtpy.testing import check_material
     print(check_material(MyMaterial(...)))
+
+The names below load their module on first use, so that importing one module
+(rtpy.testing.statistics for a render's memory figure) does not load them all.
 """
 
-from .chi_square import Chi2Result, chi2_test
-from .local_setup import (
-    ABSORBED,
-    SCATTERED,
-    SPECULAR,
-    Samples,
-    brdf_between,
-    draw_samples,
-    incident_ray,
-    light_ray,
-    local_direction,
-    local_hit,
-    view_ray,
-)
-from .material_checks import (
-    AlbedoEstimate,
-    CheckResult,
-    check_energy,
-    check_weights,
-    directional_albedo,
-)
-from .material_report import MaterialReport, assert_material, check_material, material_name
-from .pointwise_checks import check_non_negative_finite, check_reciprocity
-from .quadrature import AdaptiveSimpson2D
-from .statistics import (
-    bonferroni_alpha,
-    bonferroni_z,
-    chi2_sf,
-    gamma_q,
-    normal_quantile,
-    sidak_alpha,
-)
+from __future__ import annotations
 
-__all__ = [
-    "ABSORBED",
-    "SCATTERED",
-    "SPECULAR",
-    "AdaptiveSimpson2D",
-    "AlbedoEstimate",
-    "CheckResult",
-    "Chi2Result",
-    "MaterialReport",
-    "Samples",
-    "assert_material",
-    "bonferroni_alpha",
-    "bonferroni_z",
-    "brdf_between",
-    "check_energy",
-    "check_material",
-    "check_non_negative_finite",
-    "check_reciprocity",
-    "check_weights",
-    "chi2_sf",
-    "chi2_test",
-    "directional_albedo",
-    "draw_samples",
-    "gamma_q",
-    "incident_ray",
-    "light_ray",
-    "local_direction",
-    "local_hit",
-    "material_name",
-    "normal_quantile",
-    "sidak_alpha",
-    "view_ray",
-]
+import importlib
+
+# name -> the module of this package that defines it
+_HOME = {
+    "ABSORBED": "local_setup",
+    "AdaptiveSimpson2D": "quadrature",
+    "AlbedoEstimate": "material_checks",
+    "CheckResult": "material_checks",
+    "Chi2Result": "chi_square",
+    "MaterialReport": "material_report",
+    "SCATTERED": "local_setup",
+    "SPECULAR": "local_setup",
+    "Samples": "local_setup",
+    "assert_material": "material_report",
+    "bonferroni_alpha": "statistics",
+    "bonferroni_z": "statistics",
+    "brdf_between": "local_setup",
+    "check_energy": "material_checks",
+    "check_material": "material_report",
+    "check_non_negative_finite": "pointwise_checks",
+    "check_reciprocity": "pointwise_checks",
+    "check_weights": "material_checks",
+    "chi2_sf": "statistics",
+    "chi2_test": "chi_square",
+    "directional_albedo": "material_checks",
+    "draw_samples": "local_setup",
+    "gamma_q": "statistics",
+    "incident_ray": "local_setup",
+    "light_ray": "local_setup",
+    "local_direction": "local_setup",
+    "local_hit": "local_setup",
+    "material_name": "material_report",
+    "normal_quantile": "statistics",
+    "sidak_alpha": "statistics",
+    "view_ray": "local_setup",
+}
+__all__ = sorted(_HOME)
+
+
+def __getattr__(name: str):
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{home}", __name__), name)
+    globals()[name] = value  # found directly from now on
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

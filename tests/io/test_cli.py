@@ -702,4 +702,5 @@ def test_a_quiet_render_loads_no_progress_bar_and_no_other_command(tmp_path):
     loaded = modules_imported_by(f"from rtpy.io.cli import main\nmain({argv!r})")
     assert out.exists() and "numpy" in loaded
     unneeded = {"tqdm", "rtpy.bench", "rtpy.grading", "importlib.metadata"}
+    unneeded |= {"rtpy.testing.chi_square", "rtpy.testing.material_checks"}
     assert not loaded & unneeded
