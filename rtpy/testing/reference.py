@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..camera import Camera
+from ..io.image import atomic_write
 from .analytic_scenes import AnalyticScene
 
 REFERENCE_RENDERS = 4
@@ -173,14 +174,14 @@ def render_reference(
     return images.mean(axis=0), variance, settings
 
 
-def _atomic_write_bytes(path: Path, write) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
+def _write_bytes(path: Path, write) -> None:
+    """Call write(file) on `path` opened for binary writing, atomically (atomic_write)."""
+
+    def write_file(tmp: Path) -> None:
         with tmp.open("wb") as f:
             write(f)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+
+    atomic_write(path, write_file)
 
 
 def get_reference(
@@ -206,8 +207,8 @@ def get_reference(
     image, variance, settings = render_reference(scene_path, width, max_depth, spp)
     cache.mkdir(parents=True, exist_ok=True)
     npz, meta_path = _cache_paths(cache, Path(scene_path), width, max_depth)
-    _atomic_write_bytes(npz, lambda f: np.savez(f, image=image, variance=variance))
-    _atomic_write_bytes(meta_path, lambda f: f.write(json.dumps(settings, indent=1).encode()))
+    _write_bytes(npz, lambda f: np.savez(f, image=image, variance=variance))
+    _write_bytes(meta_path, lambda f: f.write(json.dumps(settings, indent=1).encode()))
     return Reference(
         image=image,
         variance=variance,

@@ -166,3 +166,29 @@ def test_reference_dir_follows_the_environment(monkeypatch, tmp_path):
     monkeypatch.delenv("RTPY_CACHE")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "x"))
     assert reference_dir() == tmp_path / "x" / "rtpy" / "references"
+
+
+def test_a_failed_cache_write_leaves_no_file_and_names_the_path(tmp_path, monkeypatch):
+    """Writing the cache goes through rtpy.io.image.atomic_write: a disk that fills up
+    half-way through gives one WriteError naming the file, and no partial or temporary
+    file stays in the cache (a later run would otherwise read half an image)."""
+    import errno
+
+    from rtpy.io.image import WriteError
+
+    scene = tmp_path / "furnace.toml"
+    scene.write_text(FURNACE_TOML)
+    image = np.ones((2, 2, 3))
+    monkeypatch.setattr(
+        reference_module, "render_reference", lambda *a: (image, 0.0 * image, {"source": "x"})
+    )
+
+    def half_then_full(f, **arrays):
+        f.write(b"PK\x03\x04")  # the start of a zip archive, as np.savez begins
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(reference_module.np, "savez", half_then_full)
+    cache = tmp_path / "cache"
+    with pytest.raises(WriteError, match=r"cannot write .*furnace.*\.npz.: No space left"):
+        get_reference(scene, 2, 4, spp=4, cache=cache, log=lambda _: None)
+    assert list(cache.iterdir()) == []
