@@ -318,8 +318,11 @@ def write_exr(path: StrPath, linear: np.ndarray) -> Path:
     header = {"compression": openexr.ZIP_COMPRESSION, "type": openexr.scanlineimage}
 
     def write(tmp: Path) -> None:
-        with openexr.File(header, {"RGB": arr}) as f:
-            f.write(str(tmp))
+        try:
+            with openexr.File(header, {"RGB": arr}) as f:
+                f.write(str(tmp))
+        except RuntimeError as err:  # how OpenEXR reports a failed write
+            raise OSError(str(err)) from err
 
     return atomic_write(p, write)
 

@@ -540,6 +540,38 @@ def test_exr_round_trip(tmp_path: Path) -> None:
     assert listing(tmp_path) == ["a.exr", "b.EXR"]
 
 
+def test_a_failed_exr_write_is_one_write_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """OpenEXR reports a failed write (disk full, I/O error) as a RuntimeError, not an
+    OSError: it becomes the same one-line WriteError, and the existing file stays."""
+    openexr = pytest.importorskip("OpenEXR")
+
+    class FullDisk:
+        def __init__(self, *args):
+            pass
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def write(self, path):
+            Path(path).write_bytes(b"v/1\x01")  # the start of a file, as OpenEXR writes
+            raise RuntimeError(f'Cannot write image file "{path}". No space left on device')
+
+    out = tmp_path / "a.exr"
+    out.write_bytes(b"before")
+    monkeypatch.setattr(openexr, "File", FullDisk)
+    with pytest.raises(WriteError) as info:
+        write_linear(out, random_image(3, 5, seed=9))
+    message = str(info.value)
+    assert message.startswith(f"cannot write '{out}': ") and "No space left" in message
+    assert "\n" not in message
+    assert out.read_bytes() == b"before" and listing(tmp_path) == ["a.exr"]
+
+
 def test_exr_without_openexr_says_how_to_install(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
