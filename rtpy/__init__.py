@@ -156,7 +156,7 @@ def render(
         workers=workers,
         quiet=not show_progress,
         backend=backend,
-        preview=preview_target(preview),
+        preview=preview_target(preview, scene.files),
         preview_seconds=preview_seconds,
     )
     return renderer.render()

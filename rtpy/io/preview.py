@@ -7,19 +7,21 @@ image, so it is a whole frame that sharpens as the render goes on.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
-from .image import RenderedImage, check_image_path
+from .image import RenderedImage, StrPath, check_image_path
+from .outputs import check_output
 
 Preview = Callable[[RenderedImage], object]
 
 
-def preview_target(preview: object) -> Preview | None:
+def preview_target(preview: object, inputs: Iterable[StrPath] = ()) -> Preview | None:
     """render()'s `preview` as a function of the image so far, or None.
 
     None or False: no preview. A path (str or os.PathLike) to a .png or .jpg: the
     file is rewritten atomically with each preview (checked before the render
-    starts). True: in a Jupyter notebook, one output that each preview replaces.
+    starts, and refused when it is one of `inputs`, the files the scene was read
+    from). True: in a Jupyter notebook, one output that each preview replaces.
     A function: called with each preview, a RenderedImage.
     """
     if preview is None or preview is False:
@@ -27,7 +29,7 @@ def preview_target(preview: object) -> Preview | None:
     if preview is True:
         return notebook_preview()
     if isinstance(preview, str | os.PathLike):
-        path = check_image_path(preview)
+        path = check_output(preview, "preview", inputs, check=check_image_path)
         return lambda image: image.save(path)
     if callable(preview):
         return preview

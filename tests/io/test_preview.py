@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+import rtpy
 from rtpy.io.image import OutputError, RenderedImage
 from rtpy.io.preview import notebook_preview, preview_target
 
@@ -37,6 +38,24 @@ def test_a_file_that_cannot_be_written_is_refused_before_the_render(tmp_path):
         preview_target(tmp_path / "preview.npy")
     with pytest.raises(OutputError, match="does not exist"):
         preview_target(tmp_path / "missing" / "preview.png")
+
+
+def test_a_preview_over_one_of_the_scenes_files_is_refused(tmp_path):
+    """As the CLI's --preview: rtpy.render(scene, preview=...) never overwrites a file
+    the scene was read from (here its image texture), whatever the extension."""
+    texture = tmp_path / "wood.png"
+    Image.new("RGB", (2, 2), (200, 120, 40)).save(texture)
+    scene_file = tmp_path / "scene.toml"
+    scene_file.write_text(
+        '[camera]\nwidth = 4\naspect_ratio = 1.0\n\n[textures.wood]\ntype = "image"\n'
+        'path = "wood.png"\n\n[materials.m]\ntype = "lambertian"\nalbedo = "wood"\n\n'
+        '[[objects]]\ntype = "sphere"\ncenter = [0, 0, -2]\nradius = 1\nmaterial = "m"\n'
+    )
+    scene = rtpy.load_scene(scene_file)
+    before = texture.read_bytes()
+    with pytest.raises(OutputError, match="preview .*wood.png: would overwrite .*an input"):
+        rtpy.render(scene, spp=1, preview=texture)
+    assert texture.read_bytes() == before
 
 
 def test_a_function_is_called_as_it_is():
