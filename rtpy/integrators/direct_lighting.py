@@ -75,7 +75,7 @@ def sample_one_light(
     area lights (with mis = False the weight is 1: light sampling alone)."""
     n_lights = len(lights)
     k = int(random_double() * n_lights)
-    light = lights[k] if k < n_lights else lights[-1]  # u * n rounds up to n for u near 1
+    light = lights[k] if k < n_lights else lights[-1]  # k = n: a sampler gave 1.0 (rounding)
     sample = light.sample(hit.point)
     if sample is None or sample.radiance.is_black():
         return BLACK
