@@ -266,7 +266,8 @@ def classify(raw: str, regions: dict[str, set[int]]) -> tuple[Counter, Counter, 
 
 def print_shares(width: int, spp: int, max_depth: int, renders: int) -> None:
     """Profile `renders` renders of rtpy in one process with py-spy; print the shares."""
-    py_spy = shutil.which("py-spy")
+    # On the PATH, or beside this Python (a virtual environment not activated).
+    py_spy = shutil.which("py-spy") or shutil.which("py-spy", path=Path(sys.executable).parent)
     if py_spy is None:
         print("--shares needs py-spy on the PATH: pip install py-spy")
         return
