@@ -245,8 +245,9 @@ def classify(raw: str, regions: dict[str, set[int]]) -> tuple[Counter, Counter, 
         frames = []
         for text in stack.split(";"):
             m = FRAME.match(text)
-            if m and "rtpy/" in m["file"]:
-                rel = "rtpy/" + m["file"].rpartition("rtpy/")[2]
+            file = m["file"].replace("\\", "/") if m else ""
+            if "rtpy/" in file:
+                rel = "rtpy/" + file.rpartition("rtpy/")[2]
                 frames.append((m["function"], rel, int(m["line"])))
         if not any(f[0] == "render_unit" for f in frames):
             continue  # start-up, imports, the image's assembly
@@ -276,12 +277,16 @@ def print_shares(width: int, spp: int, max_depth: int, renders: int) -> None:
         command = [py_spy, "record", "--rate", "1000", "--format", "raw", "--output", str(out)]
         command += ["--", sys.executable, __file__, "--child", "rtpy", "--renders", str(renders)]
         command += ["--width", str(width), "--spp", str(spp), "--max-depth", str(max_depth)]
-        subprocess.run(command, check=True, capture_output=True)
+        run = subprocess.run(command, capture_output=True, text=True)
+        if run.returncode != 0:
+            lines = (run.stderr or run.stdout).strip().splitlines() or ["no output"]
+            print(f"py-spy failed (exit {run.returncode}): {lines[-1]}")
+            return
         shares, elsewhere, total = classify(out.read_text(), region_lines())
     if not total:
         print("py-spy recorded no samples inside the render")
         return
-    print(f"rtpy's render, {renders} x width {width}, {spp} spp: {total} samples (1 ms)")
+    print(f"rtpy's render, {renders} x width {width}, {spp} spp: {total} samples, one per ms")
     for name in ("regions", "Vec3 from regions", "elsewhere"):
         print(f"  {name}: {100.0 * shares[name] / total:.1f} %")
     for function, n in elsewhere.most_common(12):
