@@ -41,6 +41,7 @@ class LightSample:
 
 class Light:
     is_delta = False
+    shape: Hittable | None = None  # the emitting object of an area light
 
     def sample(self, p: Vec3) -> LightSample | None:
         raise NotImplementedError

@@ -113,16 +113,23 @@ class Sphere(Hittable):
         sin2 = r2 / d2
         return d2, sin2 / (1.0 + math.sqrt(1.0 - sin2))  # 1 - cos_max without cancellation
 
-    def _cone_sample(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float, float] | None:
-        """(direction, its pdf, the distance to the sphere along it) for a direction
-        drawn uniformly in the cone the sphere subtends at p; None from inside."""
+    def sample_direction(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float] | None:
+        if self._cone(p) is None:
+            return super().sample_direction(p, r1, r2)
+        direction, pdf, _ = self.sample_hit(p, r1, r2)
+        return direction, pdf
+
+    def sample_hit(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float, HitInfo] | None:
+        """As Hittable.sample_hit. From outside, the direction is drawn uniformly in
+        the cone the sphere subtends at p, and the distance to the sphere follows from
+        the sampled angle, so the ray is not traced."""
         # Written per component: every light sample of every bounce comes here.
-        c = self.center
+        c, r = self.center, self.radius
         ax, ay, az = c.e0 - p.e0, c.e1 - p.e1, c.e2 - p.e2  # from p to the center
         d2 = ax * ax + ay * ay + az * az
-        rr = self.radius * self.radius
+        rr = r * r
         if d2 <= rr * 1.0000001:
-            return None
+            return super().sample_hit(p, r1, r2)  # inside: by area
         sin2_max = rr / d2
         one_minus_cos_max = sin2_max / (1.0 + math.sqrt(1.0 - sin2_max))  # no cancellation
         cos_t = 1.0 - r1 * one_minus_cos_max
@@ -138,30 +145,15 @@ class Sphere(Hittable):
         # without cancellation; inside the cone r^2 - D^2 sin_t^2 >= 0 but for rounding.
         room = rr - d2 * sin2_t
         t = (d2 - rr) / (distance * cos_t + math.sqrt(room if room > 0.0 else 0.0))
-        return direction, 1.0 / (2.0 * math.pi * one_minus_cos_max), t
-
-    def sample_direction(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float] | None:
-        sample = self._cone_sample(p, r1, r2)
-        if sample is None:
-            return super().sample_direction(p, r1, r2)
-        return sample[0], sample[1]
-
-    def sample_hit(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float, HitInfo] | None:
-        """As Hittable.sample_hit; from outside the distance to the sphere follows
-        from the sampled angle, so the ray is not traced."""
-        sample = self._cone_sample(p, r1, r2)
-        if sample is None:
-            return super().sample_hit(p, r1, r2)
-        direction, pdf, t = sample
         # The point and the outward normal there, as hit_info makes them (seen from
-        # outside, the front face), per component: this runs for every light sample.
-        c, r = self.center, self.radius
+        # outside, the front face).
         nx = p.e0 + t * direction.e0 - c.e0
         ny = p.e1 + t * direction.e1 - c.e1
         nz = p.e2 + t * direction.e2 - c.e2
         k = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
         normal = Vec3(nx * k, ny * k, nz * k)
         point = Vec3(c.e0 + normal.e0 * r, c.e1 + normal.e1 * r, c.e2 + normal.e2 * r)
+        pdf = 1.0 / (2.0 * math.pi * one_minus_cos_max)
         return direction, pdf, HitInfo(point, normal, t, True, self.material, self)
 
     def direction_pdf(self, p: Vec3, hit: HitInfo) -> float:

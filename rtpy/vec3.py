@@ -53,22 +53,22 @@ class Vec3:
     # themselves instead of calling the class: every ray makes dozens of vectors,
     # and skipping __init__ makes each of them cheaper.
     def __add__(self, o: Vec3) -> Vec3:
-        v = _new(self.__class__)
+        v = _new(type(self))
         v.e0, v.e1, v.e2 = self.e0 + o.e0, self.e1 + o.e1, self.e2 + o.e2
         return v
 
     def __sub__(self, o: Vec3) -> Vec3:
-        v = _new(self.__class__)
+        v = _new(type(self))
         v.e0, v.e1, v.e2 = self.e0 - o.e0, self.e1 - o.e1, self.e2 - o.e2
         return v
 
     def __neg__(self) -> Vec3:
-        v = _new(self.__class__)
+        v = _new(type(self))
         v.e0, v.e1, v.e2 = -self.e0, -self.e1, -self.e2
         return v
 
     def __mul__(self, o: Vec3 | float) -> Vec3:
-        v = _new(self.__class__)
+        v = _new(type(self))
         if type(o) is float or not isinstance(o, Vec3):
             v.e0, v.e1, v.e2 = self.e0 * o, self.e1 * o, self.e2 * o
         else:  # component-wise, for colours
@@ -76,13 +76,13 @@ class Vec3:
         return v
 
     def __rmul__(self, s: float) -> Vec3:
-        v = _new(self.__class__)
+        v = _new(type(self))
         v.e0, v.e1, v.e2 = self.e0 * s, self.e1 * s, self.e2 * s
         return v
 
     def __truediv__(self, s: float) -> Vec3:
         k = 1.0 / s
-        v = _new(self.__class__)
+        v = _new(type(self))
         v.e0, v.e1, v.e2 = self.e0 * k, self.e1 * k, self.e2 * k
         return v
 

@@ -26,6 +26,12 @@ paths/s (camera paths per CPU second of rendering: other processes on the machin
 slow the wall clock far more than the CPU time), and the ratio rtpy / course.
 --rtpy DIR adds a row for another rtpy checkout (for example the base of a change),
 measured in the same rounds.
+
+--shares profiles rtpy's render instead (with py-spy, `pip install py-spy`; it
+renders --repeat times in one process) and prints where its time goes: in the
+solution regions' own lines, in the Vec3 methods those lines call, and elsewhere
+(the functions that take most), and how much faster rtpy could be at most with
+nothing but the regions and their Vec3 calls left.
 """
 
 from __future__ import annotations
@@ -34,10 +40,14 @@ import argparse
 import json
 import math
 import os
+import re
+import shutil
 import subprocess
 import sys
+import tempfile
 import time
 import types
+from collections import Counter
 from pathlib import Path
 
 # The scene, in numbers both renderers use.
@@ -124,7 +134,8 @@ def render_course(course_dir: str, width: int, spp: int, max_depth: int, seed: i
 def render_rtpy(width: int, spp: int, max_depth: int, seed: int) -> dict:
     """Render with the rtpy on sys.path, scalar backend, one process."""
     import rtpy
-    import rtpy.renderer  # noqa: F401  (imported on first use: not part of the render's time)
+    import rtpy.io.preview  # noqa: F401  (these two rtpy.render imports on first use:
+    import rtpy.renderer  # noqa: F401  imported here, they are not part of the render's time)
     from rtpy.materials import DiffuseLight, Lambertian, Phong
 
     scene = rtpy.Scene(background=rtpy.Color(*BACKGROUND))
@@ -206,6 +217,85 @@ def measure(
     return best
 
 
+# A frame of py-spy's raw output: "function (file:line)".
+FRAME = re.compile(r"^(?P<function>.*) \((?P<file>.*):(?P<line>\d+)\)$")
+
+
+def region_lines() -> dict[str, set[int]]:
+    """rtpy file ("rtpy/vec3.py") -> numbers (1-based) of the lines inside its
+    solution regions, markers excluded."""
+    import rtpy
+    from rtpy.grading.assignment import find_regions
+
+    lines: dict[str, set[int]] = {}
+    for r in find_regions(Path(rtpy.__file__).resolve().parents[1]):
+        lines.setdefault(r.path.as_posix(), set()).update(range(r.begin + 2, r.end + 1))
+    return lines
+
+
+def classify(raw: str, regions: dict[str, set[int]]) -> tuple[Counter, Counter, int]:
+    """From py-spy's raw stacks: samples per share ("regions", "Vec3 from regions",
+    "elsewhere"), samples per function elsewhere, and the samples inside the render
+    (stacks through renderer.render_unit). A sample belongs to its innermost rtpy
+    frame (builtins such as math.sqrt count for their caller); a Vec3 method outside
+    the regions called from a region's line is "Vec3 from regions"."""
+    shares, elsewhere, total = Counter(), Counter(), 0
+    for row in raw.splitlines():
+        stack, _, count = row.rpartition(" ")
+        frames = []
+        for text in stack.split(";"):
+            m = FRAME.match(text)
+            file = m["file"].replace("\\", "/") if m else ""
+            if "rtpy/" in file:
+                rel = "rtpy/" + file.rpartition("rtpy/")[2]
+                frames.append((m["function"], rel, int(m["line"])))
+        if not any(f[0] == "render_unit" for f in frames):
+            continue  # start-up, imports, the image's assembly
+        n = int(count)
+        total += n
+        function, rel, line = frames[-1]
+        caller = frames[-2] if len(frames) > 1 else None
+        if line in regions.get(rel, ()):
+            shares["regions"] += n
+        elif rel == "rtpy/vec3.py" and caller and caller[2] in regions.get(caller[1], ()):
+            shares["Vec3 from regions"] += n
+        else:
+            shares["elsewhere"] += n
+            elsewhere[f"{function} ({rel})"] += n
+    return shares, elsewhere, total
+
+
+def print_shares(width: int, spp: int, max_depth: int, renders: int) -> None:
+    """Profile `renders` renders of rtpy in one process with py-spy; print the shares."""
+    # On the PATH, or beside this Python (a virtual environment not activated).
+    py_spy = shutil.which("py-spy") or shutil.which("py-spy", path=Path(sys.executable).parent)
+    if py_spy is None:
+        print("--shares needs py-spy on the PATH: pip install py-spy")
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "stacks.txt"
+        command = [py_spy, "record", "--rate", "1000", "--format", "raw", "--output", str(out)]
+        command += ["--", sys.executable, __file__, "--child", "rtpy", "--renders", str(renders)]
+        command += ["--width", str(width), "--spp", str(spp), "--max-depth", str(max_depth)]
+        run = subprocess.run(command, capture_output=True, text=True)
+        if run.returncode != 0:
+            lines = (run.stderr or run.stdout).strip().splitlines() or ["no output"]
+            print(f"py-spy failed (exit {run.returncode}): {lines[-1]}")
+            return
+        shares, elsewhere, total = classify(out.read_text(), region_lines())
+    if not total:
+        print("py-spy recorded no samples inside the render")
+        return
+    print(f"rtpy's render, {renders} x width {width}, {spp} spp: {total} samples, one per ms")
+    for name in ("regions", "Vec3 from regions", "elsewhere"):
+        print(f"  {name}: {100.0 * shares[name] / total:.1f} %")
+    for function, n in elsewhere.most_common(12):
+        print(f"    {100.0 * n / total:4.1f} %  {function}")
+    inside = shares["regions"] + shares["Vec3 from regions"]
+    if inside:
+        print(f"  at most {total / inside:.2f}x faster with nothing outside the regions")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("course_dir", nargs="?", help="checkout of the course's week-8 code")
@@ -216,14 +306,22 @@ def main() -> None:
     parser.add_argument(
         "--rtpy", action="append", default=[], metavar="DIR", help="another rtpy checkout to time"
     )
+    parser.add_argument(
+        "--shares", action="store_true", help="profile rtpy's render (py-spy): where time goes"
+    )
     parser.add_argument("--child", choices=("course", "rtpy"), help=argparse.SUPPRESS)
+    parser.add_argument("--renders", type=int, default=1, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child == "course":
         result = render_course(args.course_dir, args.width, args.spp, args.max_depth, seed=0)
     elif args.child == "rtpy":
-        result = render_rtpy(args.width, args.spp, args.max_depth, seed=0)
+        for _ in range(max(1, args.renders)):
+            result = render_rtpy(args.width, args.spp, args.max_depth, seed=0)
     if args.child:
         print(json.dumps(result))
+        return
+    if args.shares:
+        print_shares(args.width, args.spp, args.max_depth, max(1, args.repeat))
         return
 
     if not has_course(args.course_dir):

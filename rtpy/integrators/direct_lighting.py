@@ -74,7 +74,8 @@ def sample_one_light(
     probability 1 / len(lights) of picking that light, times the MIS weight for
     area lights (with mis = False the weight is 1: light sampling alone)."""
     n_lights = len(lights)
-    light = lights[min(int(random_double() * n_lights), n_lights - 1)]
+    k = int(random_double() * n_lights)
+    light = lights[k] if k < n_lights else lights[-1]  # k = n: a sampler gave 1.0 (rounding)
     sample = light.sample(hit.point)
     if sample is None or sample.radiance.is_black():
         return BLACK
@@ -82,7 +83,7 @@ def sample_one_light(
     # the cap facing the point, a flat quad or triangle cannot hide the sampled point
     # from it, while rounding near that point could make it seem to, most where the
     # light is seen at a slant.
-    estimate = light_sample_estimate(scene, ray_in, hit, sample, getattr(light, "shape", None))
+    estimate = light_sample_estimate(scene, ray_in, hit, sample, light.shape)
     if sample.is_delta or not mis or estimate.is_black():
         return estimate * n_lights
     # The power heuristic against the density with which BRDF sampling picks the same

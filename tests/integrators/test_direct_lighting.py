@@ -10,7 +10,7 @@ import pytest
 import rtpy
 from rtpy import Color, DiffuseLight, Lambertian, Quad, RenderSettings, Scene, Sphere, Vec3
 from rtpy.integrators import make_integrator
-from rtpy.integrators.direct_lighting import emission_weight
+from rtpy.integrators.direct_lighting import emission_weight, sample_one_light
 from rtpy.sampling import make_generator, use_generator
 from rtpy.testing.analytic_scenes import (
     PLANE_ALBEDO,
@@ -98,3 +98,26 @@ def test_emission_weight_is_the_power_heuristic_against_light_sampling():
     assert emission_weight(scene, hit, p, brdf_pdf, False, 2, mis=False) == 0.0
     expected = brdf_pdf**2 / (brdf_pdf**2 + (light_pdf / 2) ** 2)
     assert emission_weight(scene, hit, p, brdf_pdf, False, 2) == pytest.approx(expected, rel=1e-12)
+
+
+def test_light_choice_of_one_picks_the_last_light():
+    """A sampler can give the light choice 1.0 (its strata round up): then the last of
+    the lights is sampled, with the weight of one choice in len(lights)."""
+
+    class Ones:
+        def random(self) -> float:
+            return 1.0
+
+    albedo = Color(0.5, 0.5, 0.5)
+    lights = [
+        rtpy.PointLight(Vec3(0.0, 1.0, 0.0), Color(1.0, 1.0, 1.0)),
+        rtpy.PointLight(Vec3(0.0, 2.0, 0.0), Color(4.0, 8.0, 12.0)),
+    ]
+    scene = Scene(point_lights=lights)
+    hit = rtpy.HitInfo(Vec3(0.0, 0.0, 0.0), Vec3(0.0, 1.0, 0.0), 1.0, True, Lambertian(albedo))
+    ray_in = rtpy.Ray(Vec3(0.0, 1.0, 1.0), unit_vector(Vec3(0.0, -1.0, -1.0)))
+    with use_generator(Ones()):
+        got = sample_one_light(scene, ray_in, hit, scene.lights)
+    # f_r * I / d^2 * cos / pdf times 2 choices: albedo / pi * I / 4 * 1 / 1 * 2
+    expected = [a / math.pi * i / 4.0 * 2.0 for a, i in zip(albedo, (4.0, 8.0, 12.0), strict=True)]
+    assert list(got) == pytest.approx(expected, rel=1e-12)
