@@ -51,6 +51,7 @@ MASK64 = 0xFFFFFFFFFFFFFFFF
 GOLDEN = 0x9E3779B97F4A7C15  # 2^64 / golden ratio: splitmix64's increment
 TWO_TO_MINUS_32 = 1.0 / (1 << 32)
 TWO_TO_MINUS_53 = 1.0 / (1 << 53)
+ONE_MINUS_EPSILON = 1.0 - TWO_TO_MINUS_53  # the largest float below 1
 
 # Dimension numbers: every 1D or 2D dimension of a sample has its own.
 PIXEL, LENS, LIGHT_CHOICE, LIGHT, BRDF = range(5)
@@ -78,6 +79,12 @@ def hash_key(*key: int) -> int:
 def unit_float(h: int) -> float:
     """A number in [0, 1) from the top 53 bits of a 64-bit hash."""
     return (h >> 11) * TWO_TO_MINUS_53
+
+
+def jittered(k: int, u: float, n: int) -> float:
+    """The point u in [0, 1) of stratum k of n strata of [0, 1): (k + u) / n, which
+    rounds to 1.0 for k = n - 1 and u just below 1, kept below 1."""
+    return min((k + u) / n, ONE_MINUS_EPSILON)
 
 
 _REVERSED_BYTE = [int(f"{b:08b}"[::-1], 2) for b in range(256)]
@@ -277,13 +284,13 @@ class StratifiedSampler(Sampler):
 
     def value_1d(self, pixel: int, index: int, dim: int) -> float:
         k, h = self._stratum(pixel, index, dim, self.spp)
-        return (k + unit_float(h)) / self.spp
+        return jittered(k, unit_float(h), self.spp)
 
     def value_2d(self, pixel: int, index: int, dim: int) -> tuple[float, float]:
         nx, ny = grid_2d(self.spp)
         k, h = self._stratum(pixel, index, dim, nx * ny)
         row, column = divmod(k, nx)
-        return (column + unit_float(h)) / nx, (row + unit_float(mix64(h))) / ny
+        return jittered(column, unit_float(h), nx), jittered(row, unit_float(mix64(h)), ny)
 
 
 class SobolSampler(Sampler):

@@ -21,6 +21,7 @@ from rtpy.sampler import (
     SobolSampler,
     StratifiedSampler,
     grid_2d,
+    jittered,
     owen_scramble,
     permute,
     reverse_bits32,
@@ -134,6 +135,16 @@ def chi_square_p(values: np.ndarray, bins: int) -> float:
     counts = np.bincount(cells, minlength=bins ** len(values))
     expected = len(cells) / len(counts)
     return chi2_sf(float(((counts - expected) ** 2 / expected).sum()), len(counts) - 1)
+
+
+def test_the_last_stratum_stays_below_one():
+    """(k + u) / n with k = n - 1 and u the largest float below 1 rounds to exactly
+    1.0 for most n; every value a sampler gives is in [0, 1) (a light choice or an
+    inverse CDF at 1.0 would index past its table)."""
+    u = 1.0 - 2.0**-53
+    last = [jittered(n - 1, u, n) for n in range(1, 300)]
+    assert max(last) < 1.0
+    assert last[2] == 1.0 - 2.0**-53  # n = 3 hits the bound: (2 + u) / 3 rounds to 1
 
 
 @pytest.mark.parametrize("name", list(SAMPLERS))

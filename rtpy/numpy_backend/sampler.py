@@ -19,6 +19,7 @@ import numpy as np
 
 from ..sampler import (
     LIGHT_CHOICE,
+    ONE_MINUS_EPSILON,
     PIXEL,
     SAMPLERS,
     SOBOL_Y_BYTES,
@@ -51,6 +52,10 @@ def hash_key(*key) -> np.ndarray:
 
 def unit_float(h: np.ndarray) -> np.ndarray:
     return (h >> U64(11)).astype(np.float64) * TWO_TO_MINUS_53
+
+
+def jittered(k: np.ndarray, u: np.ndarray, n: int) -> np.ndarray:
+    return np.minimum((k + u) / n, ONE_MINUS_EPSILON)
 
 
 def reverse_bits32(v: np.ndarray) -> np.ndarray:
@@ -164,13 +169,15 @@ class StratifiedSampler(Sampler):
 
     def value_1d(self, pixel, index, dim):
         k, h = self._stratum(pixel, index, dim, self.spp)
-        return (k + unit_float(h)) / self.spp
+        return jittered(k, unit_float(h), self.spp)
 
     def value_2d(self, pixel, index, dim):
         nx, ny = grid_2d(self.spp)
         k, h = self._stratum(pixel, index, dim, nx * ny)
         row, column = np.divmod(k, nx)
-        return np.stack([(column + unit_float(h)) / nx, (row + unit_float(mix64(h))) / ny])
+        return np.stack(
+            [jittered(column, unit_float(h), nx), jittered(row, unit_float(mix64(h)), ny)]
+        )
 
 
 class SobolSampler(Sampler):

@@ -50,6 +50,11 @@ def test_building_blocks_equal_the_scalar_ones():
     assert batch.hash_key(3, np.arange(4), 5).tolist() == [
         scalar.hash_key(3, k, 5) for k in range(4)
     ]
+    n = np.arange(1, 300)
+    for u in (0.0, 0.5, 1.0 - 2.0**-53):
+        assert batch.jittered(n - 1, u, n).tolist() == [
+            scalar.jittered(int(k) - 1, u, int(k)) for k in n
+        ]
 
 
 def make_lane_sampler(seed: int = 2) -> LaneSampler:
