@@ -288,6 +288,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small images, 1 round")
     parser.add_argument("--write-doc", action="store_true", help="update docs/bench.md")
     args = parser.parse_args(argv)
+    from rtpy.bench.machine import compile_bytecode
+
+    compile_bytecode()  # whole processes are timed: as an installed rtpy starts
     from rtpy.bench.machine import machine
     from rtpy.bench.report import machine_lines, replace_generated
 

@@ -27,6 +27,17 @@ def load_average() -> tuple[float, float, float] | None:
         return None
 
 
+def compile_bytecode() -> None:
+    """Compile rtpy's modules to bytecode files, as installing a package does, so that
+    a timed process loads them instead of compiling every module from source (which
+    it does on every start when PYTHONDONTWRITEBYTECODE is set, or the package folder
+    is read-only)."""
+    import compileall
+    from pathlib import Path
+
+    compileall.compile_dir(Path(__file__).resolve().parent.parent, quiet=1)
+
+
 def machine() -> dict:
     """The processor, its cores, the system, the Python and numpy versions and the
     load average."""

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import platform
+import sys
+from pathlib import Path
 
 import numpy as np
 
-from rtpy.bench.machine import cpu_model, load_average, machine
+import rtpy
+from rtpy.bench.machine import compile_bytecode, cpu_model, load_average, machine
 
 
 def test_machine_names_cpu_cores_versions_and_load():
@@ -28,3 +32,13 @@ def test_load_average_is_the_systems(monkeypatch):
 
     monkeypatch.setattr(os, "getloadavg", unavailable)
     assert load_average() is None
+
+
+def test_compile_bytecode_writes_every_modules_cache(tmp_path, monkeypatch):
+    """Whole-process benchmarks start rtpy as an installed package does, from bytecode."""
+    monkeypatch.setattr(sys, "pycache_prefix", str(tmp_path))  # not beside the sources
+    compile_bytecode()
+    package = Path(rtpy.__file__).parent
+    for module in ("vec3.py", "numpy_backend/quad.py", "io/cli.py"):
+        cached = Path(importlib.util.cache_from_source(str(package / module)))
+        assert cached.is_relative_to(tmp_path) and cached.exists()
