@@ -42,6 +42,11 @@ class Triangle(FlatShape):
         self.material = material
         self._area = 0.5 * n_len
         self._tangent = self.e1 / self.e1.length()  # u runs from a toward b
+        # surface_uv solves for (u, v) in the coordinate plane the triangle is least
+        # tilted from: the one across the axis of the normal's largest component.
+        drop = max(range(3), key=lambda c: abs(n[c]))
+        self._plane_axes = ((drop + 1) % 3, (drop + 2) % 3)
+        self._plane_det = n[drop]  # the projected twice-area, at least n_len / sqrt(3)
         # det^2 <= _parallel_det2 * |d|^2 means parallel
         self._parallel_det2 = (PARALLEL_TOLERANCE * self.e1.length() * self.e2.length()) ** 2
 
@@ -84,18 +89,16 @@ class Triangle(FlatShape):
         return HitInfo(ray.at(t), n if front_face else -n, t, front_face, self.material, self)
 
     def surface_uv(self, hit: HitInfo) -> tuple[float, float]:
-        # Barycentric coordinates of the hit point: p - a = u e1 + v e2, solved by the
-        # normal equations. Their determinant d00 d11 - d01^2 is |e1 x e2|^2 (Lagrange's
-        # identity), taken from the area: the difference itself cancels to 0 for a long
+        # Barycentric coordinates of the hit point, p - a = u e1 + v e2, by Cramer's
+        # rule on two of the three equations: those of the plane the triangle is least
+        # tilted from (Badouel 1990), whose determinant is largest. The normal
+        # equations would square the condition number and lose every digit on a long
         # thin triangle (edges 5e5 long, 1e-6 apart).
         p = hit.point - self.a
+        i, j = self._plane_axes
         e1, e2 = self.e1, self.e2
-        d00, d01, d11 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
-        d20, d21 = dot(p, e1), dot(p, e2)
-        twice_area = 2.0 * self._area
-        denom = twice_area * twice_area
-        u = (d11 * d20 - d01 * d21) / denom
-        v = (d00 * d21 - d01 * d20) / denom
+        u = (p[i] * e2[j] - p[j] * e2[i]) / self._plane_det
+        v = (e1[i] * p[j] - e1[j] * p[i]) / self._plane_det
         return min(1.0, max(0.0, u)), min(1.0, max(0.0, v))
 
     def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:

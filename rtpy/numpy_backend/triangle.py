@@ -35,6 +35,9 @@ class TriangleSet(PlanarSet):
         # Triangle's relative parallel test: det^2 <= parallel_det2 * |d|^2 is a miss.
         self.parallel_det2 = np.array([s._parallel_det2 for s in triangles], dtype=np.float64)
         self.N = np.cross(self.e1, self.e2)
+        # Triangle.surface_uv's coordinate plane: axes (K, 2) and determinant (K,)
+        self.plane_axes = np.array([s._plane_axes for s in triangles], dtype=np.int64)
+        self.plane_det = np.array([s._plane_det for s in triangles], dtype=np.float64)
         self.e2xa = np.cross(self.e2, self.a)
         self.axe1 = np.cross(self.a, self.e1)
         self.aN = dot(self.a, self.N)
@@ -89,15 +92,17 @@ class TriangleSet(PlanarSet):
         return self._finish(det, parallel, u_num, v_num, t_num, t_min, t_max)
 
     def surface_uv(self, k, point):
-        # Triangle.surface_uv: the normal equations, their determinant from the area.
+        # Triangle.surface_uv: Cramer's rule in each triangle's coordinate plane.
         p = point - self.a[k]
-        e1, e2 = self.e1[k], self.e2[k]
-        d00, d01, d11 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
-        d20, d21 = dot(p, e1), dot(p, e2)
-        twice_area = 2.0 * self._area[k]
-        denom = twice_area * twice_area
-        u = (d11 * d20 - d01 * d21) / denom
-        v = (d00 * d21 - d01 * d20) / denom
+        axes = self.plane_axes[k]
+        i, j = axes[:, :1], axes[:, 1:]
+
+        def pick(a, c):  # (N,) components c of the rows of a
+            return np.take_along_axis(a, c, axis=1)[:, 0]
+
+        e1, e2, det = self.e1[k], self.e2[k], self.plane_det[k]
+        u = (pick(p, i) * pick(e2, j) - pick(p, j) * pick(e2, i)) / det
+        v = (pick(e1, i) * pick(p, j) - pick(e1, j) * pick(p, i)) / det
         return np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
 
     def shading_normal(self, k, point, geo):
