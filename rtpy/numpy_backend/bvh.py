@@ -131,40 +131,40 @@ class BVH:
         node = np.zeros(n, dtype=np.int64)
         done = np.zeros(n, dtype=bool)
         while ray.size:
-            ro, ri = o[ray], inv[ray]
+            ro, ri = o.take(ray, axis=0), inv.take(ray, axis=0)
             with np.errstate(invalid="ignore", over="ignore"):
-                t0 = (self.lo[node] - ro) * ri
-                t1 = (self.hi[node] - ro) * ri
+                t0 = (self.lo.take(node, axis=0) - ro) * ri
+                t1 = (self.hi.take(node, axis=0) - ro) * ri
             near = max3(np.minimum(t0, t1))
             lo = np.maximum(t0, t1)
             far = np.minimum(np.minimum(lo[:, 0], lo[:, 1]), lo[:, 2])
-            keep = (near <= far) & (far > t_min) & (near < best_t[ray])
+            keep = (near <= far) & (far > t_min) & (near < best_t.take(ray))
             if any_hit:
-                keep &= ~done[ray]
-            ray, node = ray[keep], node[keep]
-            leaf = self.count[node] > 0
+                keep &= ~done.take(ray)
+            ray, node = ray.compress(keep), node.compress(keep)
+            cnt = self.count.take(node)
+            leaf = cnt > 0
             if leaf.any():
-                lr, ln = ray[leaf], node[leaf]
-                cnt = self.count[ln]
+                lr, ln, cnt = ray.compress(leaf), node.compress(leaf), cnt.compress(leaf)
                 pr = np.repeat(lr, cnt)
-                first = np.repeat(self.start[ln] - (np.cumsum(cnt) - cnt), cnt)
-                pp = self.order[first + np.arange(len(pr))]
-                t = test(pr, pp, best_t[pr])
-                hit = t < best_t[pr]
+                first = np.repeat(self.start.take(ln) - (np.cumsum(cnt) - cnt), cnt)
+                pp = self.order.take(first + np.arange(len(pr)))
+                t = test(pr, pp, best_t.take(pr))
+                hit = t < best_t.take(pr)
                 if hit.any():
-                    pr, pp, t = pr[hit], pp[hit], t[hit]
+                    pr, pp, t = pr.compress(hit), pp.compress(hit), t.compress(hit)
                     if any_hit:
                         done[pr] = True
                         best_t[pr] = t
                         best_p[pr] = pp
                     else:
                         np.minimum.at(best_t, pr, t)
-                        win = t == best_t[pr]
-                        best_p[pr[win]] = pp[win]
+                        win = t == best_t.take(pr)
+                        best_p[pr.compress(win)] = pp.compress(win)
                 inner = ~leaf
-                ray, node = ray[inner], node[inner]
+                ray, node = ray.compress(inner), node.compress(inner)
             ray = np.concatenate([ray, ray])
-            node = np.concatenate([self.left[node], self.right[node]])
+            node = np.concatenate([self.left.take(node), self.right.take(node)])
         return best_t, best_p
 
 

@@ -105,9 +105,9 @@ class PrimitiveSet:
         if self.bvh is not None:
 
             def test(r, p, tm):
-                t = self.hit_t(o[r], d[r], p, t_min, tm)
+                t = self.hit_t(o.take(r, axis=0), d.take(r, axis=0), p, t_min, tm)
                 if ignore is not None:
-                    t[p == ignore[r]] = INF
+                    t[p == ignore.take(r)] = INF
                 return t
 
             return self.bvh.traverse(o, d, t_min, t_max, test, any_hit)
