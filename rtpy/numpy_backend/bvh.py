@@ -74,35 +74,43 @@ class BVH:
     @staticmethod
     def _sah_split(idx, lo, hi, centroid, bins: int = 16):
         """Split idx in two by the cheapest of `bins` planes per axis (surface area
-        heuristic), or None when keeping a leaf is cheaper."""
+        heuristic), or None when keeping a leaf is cheaper. The boxes on either side
+        of every plane come from running min/max over the bins' boxes; of equal costs
+        the first in (axis, plane) order wins."""
 
         def area(a, b):
             e = np.maximum(b - a, 0.0)
             return 2.0 * (e[..., 0] * e[..., 1] + e[..., 1] * e[..., 2] + e[..., 2] * e[..., 0])
 
-        c = centroid[idx]
-        best = (area(lo[idx].min(0), hi[idx].max(0)) * len(idx), None)
+        c, box_lo, box_hi, n = centroid[idx], lo[idx], hi[idx], len(idx)
+        leaf_cost = area(box_lo.min(0), box_hi.max(0)) * n
+        cost = np.full((3, bins - 1), np.inf)
+        binned = []
         for axis in range(3):
             cmin, cmax = c[:, axis].min(), c[:, axis].max()
             if not cmax > cmin:
+                binned.append(None)
                 continue
             b = np.minimum(((c[:, axis] - cmin) / (cmax - cmin) * bins).astype(int), bins - 1)
-            for plane in range(1, bins):
-                m = b < plane
-                n_left = int(m.sum())
-                if n_left == 0 or n_left == len(idx):
-                    continue
-                il, ir = idx[m], idx[~m]
-                cost = area(lo[il].min(0), hi[il].max(0)) * len(il) + area(
-                    lo[ir].min(0), hi[ir].max(0)
-                ) * len(ir)
-                if cost < best[0]:
-                    best = (cost, (il, ir))
-        if best[1] is None and len(idx) > 4 * BVH_LEAF_SIZE:
+            binned.append(b)
+            bin_lo, bin_hi = np.full((bins, 3), np.inf), np.full((bins, 3), -np.inf)
+            np.minimum.at(bin_lo, b, box_lo)
+            np.maximum.at(bin_hi, b, box_hi)
+            n_left = np.cumsum(np.bincount(b, minlength=bins))[:-1]  # for planes 1 .. bins-1
+            left = area(np.minimum.accumulate(bin_lo)[:-1], np.maximum.accumulate(bin_hi)[:-1])
+            right_lo = np.minimum.accumulate(bin_lo[::-1])[::-1][1:]
+            right_hi = np.maximum.accumulate(bin_hi[::-1])[::-1][1:]
+            split = left * n_left + area(right_lo, right_hi) * (n - n_left)
+            cost[axis] = np.where((n_left > 0) & (n_left < n), split, np.inf)
+        axis, plane = np.unravel_index(np.argmin(cost), cost.shape)
+        if cost[axis, plane] < leaf_cost:
+            m = binned[axis] < plane + 1
+            return idx[m], idx[~m]
+        if len(idx) > 4 * BVH_LEAF_SIZE:
             # All centroids together (or no better split): halve by index.
             half = len(idx) // 2
             return idx[:half], idx[half:]
-        return best[1]
+        return None
 
     def traverse(
         self,
