@@ -28,6 +28,8 @@ BVH_LEAF_SIZE = 4
 # of the surface area of the whole set's box.
 CLUSTER_SIZE = 3
 CLUSTER_AREA = 0.5
+# Rays per chunk of the clusters' slab test.
+BOX_CHUNK = 8192
 
 
 class BVH:
@@ -300,13 +302,27 @@ def _enters_box(oc, inv, lo, hi, t_min: float, t_max: np.ndarray) -> np.ndarray:
     meet the box lo, hi at some t in (t_min, t_max) (slab test, one axis at a time).
     A zero (or subnormal) direction component gives inv = +-inf; then (lo - o) * inv is
     nan only for an origin exactly on a slab plane, and nan comparisons count as
-    entering. A huge finite inv may overflow the product to +-inf likewise."""
-    near = far = None
+    entering. A huge finite inv may overflow the product to +-inf likewise. Rays go
+    in chunks of BOX_CHUNK, so the temporaries stay in cache."""
+    out = np.empty(len(t_max), dtype=bool)
     with np.errstate(invalid="ignore", over="ignore"):
-        for c in range(3):
-            a = (lo[c] - oc[c]) * inv[c]
-            b = (hi[c] - oc[c]) * inv[c]
-            n_c, f_c = np.minimum(a, b), np.maximum(a, b)
-            near = n_c if near is None else np.fmax(near, n_c)
-            far = f_c if far is None else np.fmin(far, f_c)
-        return ~((near > far) | (far <= t_min) | (near >= t_max))
+        for s in range(0, len(t_max), BOX_CHUNK):
+            e = s + BOX_CHUNK
+            near = far = None
+            for c in range(3):
+                a = np.subtract(lo[c], oc[c, s:e])
+                a *= inv[c, s:e]
+                f_c = np.subtract(hi[c], oc[c, s:e])
+                f_c *= inv[c, s:e]
+                n_c = np.minimum(a, f_c)
+                np.maximum(a, f_c, out=f_c)
+                if near is None:
+                    near, far = n_c, f_c
+                else:
+                    np.fmax(near, n_c, out=near)
+                    np.fmin(far, f_c, out=far)
+            miss = near > far
+            miss |= far <= t_min
+            miss |= near >= t_max[s:e]
+            np.logical_not(miss, out=out[s:e])
+    return out
