@@ -72,10 +72,11 @@ class PrimitiveSet:
 
     def pair_t(
         self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray | None = None
-    ) -> np.ndarray:
+    ) -> np.ndarray | None:
         """all_t as (K, N), primitive by ray; a set may compute it in this layout, in
         which numpy runs the per-pair arithmetic and the reduction over primitives
-        on contiguous rows (then all_t is its transpose)."""
+        on contiguous rows (then all_t is its transpose). With t_max, None where the
+        set finds that no pair can hit before it."""
         return self.all_t(o, d, t_min, t_max).T
 
     def bounding_boxes(self) -> tuple[np.ndarray, np.ndarray]:
@@ -119,6 +120,8 @@ class PrimitiveSet:
         for s in range(0, len(o), chunk):
             e = min(s + chunk, len(o))
             t = self.pair_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None)
+            if t is None:
+                continue
             if ignore is not None:
                 r = np.flatnonzero(ignore[s:e] >= 0)
                 t[ignore[s:e][r], r] = INF

@@ -54,12 +54,14 @@ class QuadSet(PlanarSet):
         return np.stack([self.q, self.q + self.u, self.q + self.v, self.q + self.u + self.v], 1)
 
     def all_t(self, o, d, t_min, t_max=None):
-        return self.pair_t(o, d, t_min, t_max).T
+        t = self.pair_t(o, d, t_min, t_max)
+        return np.full((len(o), len(self)), INF) if t is None else t.T
 
     def pair_t(self, o, d, t_min, t_max=None):
         """As PrimitiveSet.pair_t. With t_max (N,) (occlusion), the edges are tested
-        only for the quads whose plane some ray crosses in (t_min, t_max): a shadow
-        ray inside a room crosses none of the walls' planes."""
+        only for the quads whose plane some ray crosses in (t_min, t_max), and None
+        says that there are none: a shadow ray inside a room crosses none of the
+        walls' planes."""
         # Homogeneous o: one product gives d - o.n and 2 (o.A - q.A) - 1 (and for B),
         # so a' = 2a - 1 and b' = 2b - 1 need one multiply-add each and the test
         # 0 <= a, b <= 1 becomes max(|a'|, |b'|) <= 1.
@@ -75,11 +77,12 @@ class QuadSet(PlanarSet):
                 return self._inside(oh, d, t, t_min, slice(None))
             crossed = (t > t_min) & (t < t_max)
             quads = np.flatnonzero(crossed.any(axis=1))
+            if quads.size == 0:
+                return None
             if quads.size == len(self):
                 return self._inside(oh, d, t, t_min, slice(None))
             out = np.full(t.shape, INF)
-            if quads.size:
-                out[quads] = self._inside(oh, d, t[quads], t_min, quads)
+            out[quads] = self._inside(oh, d, t[quads], t_min, quads)
             return out
 
     def _inside(self, oh, d, t, t_min, quads):
