@@ -28,6 +28,8 @@ BVH_LEAF_SIZE = 4
 # of the surface area of the whole set's box.
 CLUSTER_SIZE = 3
 CLUSTER_AREA = 0.5
+# Rays per chunk of the clusters' slab test.
+BOX_CHUNK = 8192
 
 
 class BVH:
@@ -74,35 +76,43 @@ class BVH:
     @staticmethod
     def _sah_split(idx, lo, hi, centroid, bins: int = 16):
         """Split idx in two by the cheapest of `bins` planes per axis (surface area
-        heuristic), or None when keeping a leaf is cheaper."""
+        heuristic), or None when keeping a leaf is cheaper. The boxes on either side
+        of every plane come from running min/max over the bins' boxes; of equal costs
+        the first in (axis, plane) order wins."""
 
         def area(a, b):
             e = np.maximum(b - a, 0.0)
             return 2.0 * (e[..., 0] * e[..., 1] + e[..., 1] * e[..., 2] + e[..., 2] * e[..., 0])
 
-        c = centroid[idx]
-        best = (area(lo[idx].min(0), hi[idx].max(0)) * len(idx), None)
+        c, box_lo, box_hi, n = centroid[idx], lo[idx], hi[idx], len(idx)
+        leaf_cost = area(box_lo.min(0), box_hi.max(0)) * n
+        cost = np.full((3, bins - 1), np.inf)
+        binned = []
         for axis in range(3):
             cmin, cmax = c[:, axis].min(), c[:, axis].max()
             if not cmax > cmin:
+                binned.append(None)
                 continue
             b = np.minimum(((c[:, axis] - cmin) / (cmax - cmin) * bins).astype(int), bins - 1)
-            for plane in range(1, bins):
-                m = b < plane
-                n_left = int(m.sum())
-                if n_left == 0 or n_left == len(idx):
-                    continue
-                il, ir = idx[m], idx[~m]
-                cost = area(lo[il].min(0), hi[il].max(0)) * len(il) + area(
-                    lo[ir].min(0), hi[ir].max(0)
-                ) * len(ir)
-                if cost < best[0]:
-                    best = (cost, (il, ir))
-        if best[1] is None and len(idx) > 4 * BVH_LEAF_SIZE:
+            binned.append(b)
+            bin_lo, bin_hi = np.full((bins, 3), np.inf), np.full((bins, 3), -np.inf)
+            np.minimum.at(bin_lo, b, box_lo)
+            np.maximum.at(bin_hi, b, box_hi)
+            n_left = np.cumsum(np.bincount(b, minlength=bins))[:-1]  # for planes 1 .. bins-1
+            left = area(np.minimum.accumulate(bin_lo)[:-1], np.maximum.accumulate(bin_hi)[:-1])
+            right_lo = np.minimum.accumulate(bin_lo[::-1])[::-1][1:]
+            right_hi = np.maximum.accumulate(bin_hi[::-1])[::-1][1:]
+            split = left * n_left + area(right_lo, right_hi) * (n - n_left)
+            cost[axis] = np.where((n_left > 0) & (n_left < n), split, np.inf)
+        axis, plane = np.unravel_index(np.argmin(cost), cost.shape)
+        if cost[axis, plane] < leaf_cost:
+            m = binned[axis] < plane + 1
+            return idx[m], idx[~m]
+        if len(idx) > 4 * BVH_LEAF_SIZE:
             # All centroids together (or no better split): halve by index.
             half = len(idx) // 2
             return idx[:half], idx[half:]
-        return best[1]
+        return None
 
     def traverse(
         self,
@@ -131,40 +141,40 @@ class BVH:
         node = np.zeros(n, dtype=np.int64)
         done = np.zeros(n, dtype=bool)
         while ray.size:
-            ro, ri = o[ray], inv[ray]
+            ro, ri = o.take(ray, axis=0), inv.take(ray, axis=0)
             with np.errstate(invalid="ignore", over="ignore"):
-                t0 = (self.lo[node] - ro) * ri
-                t1 = (self.hi[node] - ro) * ri
+                t0 = (self.lo.take(node, axis=0) - ro) * ri
+                t1 = (self.hi.take(node, axis=0) - ro) * ri
             near = max3(np.minimum(t0, t1))
             lo = np.maximum(t0, t1)
             far = np.minimum(np.minimum(lo[:, 0], lo[:, 1]), lo[:, 2])
-            keep = (near <= far) & (far > t_min) & (near < best_t[ray])
+            keep = (near <= far) & (far > t_min) & (near < best_t.take(ray))
             if any_hit:
-                keep &= ~done[ray]
-            ray, node = ray[keep], node[keep]
-            leaf = self.count[node] > 0
+                keep &= ~done.take(ray)
+            ray, node = ray.compress(keep), node.compress(keep)
+            cnt = self.count.take(node)
+            leaf = cnt > 0
             if leaf.any():
-                lr, ln = ray[leaf], node[leaf]
-                cnt = self.count[ln]
+                lr, ln, cnt = ray.compress(leaf), node.compress(leaf), cnt.compress(leaf)
                 pr = np.repeat(lr, cnt)
-                first = np.repeat(self.start[ln] - (np.cumsum(cnt) - cnt), cnt)
-                pp = self.order[first + np.arange(len(pr))]
-                t = test(pr, pp, best_t[pr])
-                hit = t < best_t[pr]
+                first = np.repeat(self.start.take(ln) - (np.cumsum(cnt) - cnt), cnt)
+                pp = self.order.take(first + np.arange(len(pr)))
+                t = test(pr, pp, best_t.take(pr))
+                hit = t < best_t.take(pr)
                 if hit.any():
-                    pr, pp, t = pr[hit], pp[hit], t[hit]
+                    pr, pp, t = pr.compress(hit), pp.compress(hit), t.compress(hit)
                     if any_hit:
                         done[pr] = True
                         best_t[pr] = t
                         best_p[pr] = pp
                     else:
                         np.minimum.at(best_t, pr, t)
-                        win = t == best_t[pr]
-                        best_p[pr[win]] = pp[win]
+                        win = t == best_t.take(pr)
+                        best_p[pr.compress(win)] = pp.compress(win)
                 inner = ~leaf
-                ray, node = ray[inner], node[inner]
+                ray, node = ray.compress(inner), node.compress(inner)
             ray = np.concatenate([ray, ray])
-            node = np.concatenate([self.left[node], self.right[node]])
+            node = np.concatenate([self.left.take(node), self.right.take(node)])
         return best_t, best_p
 
 
@@ -292,13 +302,27 @@ def _enters_box(oc, inv, lo, hi, t_min: float, t_max: np.ndarray) -> np.ndarray:
     meet the box lo, hi at some t in (t_min, t_max) (slab test, one axis at a time).
     A zero (or subnormal) direction component gives inv = +-inf; then (lo - o) * inv is
     nan only for an origin exactly on a slab plane, and nan comparisons count as
-    entering. A huge finite inv may overflow the product to +-inf likewise."""
-    near = far = None
+    entering. A huge finite inv may overflow the product to +-inf likewise. Rays go
+    in chunks of BOX_CHUNK, so the temporaries stay in cache."""
+    out = np.empty(len(t_max), dtype=bool)
     with np.errstate(invalid="ignore", over="ignore"):
-        for c in range(3):
-            a = (lo[c] - oc[c]) * inv[c]
-            b = (hi[c] - oc[c]) * inv[c]
-            n_c, f_c = np.minimum(a, b), np.maximum(a, b)
-            near = n_c if near is None else np.fmax(near, n_c)
-            far = f_c if far is None else np.fmin(far, f_c)
-        return ~((near > far) | (far <= t_min) | (near >= t_max))
+        for s in range(0, len(t_max), BOX_CHUNK):
+            e = s + BOX_CHUNK
+            near = far = None
+            for c in range(3):
+                a = np.subtract(lo[c], oc[c, s:e])
+                a *= inv[c, s:e]
+                f_c = np.subtract(hi[c], oc[c, s:e])
+                f_c *= inv[c, s:e]
+                n_c = np.minimum(a, f_c)
+                np.maximum(a, f_c, out=f_c)
+                if near is None:
+                    near, far = n_c, f_c
+                else:
+                    np.fmax(near, n_c, out=near)
+                    np.fmin(far, f_c, out=far)
+            miss = near > far
+            miss |= far <= t_min
+            miss |= near >= t_max[s:e]
+            np.logical_not(miss, out=out[s:e])
+    return out

@@ -70,6 +70,15 @@ class PrimitiveSet:
         k = np.arange(len(self))[None, :]
         return self.hit_t(o[:, None, :], d[:, None, :], k, t_min, INF)
 
+    def pair_t(
+        self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray | None = None
+    ) -> np.ndarray | None:
+        """all_t as (K, N), primitive by ray; a set may compute it in this layout, in
+        which numpy runs the per-pair arithmetic and the reduction over primitives
+        on contiguous rows (then all_t is its transpose). With t_max, None where the
+        set finds that no pair can hit before it."""
+        return self.all_t(o, d, t_min, t_max).T
+
     def bounding_boxes(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi), each (K, 3): the primitives' axis-aligned boxes (Hittable.bounding_box)."""
         raise NotImplementedError
@@ -97,9 +106,9 @@ class PrimitiveSet:
         if self.bvh is not None:
 
             def test(r, p, tm):
-                t = self.hit_t(o[r], d[r], p, t_min, tm)
+                t = self.hit_t(o.take(r, axis=0), d.take(r, axis=0), p, t_min, tm)
                 if ignore is not None:
-                    t[p == ignore[r]] = INF
+                    t[p == ignore.take(r)] = INF
                 return t
 
             return self.bvh.traverse(o, d, t_min, t_max, test, any_hit)
@@ -108,15 +117,15 @@ class PrimitiveSet:
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(len(o), -1, dtype=np.int64)
         chunk = max(RAY_CHUNK, PAIR_CHUNK // len(self))
-        row_start = np.arange(0, min(chunk, len(o)) * len(self), len(self))  # in t.ravel()
         for s in range(0, len(o), chunk):
             e = min(s + chunk, len(o))
-            t = self.all_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None)
+            t = self.pair_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None)
+            if t is None:
+                continue
             if ignore is not None:
                 r = np.flatnonzero(ignore[s:e] >= 0)
-                t[r, ignore[s:e][r]] = INF
-            j = np.argmin(t, axis=1)
-            tj = t.ravel().take(row_start[: e - s] + j)  # t[i, j[i]]
+                t[ignore[s:e][r], r] = INF
+            tj, j = nearest(t)
             hit = tj < t_best[s:e]
             np.copyto(t_best[s:e], tj, where=hit)
             np.copyto(idx[s:e], j, where=hit)
@@ -169,6 +178,23 @@ class PrimitiveSet:
         valid &= t < INF
         point, geo = self.geometric(k, p, direction, np.where(valid, t, 0.0))
         return direction, pdf, valid, t, point, geo
+
+
+def nearest(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(t.min(axis=0), t.argmin(axis=0)) for (K, N) t: each ray's smallest t and the
+    first primitive giving it. numpy reduces along a C-contiguous array's first axis
+    quickly, but finds the argmin row by row, slowly for small K: here the argmin of
+    a C-contiguous t is the smallest k - K over the rows equal to the minimum."""
+    k = len(t)
+    if not t.flags.c_contiguous or k > 127:  # (all_t's (N, K) transposed: rows are cheap)
+        j = t.argmin(axis=0)
+        return t.T.ravel().take(j + np.arange(0, t.size, k)), j
+    tj = t.min(axis=0)
+    code = (t == tj).view(np.int8)
+    code *= np.arange(-k, 0, dtype=np.int8)[:, None]
+    j = code.min(axis=0).astype(np.int64)
+    j += k
+    return tj, j
 
 
 def area_direction(

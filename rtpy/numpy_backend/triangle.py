@@ -13,7 +13,7 @@ import numpy as np
 
 from ..mesh import SmoothTriangle
 from ..triangle import Triangle
-from .arrays import dot
+from .arrays import at, dot
 from .hittable import INF, PlanarSet, area_direction_pdf
 from .vec3 import rows_of
 
@@ -83,12 +83,12 @@ class TriangleSet(PlanarSet):
 
     def hit_t(self, o, d, k, t_min, t_max):
         m = np.cross(o, d)
-        nn = self.N[k]
+        nn = at(self.N, k)
         det = -dot(d, nn)
-        u_num = dot(self.e2[k], m) - dot(d, self.e2xa[k])
-        v_num = -dot(self.e1[k], m) - dot(d, self.axe1[k])
-        t_num = dot(o, nn) - self.aN[k]
-        parallel = self.parallel_det2[k] * dot(d, d)
+        u_num = dot(at(self.e2, k), m) - dot(d, at(self.e2xa, k))
+        v_num = -dot(at(self.e1, k), m) - dot(d, at(self.axe1, k))
+        t_num = dot(o, nn) - at(self.aN, k)
+        parallel = at(self.parallel_det2, k) * dot(d, d)
         return self._finish(det, parallel, u_num, v_num, t_num, t_min, t_max)
 
     def surface_uv(self, k, point):

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from rtpy import Quad, Scene
+from rtpy.numpy_backend import bvh
+from rtpy.numpy_backend.bvh import _enters_box
 from rtpy.numpy_backend.quad import QuadSet
 from rtpy.numpy_backend.scene import BatchScene
 
@@ -72,3 +74,31 @@ def test_clustered_quads_give_the_brute_force_answer():
     np.testing.assert_array_equal(obj, obj2)
     np.testing.assert_allclose(t, t2, rtol=1e-12)
     np.testing.assert_array_equal(blocked, geo.find_occlusion(o, d, t_max, ignore=skip))
+
+
+def test_slab_test_answers_alike_in_any_chunking(monkeypatch):
+    rng = np.random.default_rng(13)
+    lo, hi = np.array([-1.0, -0.5, 0.0]), np.array([1.0, 0.5, 2.0])
+    o, d = random_rays(rng, 3000, spread=4.0)
+    d[:10, 0] = 0.0  # parallel to a slab: inv = inf
+    # Rays aimed at points inside the box enter it before reaching them, unless the
+    # point lies behind t_min; rays from outside aimed away never enter it.
+    target = rng.uniform(lo, hi, (3000, 3))
+    aimed = np.arange(1000, 2000)
+    d[aimed] = target[aimed] - o[aimed]
+    dist = np.linalg.norm(d[aimed], axis=1)
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    away = np.arange(2000, 3000)
+    outside = ((o[away] < lo) | (o[away] > hi)).any(axis=1)
+    d[away] = np.where(outside[:, None], o[away] - target[away], d[away])
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    t_max = rng.uniform(0.0, 10.0, 3000)
+    t_max[aimed] = dist + 1e-9
+    oc = np.ascontiguousarray(o.T)
+    with np.errstate(divide="ignore"):
+        inv = 1.0 / np.ascontiguousarray(d.T)
+    whole = _enters_box(oc, inv, lo, hi, 0.0, t_max)
+    assert whole[aimed].all()
+    assert not whole[away[outside]].any()
+    monkeypatch.setattr(bvh, "BOX_CHUNK", 7)
+    np.testing.assert_array_equal(_enters_box(oc, inv, lo, hi, 0.0, t_max), whole)

@@ -23,3 +23,42 @@ def test_quad_t_matches_scalar(q, u, v, origin, ab):
 
     target = np.array(q) + ab[0] * np.array(u) + ab[1] * np.array(v)
     check_planar(quad, QuadSet([quad]), origin, target, edge_distance)
+
+
+def test_a_ray_in_a_quads_plane_still_finds_the_next_quad():
+    # The ray lies in the first quad's plane: its t there is 0 / 0 = nan, a miss.
+    floor = Quad(V((-5, -5, 0)), V((10, 0, 0)), V((0, 10, 0)), MAT)
+    wall = Quad(V((3, -5, -5)), V((0, 10, 0)), V((0, 0, 10)), MAT)
+    quads = QuadSet([floor, wall], cluster=False)
+    o = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 1.0]])
+    d = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    for any_hit in (False, True):
+        t, k = quads.closest_hit(o, d, 0.0, np.full(2, np.inf), any_hit)
+        np.testing.assert_array_equal(k, [1, 1])
+        np.testing.assert_allclose(t, [3.0, 3.0], rtol=1e-15)
+
+
+def test_occlusion_inside_a_closed_box_over_several_chunks():
+    # A ray from inside the cube [-1, 1]^3 meets a face at t >= 0.1; chunks of rays
+    # whose t_max stops short of every face cross no quad's plane at all.
+    faces = [
+        Quad(V(q), V(u), V(v), MAT)
+        for q, u, v in (
+            ((-1, -1, -1), (2, 0, 0), (0, 2, 0)),
+            ((-1, -1, 1), (2, 0, 0), (0, 2, 0)),
+            ((-1, -1, -1), (0, 2, 0), (0, 0, 2)),
+            ((1, -1, -1), (0, 2, 0), (0, 0, 2)),
+            ((-1, -1, -1), (2, 0, 0), (0, 0, 2)),
+            ((-1, 1, -1), (2, 0, 0), (0, 0, 2)),
+        )
+    ]
+    quads = QuadSet(faces, cluster=False)
+    rng = np.random.default_rng(17)
+    n = 10000
+    o = rng.uniform(-0.9, 0.9, (n, 3))
+    d = rng.normal(size=(n, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    short = np.arange(n) < 4000
+    t_max = np.where(short, 0.05, 10.0)
+    _, k = quads.closest_hit(o, d, 0.0, t_max, any_hit=True)
+    np.testing.assert_array_equal(k >= 0, ~short)
