@@ -4,6 +4,7 @@ one error when they cannot start, and the CPUs a render may use."""
 from __future__ import annotations
 
 import os
+import pickle
 import subprocess
 import sys
 
@@ -103,3 +104,35 @@ def test_available_cpus_is_what_this_process_may_use(monkeypatch):
     assert available_cpus() == 64  # Windows and macOS before 3.13
     monkeypatch.setattr(os, "cpu_count", lambda: None)
     assert available_cpus() == 1
+
+
+def _signal_handlers() -> tuple:
+    import signal
+
+    return signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+
+
+def test_a_worker_ignores_ctrl_c_and_ends_at_once_on_sigterm():
+    """The parent alone handles Ctrl-C (the terminal sends it to the whole group) and
+    ends the workers with SIGTERM: a worker ignores SIGINT and keeps SIGTERM's default
+    action, whatever handlers the parent had when it forked."""
+    import multiprocessing
+    import signal
+    from concurrent.futures import ProcessPoolExecutor
+
+    from rtpy.render_settings import RenderSettings
+    from rtpy.renderer import ScalarBackend
+    from rtpy.workers import _init_worker
+
+    backend = ScalarBackend(*small_scene(), RenderSettings())
+    previous = signal.signal(signal.SIGTERM, lambda *_: None)  # as the CLI's, inherited
+    try:
+        context = multiprocessing.get_context()
+        payload = backend if context.get_start_method() == "fork" else pickle.dumps(backend)
+        with ProcessPoolExecutor(
+            1, mp_context=context, initializer=_init_worker, initargs=({}, payload)
+        ) as pool:
+            handlers = pool.submit(_signal_handlers).result(timeout=120)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert handlers == (signal.SIG_IGN, signal.SIG_DFL)
