@@ -217,7 +217,11 @@ def format_report(startup, scaling, mitsuba, course, course_note, samplers) -> l
     for what, ratio, goal in summary(scaling, mitsuba, course):
         shown = "skipped" if ratio is None else f"{ratio:.2f}x"
         lines.append(f"| {what} | {shown} | {'' if goal is None else f'{goal:g}x'} |")
-    lines += ["", "Start-up of a small render (median seconds per step):", ""]
+    title = (
+        "Start-up of a small render (median seconds per step; rtpy's modules compiled "
+        "to bytecode first, as an installed package has them):"
+    )
+    lines += ["", title, ""]
     lines += ["| step | seconds |", "|---|---|"]
     lines += [f"| {step} | {seconds:.3f} |" for step, seconds in startup]
     lines += ["", "2-worker scaling, cornell, numpy backend, whole process:", ""]
