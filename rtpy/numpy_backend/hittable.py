@@ -163,7 +163,7 @@ class PrimitiveSet:
         """Hittable.sample_direction: (direction, pdf, valid) toward a point sampled
         uniformly by area, pdf converted to solid angle."""
         q, n = self.sample_point(k, r1, r2)
-        return area_direction(p, q, n, self.area(k))
+        return area_direction(p, q, n, self.area(k))[:3]
 
     def direction_pdf(self, k, p, q, n) -> np.ndarray:
         """Hittable.direction_pdf: the density with which sample_direction(p) picks the
@@ -199,20 +199,20 @@ def nearest(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def area_direction(
     p: np.ndarray, point: np.ndarray, normal: np.ndarray, area: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Hittable.sample_direction after sample_point: (direction, pdf, valid) for the
-    direction from p to a point sampled by area, pdf = dist^2 / (|cos_light| area)."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Hittable.sample_direction after sample_point: (direction, pdf, valid, distance)
+    for the direction from p to a point sampled by area, pdf = dist^2 / (|cos_light| area)."""
     dv = point - p
     dist2 = dot(dv, dv)
     valid = dist2 >= MIN_LIGHT_DISTANCE2
     # Invalid rows (too near, grazing) may divide by ~0 here; np.where discards them.
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        k = 1.0 / np.sqrt(dist2)
-        direction = scale(dv, k)
+        dist = np.sqrt(dist2)
+        direction = scale(dv, 1.0 / dist)
         cos_light = np.abs(dot(direction, normal))
         valid &= cos_light >= 1e-12
         pdf = dist2 / (cos_light * area)
-    return direction, np.where(valid, pdf, 0.0), valid
+    return direction, np.where(valid, pdf, 0.0), valid, dist
 
 
 def area_direction_pdf(p: np.ndarray, q: np.ndarray, n: np.ndarray, area: np.ndarray) -> np.ndarray:
@@ -264,9 +264,8 @@ class PlanarSet(PrimitiveSet):
         the plane, so it is not traced again (the scalar code traces it and gets the
         same point up to rounding)."""
         q, n = self.sample_point(k, r1, r2)
-        direction, pdf, valid = area_direction(p, q, n, self.area(k))
-        dv = q - p
-        return direction, pdf, valid, np.sqrt(dot(dv, dv)), q, n
+        direction, pdf, valid, dist = area_direction(p, q, n, self.area(k))
+        return direction, pdf, valid, dist, q, n
 
 
 class ScalarSet(PrimitiveSet):

@@ -18,10 +18,16 @@ def offset_scale(p: np.ndarray) -> np.ndarray:
     return SPAWN_ABSOLUTE_OFFSET + SPAWN_RELATIVE_OFFSET * max3(np.abs(p))
 
 
-def spawn_origins(point: np.ndarray, normal: np.ndarray, direction: np.ndarray) -> np.ndarray:
+def spawn_origins(
+    point: np.ndarray,
+    normal: np.ndarray,
+    direction: np.ndarray,
+    offset: np.ndarray | None = None,
+) -> np.ndarray:
     """Origins of rtpy.ray.spawn_ray(point, normal, direction) for (N, 3) arrays: the
-    point pushed off the surface along the normal to the side the direction goes."""
-    eps = offset_scale(point)
+    point pushed off the surface along the normal to the side the direction goes.
+    offset: offset_scale(point), when the caller has it."""
+    eps = offset_scale(point) if offset is None else offset.copy()
     below = dot(direction, normal) < 0.0
     np.negative(eps, out=eps, where=below)
     return axpy(eps, normal, point)

@@ -56,13 +56,14 @@ def sample_one_light(
     if keep.size < idx.size:
         idx, wi, f, part = idx.take(keep), rows(wi, keep), rows(f, keep), part.take(keep)
         brdf_pdf = None if brdf_pdf is None else brdf_pdf.take(keep)
-    origin = spawn_origins(part.point, part.normal, wi)
+    offset = offset_scale(part.point)
+    origin = spawn_origins(part.point, part.normal, wi, offset)
     # Stop the shadow ray just short of the light's surface, and let the light
     # itself not block it: the spawned origin is off the point the light was
     # sampled from, so the shadow ray can meet the light's surface a little
     # before `distance` (by far more than the offsets where it arrives at a
     # slant), and a convex light cannot hide its own sampled point.
-    t_max = s.distance.take(idx) - offset_scale(rows(s.point, idx)) - offset_scale(part.point)
+    t_max = s.distance.take(idx) - offset_scale(rows(s.point, idx)) - offset
     blocked = scene.find_occlusion(origin, wi, t_max, ignore=s.obj.take(idx))
     if blocked.any():
         keep = np.flatnonzero(~blocked)
