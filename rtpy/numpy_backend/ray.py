@@ -23,11 +23,12 @@ def spawn_origins(
     normal: np.ndarray,
     direction: np.ndarray,
     offset: np.ndarray | None = None,
+    cos: np.ndarray | None = None,
 ) -> np.ndarray:
     """Origins of rtpy.ray.spawn_ray(point, normal, direction) for (N, 3) arrays: the
     point pushed off the surface along the normal to the side the direction goes.
-    offset: offset_scale(point), when the caller has it."""
+    offset, cos: offset_scale(point) and dot(direction, normal), when the caller has them."""
     eps = offset_scale(point) if offset is None else offset.copy()
-    below = dot(direction, normal) < 0.0
+    below = (dot(direction, normal) if cos is None else cos) < 0.0
     np.negative(eps, out=eps, where=below)
     return axpy(eps, normal, point)
