@@ -71,12 +71,18 @@ class PrimitiveSet:
         return self.hit_t(o[:, None, :], d[:, None, :], k, t_min, INF)
 
     def pair_t(
-        self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray | None = None
+        self,
+        o: np.ndarray,
+        d: np.ndarray,
+        t_min: float,
+        t_max: np.ndarray | None = None,
+        columns: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> np.ndarray | None:
         """all_t as (K, N), primitive by ray; a set may compute it in this layout, in
         which numpy runs the per-pair arithmetic and the reduction over primitives
         on contiguous rows (then all_t is its transpose). With t_max, None where the
-        set finds that no pair can hit before it."""
+        set finds that no pair can hit before it. columns: ray.ray_columns(o, d), when
+        the caller has them (a set may use them instead of o and d)."""
         return self.all_t(o, d, t_min, t_max).T
 
     def bounding_boxes(self) -> tuple[np.ndarray, np.ndarray]:
@@ -99,10 +105,11 @@ class PrimitiveSet:
         t_max: np.ndarray,
         any_hit: bool = False,
         ignore: np.ndarray | None = None,
+        columns: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """(t, local index) of each ray's closest hit before t_max (t_max, -1 if none),
         as the scalar BVH.closest_hit. any_hit: any hit will do (occlusion, BVH.any_hit).
-        ignore: per ray, a primitive not to test (-1: none)."""
+        ignore: per ray, a primitive not to test (-1: none). columns: as in pair_t."""
         if self.bvh is not None:
 
             def test(r, p, tm):
@@ -119,7 +126,8 @@ class PrimitiveSet:
         chunk = max(RAY_CHUNK, PAIR_CHUNK // len(self))
         for s in range(0, len(o), chunk):
             e = min(s + chunk, len(o))
-            t = self.pair_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None)
+            cols = None if columns is None else (columns[0][:, s:e], columns[1][:, s:e])
+            t = self.pair_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None, cols)
             if t is None:
                 continue
             if ignore is not None:

@@ -18,6 +18,15 @@ def offset_scale(p: np.ndarray) -> np.ndarray:
     return SPAWN_ABSOLUTE_OFFSET + SPAWN_RELATIVE_OFFSET * max3(np.abs(p))
 
 
+def ray_columns(o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rays (o, d) as columns: (4, N) homogeneous origins (x, y, z, 1) and (3, N)
+    directions, the layout of QuadSet.pair_t's matrix products."""
+    oh = np.empty((4, len(o)))
+    oh[:3] = o.T
+    oh[3] = 1.0
+    return oh, np.ascontiguousarray(d.T)
+
+
 def spawn_origins(
     point: np.ndarray,
     normal: np.ndarray,
