@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .arrays import max3
+from .ray import ray_columns
 
 if TYPE_CHECKING:
     from .hittable import PrimitiveSet
@@ -216,28 +217,29 @@ class Clusters:
         without a box goes first)."""
         t_best = np.array(t_max, dtype=np.float64, copy=True)
         idx = np.full(len(o), -1, dtype=np.int64)
-        oc = np.ascontiguousarray(o.T)
+        columns = ray_columns(o, d)
         with np.errstate(divide="ignore", over="ignore"):  # 0 or subnormal: +-inf
-            inv = 1.0 / np.ascontiguousarray(d.T)
+            inv = 1.0 / columns[1]
         for p, (lo, hi, part, members) in enumerate(self.parts):
             if lo is None:
                 rays = None
-                ro, rd, rt = o, d, t_best
+                ro, rd, rt, cols = o, d, t_best, columns
             else:
-                enter = _enters_box(oc, inv, lo, hi, t_min, t_best)
+                enter = _enters_box(columns[0], inv, lo, hi, t_min, t_best)
                 if any_hit:
                     enter &= idx < 0
                 rays = np.flatnonzero(enter)
                 if rays.size == 0:
                     continue
                 ro, rd, rt = o.take(rays, axis=0), d.take(rays, axis=0), t_best.take(rays)
+                cols = None
             local_ignore = None
             if ignore is not None:
                 ig = ignore if rays is None else ignore.take(rays)
                 k = np.maximum(ig, 0)
                 mine = (ig >= 0) & (self.part_of.take(k) == p)
                 local_ignore = np.where(mine, self.part_pos.take(k), -1)
-            t, k = part.closest_hit(ro, rd, t_min, rt, any_hit, local_ignore)
+            t, k = part.closest_hit(ro, rd, t_min, rt, any_hit, local_ignore, cols)
             hit = np.flatnonzero(k >= 0)
             w = hit if rays is None else rays.take(hit)
             t_best[w] = t.take(hit)
@@ -298,7 +300,7 @@ def _padded_box(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
 
 def _enters_box(oc, inv, lo, hi, t_min: float, t_max: np.ndarray) -> np.ndarray:
-    """(N,) bool: rays (origin columns oc (3, N), reciprocal direction columns inv)
+    """(N,) bool: rays (origin columns oc (3+, N), reciprocal direction columns inv)
     meet the box lo, hi at some t in (t_min, t_max) (slab test, one axis at a time).
     A zero (or subnormal) direction component gives inv = +-inf; then (lo - o) * inv is
     nan only for an origin exactly on a slab plane, and nan comparisons count as

@@ -101,6 +101,14 @@ class _HitRows(HitBatch):
     def __len__(self) -> int:
         return len(self._k)
 
+    def take(self, mask_or_index: np.ndarray) -> HitBatch:
+        """Rows of rows: the parent's rows, gathered once when a field is read (not
+        first into this batch, then again)."""
+        k = mask_or_index
+        if k.dtype == np.bool_:
+            k = np.flatnonzero(k)
+        return _HitRows(self._parent, self._k.take(k))
+
     def __getattr__(self, name: str) -> np.ndarray:
         if name not in _FIELDS:
             raise AttributeError(name)

@@ -71,12 +71,18 @@ class PrimitiveSet:
         return self.hit_t(o[:, None, :], d[:, None, :], k, t_min, INF)
 
     def pair_t(
-        self, o: np.ndarray, d: np.ndarray, t_min: float, t_max: np.ndarray | None = None
+        self,
+        o: np.ndarray,
+        d: np.ndarray,
+        t_min: float,
+        t_max: np.ndarray | None = None,
+        columns: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> np.ndarray | None:
         """all_t as (K, N), primitive by ray; a set may compute it in this layout, in
         which numpy runs the per-pair arithmetic and the reduction over primitives
         on contiguous rows (then all_t is its transpose). With t_max, None where the
-        set finds that no pair can hit before it."""
+        set finds that no pair can hit before it. columns: ray.ray_columns(o, d), when
+        the caller has them (a set may use them instead of o and d)."""
         return self.all_t(o, d, t_min, t_max).T
 
     def bounding_boxes(self) -> tuple[np.ndarray, np.ndarray]:
@@ -99,10 +105,11 @@ class PrimitiveSet:
         t_max: np.ndarray,
         any_hit: bool = False,
         ignore: np.ndarray | None = None,
+        columns: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """(t, local index) of each ray's closest hit before t_max (t_max, -1 if none),
         as the scalar BVH.closest_hit. any_hit: any hit will do (occlusion, BVH.any_hit).
-        ignore: per ray, a primitive not to test (-1: none)."""
+        ignore: per ray, a primitive not to test (-1: none). columns: as in pair_t."""
         if self.bvh is not None:
 
             def test(r, p, tm):
@@ -119,7 +126,8 @@ class PrimitiveSet:
         chunk = max(RAY_CHUNK, PAIR_CHUNK // len(self))
         for s in range(0, len(o), chunk):
             e = min(s + chunk, len(o))
-            t = self.pair_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None)
+            cols = None if columns is None else (columns[0][:, s:e], columns[1][:, s:e])
+            t = self.pair_t(o[s:e], d[s:e], t_min, t_best[s:e] if any_hit else None, cols)
             if t is None:
                 continue
             if ignore is not None:
@@ -163,7 +171,7 @@ class PrimitiveSet:
         """Hittable.sample_direction: (direction, pdf, valid) toward a point sampled
         uniformly by area, pdf converted to solid angle."""
         q, n = self.sample_point(k, r1, r2)
-        return area_direction(p, q, n, self.area(k))
+        return area_direction(p, q, n, self.area(k))[:3]
 
     def direction_pdf(self, k, p, q, n) -> np.ndarray:
         """Hittable.direction_pdf: the density with which sample_direction(p) picks the
@@ -199,20 +207,20 @@ def nearest(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def area_direction(
     p: np.ndarray, point: np.ndarray, normal: np.ndarray, area: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Hittable.sample_direction after sample_point: (direction, pdf, valid) for the
-    direction from p to a point sampled by area, pdf = dist^2 / (|cos_light| area)."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Hittable.sample_direction after sample_point: (direction, pdf, valid, distance)
+    for the direction from p to a point sampled by area, pdf = dist^2 / (|cos_light| area)."""
     dv = point - p
     dist2 = dot(dv, dv)
     valid = dist2 >= MIN_LIGHT_DISTANCE2
     # Invalid rows (too near, grazing) may divide by ~0 here; np.where discards them.
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        k = 1.0 / np.sqrt(dist2)
-        direction = scale(dv, k)
+        dist = np.sqrt(dist2)
+        direction = scale(dv, 1.0 / dist)
         cos_light = np.abs(dot(direction, normal))
         valid &= cos_light >= 1e-12
         pdf = dist2 / (cos_light * area)
-    return direction, np.where(valid, pdf, 0.0), valid
+    return direction, np.where(valid, pdf, 0.0), valid, dist
 
 
 def area_direction_pdf(p: np.ndarray, q: np.ndarray, n: np.ndarray, area: np.ndarray) -> np.ndarray:
@@ -264,9 +272,8 @@ class PlanarSet(PrimitiveSet):
         the plane, so it is not traced again (the scalar code traces it and gets the
         same point up to rounding)."""
         q, n = self.sample_point(k, r1, r2)
-        direction, pdf, valid = area_direction(p, q, n, self.area(k))
-        dv = q - p
-        return direction, pdf, valid, np.sqrt(dot(dv, dv)), q, n
+        direction, pdf, valid, dist = area_direction(p, q, n, self.area(k))
+        return direction, pdf, valid, dist, q, n
 
 
 class ScalarSet(PrimitiveSet):

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..hittable import MIN_LIGHT_DISTANCE2
-from .arrays import dot, put_rows, rows, where_rows
+from .arrays import dot, put_rows, rows
 from .materials.diffuse_light import DiffuseLightKernel
 from .vec3 import rows_of
 
@@ -65,9 +65,9 @@ class LightTable:
         self.single = self._single_diffuse_light()
 
     def _single_diffuse_light(self):
-        """(set, local index, object, emit (3,), two_sided) when the scene's only light
-        is one area light whose material is a DiffuseLight (all bundled scenes with an
-        area light), else None. Such a light is sampled by sample_single."""
+        """(set, local index, object, (2, 3) rows [0, emit], two_sided) when the scene's
+        only light is one area light whose material is a DiffuseLight (all bundled
+        scenes with an area light), else None. Such a light is sampled by sample_single."""
         if self.n != 1 or self.n_area != 1:
             return None
         scene, obj = self.scene, int(self.area_object[0])
@@ -78,7 +78,8 @@ class LightTable:
             return None
         slot = materials.slot[mid]
         prims = scene.sets[scene.kind[obj]]
-        return prims, int(scene.local[obj]), obj, kernel.emit[slot], bool(kernel.two_sided[slot])
+        dark_or_emit = np.stack([np.zeros(3), kernel.emit[slot]])
+        return prims, int(scene.local[obj]), obj, dark_or_emit, bool(kernel.two_sided[slot])
 
     def count(self, include_area: bool = True) -> int:
         return self.n if include_area else self.n_point
@@ -123,7 +124,7 @@ class LightTable:
         """sample() for a single DiffuseLight area light: no light choice, and the
         emission is `emit` where the sample sees the light's front face (or both faces
         when two-sided), without building the hits on the light."""
-        prims, local, obj, emit, two_sided = self.single
+        prims, local, obj, dark_or_emit, two_sided = self.single
         n = len(p)
         rng.random(n)  # the light choice's number: the general path's random stream
         r = rng.random((2, n))
@@ -133,7 +134,7 @@ class LightTable:
         # The front face is the one the geometric normal points to: dot(geo, d) < 0
         # for the direction d arriving there, as in BatchScene.hits_at.
         on = valid if two_sided else valid & (dot(geo, direction) < 0.0)
-        radiance = where_rows(on, np.broadcast_to(emit, (n, 3)))
+        radiance = dark_or_emit.take(on.view(np.uint8), axis=0)  # emit where on, else 0
         is_delta = np.zeros(n, dtype=bool)
         return LightSamples(
             direction, t, radiance, pdf, is_delta, point, valid, np.full(n, obj, dtype=np.int64)

@@ -13,6 +13,7 @@ import numpy as np
 from ..quad import Quad
 from .arrays import at, axpy, dot
 from .hittable import INF, PlanarSet
+from .ray import ray_columns
 from .vec3 import rows_of
 
 # Quads accept hits this little outside their edges (in units of the edge length):
@@ -57,7 +58,7 @@ class QuadSet(PlanarSet):
         t = self.pair_t(o, d, t_min, t_max)
         return np.full((len(o), len(self)), INF) if t is None else t.T
 
-    def pair_t(self, o, d, t_min, t_max=None):
+    def pair_t(self, o, d, t_min, t_max=None, columns=None):
         """As PrimitiveSet.pair_t. With t_max (N,) (occlusion), the edges are tested
         only for the quads whose plane some ray crosses in (t_min, t_max), and None
         says that there are none: a shadow ray inside a room crosses none of the
@@ -65,10 +66,7 @@ class QuadSet(PlanarSet):
         # Homogeneous o: one product gives d - o.n and 2 (o.A - q.A) - 1 (and for B),
         # so a' = 2a - 1 and b' = 2b - 1 need one multiply-add each and the test
         # 0 <= a, b <= 1 becomes max(|a'|, |b'|) <= 1.
-        oh = np.empty((4, len(o)))
-        oh[:3] = o.T
-        oh[3] = 1.0
-        d = np.ascontiguousarray(d.T)
+        oh, d = ray_columns(o, d) if columns is None else columns
         # A ray (almost) parallel to a plane meets it at t = inf or NaN (over a
         # subnormal denominator): a miss, as every comparison below finds.
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):

@@ -247,7 +247,7 @@ class SphereSet(PrimitiveSet):
             if isinstance(k, int):
                 k = np.full(len(p), k)
             q, n = self.sample_point(k[i], r1[i], r2[i])
-            direction[i], pdf[i], valid[i] = area_direction(p[i], q, n, self.area(k[i]))
+            direction[i], pdf[i], valid[i] = area_direction(p[i], q, n, self.area(k[i]))[:3]
         return direction, pdf, valid
 
     def sample_light(self, k, p, r1, r2):

@@ -47,3 +47,14 @@ def test_fields_are_gathered_only_when_read_and_once():
     assert part.normal is normal  # kept, not gathered again
     # Unused fields stay stride-0 zeros of the new length.
     assert part.tangent.shape == (3, 3) and part.tangent.strides[0] == 0
+
+
+def test_a_take_of_a_take_gathers_once_from_the_first_batch():
+    rng = np.random.default_rng(3)
+    hits = batch(50, rng)
+    once = hits.take(np.arange(10, 40))
+    mask = rng.random(30) < 0.5
+    twice = once.take(mask)
+    np.testing.assert_array_equal(twice.point, hits.point[10:40][mask])
+    np.testing.assert_array_equal(twice.front_face, hits.front_face[10:40][mask])
+    assert not set(FIELDS) & set(vars(once))  # nothing gathered into the middle batch

@@ -7,6 +7,7 @@ from hypothesis import assume, given, settings
 
 from rtpy import Quad
 from rtpy.numpy_backend.quad import QuadSet
+from rtpy.numpy_backend.ray import ray_columns
 
 from .geometry_checks import MAT, V, check_planar, planar_shape, unit_pair, vec
 
@@ -38,9 +39,8 @@ def test_a_ray_in_a_quads_plane_still_finds_the_next_quad():
         np.testing.assert_allclose(t, [3.0, 3.0], rtol=1e-15)
 
 
-def test_occlusion_inside_a_closed_box_over_several_chunks():
-    # A ray from inside the cube [-1, 1]^3 meets a face at t >= 0.1; chunks of rays
-    # whose t_max stops short of every face cross no quad's plane at all.
+def _cube_and_rays(n: int):
+    """The six faces of the cube [-1, 1]^3, unclustered, and n rays from inside it."""
     faces = [
         Quad(V(q), V(u), V(v), MAT)
         for q, u, v in (
@@ -52,13 +52,32 @@ def test_occlusion_inside_a_closed_box_over_several_chunks():
             ((-1, 1, -1), (2, 0, 0), (0, 0, 2)),
         )
     ]
-    quads = QuadSet(faces, cluster=False)
     rng = np.random.default_rng(17)
-    n = 10000
     o = rng.uniform(-0.9, 0.9, (n, 3))
     d = rng.normal(size=(n, 3))
     d /= np.linalg.norm(d, axis=1, keepdims=True)
+    return QuadSet(faces, cluster=False), o, d
+
+
+def test_occlusion_inside_a_closed_box_over_several_chunks():
+    # A ray from inside the cube [-1, 1]^3 meets a face at t >= 0.1; chunks of rays
+    # whose t_max stops short of every face cross no quad's plane at all.
+    n = 10000
+    quads, o, d = _cube_and_rays(n)
     short = np.arange(n) < 4000
     t_max = np.where(short, 0.05, 10.0)
     _, k = quads.closest_hit(o, d, 0.0, t_max, any_hit=True)
     np.testing.assert_array_equal(k >= 0, ~short)
+
+
+def test_closest_hit_on_handed_columns_is_closest_hit_on_rays():
+    # Several chunks of rays: each chunk must use its own columns.
+    n = 10000
+    quads, o, d = _cube_and_rays(n)
+    t_max = np.where(np.arange(n) % 3 == 0, 0.5, np.inf)
+    for any_hit in (False, True):
+        t, k = quads.closest_hit(o, d, 0.0, t_max, any_hit)
+        tc, kc = quads.closest_hit(o, d, 0.0, t_max, any_hit, columns=ray_columns(o, d))
+        assert (k >= 0).any() and (k < 0).any()
+        np.testing.assert_array_equal(kc, k)
+        np.testing.assert_array_equal(tc, t)

@@ -36,7 +36,8 @@ def sample_one_light(
     out = np.zeros((n, 3))
     n_lights = scene.lights.count(include_area)
     s = scene.lights.sample(hits.point, rng, include_area)
-    cos_i = np.abs(dot(hits.normal, s.direction))  # behind the surface: BRDF 0 unless glass
+    cos = dot(hits.normal, s.direction)
+    cos_i = np.abs(cos)  # behind the surface: BRDF 0 unless glass
     ok = s.valid & (max3(s.radiance) > 0.0) & (cos_i > 0.0)
     idx = np.flatnonzero(ok)
     if idx.size == 0:
@@ -56,13 +57,14 @@ def sample_one_light(
     if keep.size < idx.size:
         idx, wi, f, part = idx.take(keep), rows(wi, keep), rows(f, keep), part.take(keep)
         brdf_pdf = None if brdf_pdf is None else brdf_pdf.take(keep)
-    origin = spawn_origins(part.point, part.normal, wi)
+    offset = offset_scale(part.point)
+    origin = spawn_origins(part.point, part.normal, wi, offset, cos.take(idx))
     # Stop the shadow ray just short of the light's surface, and let the light
     # itself not block it: the spawned origin is off the point the light was
     # sampled from, so the shadow ray can meet the light's surface a little
     # before `distance` (by far more than the offsets where it arrives at a
     # slant), and a convex light cannot hide its own sampled point.
-    t_max = s.distance.take(idx) - offset_scale(rows(s.point, idx)) - offset_scale(part.point)
+    t_max = s.distance.take(idx) - offset_scale(rows(s.point, idx)) - offset
     blocked = scene.find_occlusion(origin, wi, t_max, ignore=s.obj.take(idx))
     if blocked.any():
         keep = np.flatnonzero(~blocked)

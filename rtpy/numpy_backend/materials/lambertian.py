@@ -9,7 +9,7 @@ import numpy as np
 from ...materials import Lambertian
 from ..arrays import put_rows, select
 from ..hit_info import HitBatch
-from ..onb import ONB
+from ..onb import local_to_world
 from ..sampling import cosine_direction
 from ..scatter_info import ScatterBatch
 from ..vec3 import components, dot, stack
@@ -28,7 +28,7 @@ class LambertianKernel(AlbedoKernel):
         n = len(slots)
         r = rng.random((2, n))
         local = cosine_direction(r[0], r[1])  # z = cos(theta) from the normal
-        direction = stack(*ONB(components(hits.normal)).to_world(local))
+        direction = stack(*local_to_world(components(hits.normal), *local))
         # BRDF * cos / pdf = (albedo / pi) * cos / (cos / pi) = albedo
         alive = np.ones(n, dtype=bool)
         return ScatterBatch(direction, self.albedo(slots, hits), local[2] * INV_PI, alive, ~alive)
