@@ -29,14 +29,17 @@ def on_every_core(function: Callable[[T], R], items: list[T]) -> list[R]:
 
 def _check(checks: dict[str, Callable[..., Any]], job: tuple[str, dict]) -> Any:
     test_name, params = job
-    return checks[test_name](**params)
+    try:
+        return checks[test_name](**params)
+    except AssertionError as error:  # raised again by outcome(), on its own test
+        return error
 
 
 def selected_checks(request, checks: dict[str, Callable[..., R]]) -> dict[str, R]:
     """For a module-scoped fixture: node id -> the outcome of checks[test](**params) for
     every test of the fixture's module named in `checks` that this session runs, with
-    that test's parameters. All of them run on every core, the tests in the order of
-    `checks` (list the longest first)."""
+    that test's parameters (or the AssertionError it raised). All of them run on every
+    core, the tests in the order of `checks` (list the longest first)."""
     order = list(checks)
     items = sorted(
         (
@@ -49,3 +52,12 @@ def selected_checks(request, checks: dict[str, Callable[..., R]]) -> dict[str, R
     jobs = [(item.originalname, dict(item.callspec.params)) for item in items]
     outcomes = on_every_core(functools.partial(_check, checks), jobs)
     return {item.nodeid: outcome for item, outcome in zip(items, outcomes, strict=True)}
+
+
+def outcome(outcomes: dict[str, R], request) -> R:
+    """The outcome of the requesting test in selected_checks' `outcomes`; the assertion
+    error of its check raised here."""
+    result = outcomes[request.node.nodeid]
+    if isinstance(result, AssertionError):
+        raise result
+    return result

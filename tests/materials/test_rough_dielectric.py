@@ -39,7 +39,7 @@ from rtpy.testing import (
 )
 from rtpy.vec3 import Color, dot
 
-from ..cores import selected_checks
+from ..cores import outcome, selected_checks
 from ..tiers import slow_except
 from ..vectors import angle, dot3, unit3
 from .directions import (
@@ -282,7 +282,7 @@ SAMPLING_CASES = [
 )
 @pytest.mark.slow
 def test_scattering_draws_the_pdf_and_weighs_by_it(slow_outcomes, request, name, theta, inside):
-    chi2_passed, chi2_summary, weights_passed, weights_detail = slow_outcomes[request.node.nodeid]
+    chi2_passed, chi2_summary, weights_passed, weights_detail = outcome(slow_outcomes, request)
     assert chi2_passed, chi2_summary
     assert weights_passed, weights_detail
 
@@ -380,7 +380,7 @@ def test_the_light_lost_is_what_the_facets_block(slow_outcomes, request, name, t
     the BSDF over the directions) is the visible-facet integral of what G1 blocks: the
     documented loss of single scattering, computed over m instead of wi (so the
     Jacobians, F and the eta^2 are checked by an independent route)."""
-    lost, quadrature_error, expected = slow_outcomes[request.node.nodeid]
+    lost, quadrature_error, expected = outcome(slow_outcomes, request)
     assert lost == pytest.approx(expected, abs=10 * quadrature_error + 2e-4)
     assert -1e-12 <= expected < 1.0
 
@@ -483,7 +483,7 @@ def slow_outcomes(request) -> dict[str, object]:
 @pytest.mark.parametrize("name", list(GLASSES))
 def test_check_material_passes_the_lecture_glasses(slow_outcomes, request, name):
     angles = CHECKED_ANGLES
-    report = slow_outcomes[request.node.nodeid]
+    report = outcome(slow_outcomes, request)
     assert report.passed, str(report)
     sides = [(c.incident_deg, c.inside) for c in report.checks if c.check == "chi2"]
     assert sides == [(t, inside) for inside in (False, True) for t in angles]
