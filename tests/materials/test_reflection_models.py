@@ -16,11 +16,7 @@ show that the same test at the same level rejects them.
 from __future__ import annotations
 
 import math
-import multiprocessing
-import os
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TypeVar
 
 import pytest
 
@@ -36,7 +32,8 @@ from rtpy.testing import (
 )
 from rtpy.vec3 import Color, dot, halfvector
 
-T, R = TypeVar("T"), TypeVar("R")
+from ..cores import on_every_core
+
 ALBEDO = Color(0.9, 0.6, 0.3)
 ANGLES = (0.0, 45.0, 80.0, 89.9)
 N_SAMPLES = 100_000
@@ -151,16 +148,6 @@ def run_case(case: tuple[str, float]) -> Outcome:
         energy.skipped,
         energy.detail,
     )
-
-
-def on_every_core(function: Callable[[T], R], items: list[T]) -> list[R]:
-    """[function(x) for x in items], in forked processes, one per core, where the
-    system forks (the checks are pure Python: threads would take turns)."""
-    workers = min(len(items), os.cpu_count() or 1)
-    if workers > 1 and "fork" in multiprocessing.get_all_start_methods():
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
-            return pool.map(function, items, chunksize=1)
-    return [function(x) for x in items]
 
 
 @pytest.fixture(scope="module")

@@ -39,6 +39,7 @@ from rtpy.testing import (
 )
 from rtpy.vec3 import Color, dot
 
+from ..cores import outcome, selected_checks
 from ..tiers import slow_except
 from ..vectors import angle, dot3, unit3
 from .directions import (
@@ -55,7 +56,6 @@ from .directions import (
 )
 from .directions import polar as direction
 from .test_cook_torrance import ref_D, ref_G1
-from .test_reflection_models import on_every_core
 
 # The lecture's glasses (Walter et al. 2007, fitted to measurements), ior 1.5.
 GLASSES = {
@@ -281,12 +281,20 @@ SAMPLING_CASES = [
     slow_except(SAMPLING_CASES, ("ground", 30.0, False), ("anti_glare", 30.0, True)),
 )
 @pytest.mark.slow
-def test_scattering_draws_the_pdf_and_weighs_by_it(name, theta, inside):
+def test_scattering_draws_the_pdf_and_weighs_by_it(slow_outcomes, request, name, theta, inside):
+    chi2_passed, chi2_summary, weights_passed, weights_detail = outcome(slow_outcomes, request)
+    assert chi2_passed, chi2_summary
+    assert weights_passed, weights_detail
+
+
+def sampling_outcome(name: str, theta: float, inside: bool) -> tuple[bool, str, bool, str]:
+    """The chi-square test of 30,000 samples at level 1e-3 and the weights check on the
+    same samples: (chi2 passed, its summary, weights passed, their detail)."""
     m = glass(name)
     samples = draw_samples(m, theta, 30_000, seed=5, inside=inside)
     result = chi2_test(m, theta, samples=samples, inside=inside)
-    assert result.passed(1e-3), result.summary()
-    assert check_weights(m, theta, samples=samples, inside=inside)
+    weights = check_weights(m, theta, samples=samples, inside=inside)
+    return result.passed(1e-3), result.summary(), weights.passed, weights.detail
 
 
 # --- radiance transport: the eta^2 --------------------------------------------------------
@@ -367,16 +375,22 @@ def visible_facet_loss(m: RoughDielectric, theta_deg: float, inside: bool) -> fl
     ),
 )
 @pytest.mark.slow
-def test_the_light_lost_is_what_the_facets_block(name, theta, inside):
+def test_the_light_lost_is_what_the_facets_block(slow_outcomes, request, name, theta, inside):
     """reflected + transmitted + lost = 1, where lost (from rtpy.testing's quadrature of
     the BSDF over the directions) is the visible-facet integral of what G1 blocks: the
     documented loss of single scattering, computed over m instead of wi (so the
     Jacobians, F and the eta^2 are checked by an independent route)."""
+    lost, quadrature_error, expected = outcome(slow_outcomes, request)
+    assert lost == pytest.approx(expected, abs=10 * quadrature_error + 2e-4)
+    assert -1e-12 <= expected < 1.0
+
+
+def loss_outcome(name: str, theta: float, inside: bool) -> tuple[float, float, float]:
+    """(the light lost by rtpy.testing's albedo, its quadrature error, the light lost by
+    visible_facet_loss)."""
     m = glass(name)
     a = directional_albedo(m, theta, n_samples=20_000, inside=inside)
-    expected = visible_facet_loss(m, theta, inside)
-    assert a.lost[0] == pytest.approx(expected, abs=10 * a.quadrature_error + 2e-4)
-    assert -1e-12 <= expected < 1.0
+    return a.lost[0], a.quadrature_error, visible_facet_loss(m, theta, inside)
 
 
 # --- planted mistakes: each formula's check catches it ----------------------------------
@@ -454,16 +468,22 @@ def check_glass(name: str) -> MaterialReport:
 
 
 @pytest.fixture(scope="module")
-def glass_reports() -> dict[str, MaterialReport]:
-    """name -> its check_glass report, the glasses on every core."""
-    return dict(zip(GLASSES, on_every_core(check_glass, list(GLASSES)), strict=True))
+def slow_outcomes(request) -> dict[str, object]:
+    """node id -> the outcome of each selected slow test's heavy part, all of them on
+    every core, the longest (the glasses, then the losses) first."""
+    checks = {
+        "test_check_material_passes_the_lecture_glasses": check_glass,
+        "test_the_light_lost_is_what_the_facets_block": loss_outcome,
+        "test_scattering_draws_the_pdf_and_weighs_by_it": sampling_outcome,
+    }
+    return selected_checks(request, checks)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(GLASSES))
-def test_check_material_passes_the_lecture_glasses(glass_reports, name):
+def test_check_material_passes_the_lecture_glasses(slow_outcomes, request, name):
     angles = CHECKED_ANGLES
-    report = glass_reports[name]
+    report = outcome(slow_outcomes, request)
     assert report.passed, str(report)
     sides = [(c.incident_deg, c.inside) for c in report.checks if c.check == "chi2"]
     assert sides == [(t, inside) for inside in (False, True) for t in angles]

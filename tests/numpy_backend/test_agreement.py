@@ -35,6 +35,7 @@ from rtpy.io.bundled import bundled_scenes
 from rtpy.numpy_backend.integrators import direct_lighting
 from rtpy.testing.statistics import BlockTest, block_z_test
 
+from ..cores import on_every_core
 from ..tiers import slow_except
 
 ALPHA = 1e-3
@@ -44,17 +45,16 @@ SCENES = [name for name, _ in bundled_scenes()]
 SPP = {"jittered": 2, "direct": 3, "whitted": 2, "path": 3}
 NUMPY_FACTOR = 4
 SEEDS = (11, 12, 13, 14)
+BACKENDS = ("scalar", "numpy")
 
 
-def render_uncached(name: str, integrator: str, backend: str, seed: int, spp: int) -> np.ndarray:
-    """The linear image of a bundled scene, WIDTH pixels wide (the scalar backend on
-    two processes)."""
+def render(job: tuple[str, str, str, int, int]) -> np.ndarray:
+    """The linear image of a bundled scene, WIDTH pixels wide, for the job (name,
+    integrator, backend, seed, spp), in this process (a seed gives the same image on
+    any number of workers)."""
+    name, integrator, backend, seed, spp = job
     settings = {"width": WIDTH, "spp": spp, "integrator": integrator, "seed": seed}
-    workers = 2 if backend == "scalar" else 1
-    return rtpy.render(rtpy.load_scene(name), workers=workers, backend=backend, **settings).linear
-
-
-render = cache(render_uncached)
+    return rtpy.render(rtpy.load_scene(name), backend=backend, **settings).linear
 
 
 def compare(renders_a, spp_a, renders_b, spp_b, alpha: float = ALPHA) -> BlockTest:
@@ -66,8 +66,12 @@ def compare(renders_a, spp_a, renders_b, spp_b, alpha: float = ALPHA) -> BlockTe
     return block_z_test(a.mean(axis=0), var_a, b.mean(axis=0), var_b, alpha)
 
 
-def renders(name: str, integrator: str, backend: str, spp: int) -> list[np.ndarray]:
-    return [render(name, integrator, backend, s, spp) for s in SEEDS]
+def renders_uncached(name: str, integrator: str, backend: str, spp: int) -> list[np.ndarray]:
+    """The renders with every seed of SEEDS, on every core."""
+    return on_every_core(render, [(name, integrator, backend, s, spp) for s in SEEDS])
+
+
+renders = cache(renders_uncached)
 
 
 def check(name: str, integrator: str, spp: int) -> None:
@@ -86,8 +90,7 @@ def test_center_images_agree(name):
     if rtpy.load_scene(name).camera.defocus_angle > 0:
         check(name, "center", 1)  # the lens is sampled: compare as noise
         return
-    a = render(name, "center", "scalar", 0, 1)
-    b = render(name, "center", "numpy", 0, 1)
+    a, b = on_every_core(render, [(name, "center", backend, 0, 1) for backend in BACKENDS])
     # A pixel centre on the exact edge of a quad may round to either side.
     close = np.isclose(a, b, rtol=1e-9, atol=1e-12).all(axis=2)
     assert close.mean() > 0.99, f"{(~close).sum()} pixels differ"
@@ -107,7 +110,7 @@ def test_a_biased_kernel_is_flagged(monkeypatch):
     name, integrator, spp = "cornell", "path", SPP["path"]
     scalar = renders(name, integrator, "scalar", spp)
     monkeypatch.setattr(direct_lighting, "emission_weight", lambda _, obj, *a: np.ones(len(obj)))
-    biased = [render_uncached(name, integrator, "numpy", s, spp * NUMPY_FACTOR) for s in SEEDS]
+    biased = renders_uncached(name, integrator, "numpy", spp * NUMPY_FACTOR)  # forked: patched
     test = compare(scalar, spp, biased, spp * NUMPY_FACTOR)
     assert not test.passed
     assert (test.z > test.threshold).any(axis=1).sum() > 1  # many blocks, not one

@@ -18,6 +18,7 @@ from rtpy.numpy_backend.materials.rough_dielectric import (
 )
 from rtpy.testing import chi2_test
 
+from ...cores import outcome, selected_checks
 from ...tiers import slow_except
 from .kernel_checks import CHI2_ALPHA, compare_with_scalar_sampler, head
 
@@ -45,12 +46,27 @@ GLASSES = [
 CASES = [(k, theta, inside) for k in range(3) for theta in (0.0, 45.0, 80.0) for inside in (0, 1)]
 
 
-@pytest.mark.parametrize("glass, theta, inside", slow_except(CASES, (1, 45.0, 1), (0, 80.0, 0)))
-@pytest.mark.slow
-def test_sampler_agrees_with_scalar_and_follows_the_pdf(glass, theta, inside):
+def sampler_check(glass: int, theta: float, inside: int) -> None:
+    """The batched sampler against the scalar one, and the chi-square test of its
+    samples."""
     material = GLASSES[glass]
     batched = compare_with_scalar_sampler(material, theta, 30.0, inside=bool(inside))
     result = chi2_test(
         material, theta, phi_deg=30.0, samples=head(batched, 30_000), inside=bool(inside)
     )
     assert result.passed(CHI2_ALPHA), result.summary()
+
+
+@pytest.fixture(scope="module")
+def sampler_checks(request) -> dict[str, None]:
+    """The selected cases' sampler_check, on every core."""
+    test = "test_sampler_agrees_with_scalar_and_follows_the_pdf"
+    return selected_checks(request, {test: sampler_check})
+
+
+@pytest.mark.parametrize("glass, theta, inside", slow_except(CASES, (1, 45.0, 1), (0, 80.0, 0)))
+@pytest.mark.slow
+def test_sampler_agrees_with_scalar_and_follows_the_pdf(
+    sampler_checks, request, glass, theta, inside
+):
+    outcome(sampler_checks, request)

@@ -1,0 +1,63 @@
+"""Independent heavy checks of a test module run on both cores of the machine.
+
+The checks are pure Python (threads would take turns), so they run in forked
+processes, one per core. Each test still asserts on its own outcome, so a failure is
+reported on the test (and the parameters) it belongs to.
+"""
+
+from __future__ import annotations
+
+import functools
+import multiprocessing
+import os
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+T, R = TypeVar("T"), TypeVar("R")
+
+
+def on_every_core(function: Callable[[T], R], items: list[T]) -> list[R]:
+    """[function(x) for x in items], in forked processes, one per core, where the
+    system forks; the items are handed out in order, one at a time, so the longest
+    ones listed first keep both cores busy to the end."""
+    workers = min(len(items), os.cpu_count() or 1)
+    if workers > 1 and "fork" in multiprocessing.get_all_start_methods():
+        with multiprocessing.get_context("fork").Pool(workers) as pool:
+            return pool.map(function, items, chunksize=1)
+    return [function(x) for x in items]
+
+
+def _check(checks: dict[str, Callable[..., Any]], job: tuple[str, dict]) -> Any:
+    test_name, params = job
+    try:
+        return checks[test_name](**params)
+    except AssertionError as error:  # raised again by outcome(), on its own test
+        return error
+
+
+def selected_checks(request, checks: dict[str, Callable[..., R]]) -> dict[str, R]:
+    """For a module-scoped fixture: node id -> the outcome of checks[test](**params) for
+    every test of the fixture's module named in `checks` that this session runs, with
+    that test's parameters (or the AssertionError it raised). All of them run on every
+    core, the tests in the order of `checks` (list the longest first)."""
+    order = list(checks)
+    items = sorted(
+        (
+            item
+            for item in request.session.items
+            if item.module is request.module and item.originalname in checks
+        ),
+        key=lambda item: order.index(item.originalname),
+    )
+    jobs = [(item.originalname, dict(item.callspec.params)) for item in items]
+    outcomes = on_every_core(functools.partial(_check, checks), jobs)
+    return {item.nodeid: outcome for item, outcome in zip(items, outcomes, strict=True)}
+
+
+def outcome(outcomes: dict[str, R], request) -> R:
+    """The outcome of the requesting test in selected_checks' `outcomes`; the assertion
+    error of its check raised here."""
+    result = outcomes[request.node.nodeid]
+    if isinstance(result, AssertionError):
+        raise result
+    return result
