@@ -59,11 +59,10 @@ END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
 # What the student repository holds besides rtpy/ (top-level names of the source tree).
 COPIED = ("pyproject.toml", ".gitignore", "LICENSE", "scenes", "docs")
 TEST_WEEKS_FILE = "assignments/test_weeks.toml"
-# Tests that belong to rtpy's own repository only (and are not mapped): the assignment
-# machinery's, which grade every week, generate repositories and check the task maps
-# against the solution regions and the pages made from them, the checks of rtpy's
-# README (a student repository's README.md is the week's) and of its layout (which
-# counts the numpy backend's modules and tests).
+# Tests that belong to rtpy's own repository only (and are not mapped): the assignment machinery's,
+# which grade every week, generate repositories and check the task maps against the solution
+# regions and the pages made from them, the checks of rtpy's README (a student repository's
+# README.md is the week's) and of its layout (which counts the numpy backend's modules and tests).
 MACHINERY_TESTS = (
     "tests/grading/test_graders.py",
     "tests/grading/test_assignment.py",
@@ -84,8 +83,7 @@ NUMPY_USE = re.compile(r"numpy_backend|[\"']numpy[\"']|rtpy\.BACKENDS")
 
 
 def never_mapped(rel: str) -> bool:
-    """Test files (tests/... paths) that map-tests leaves out and no week ships: the
-    numpy backend's (the backend is withheld) and the assignment machinery's."""
+    """Test files no week ships nor maps: the numpy backend's (withheld) and MACHINERY_TESTS."""
     return rel.startswith("tests/numpy_backend/") or rel in MACHINERY_TESTS
 
 
@@ -164,6 +162,8 @@ def _comment_lines(source: str) -> set[int]:
 def regions_in(path: Path, root: Path) -> list[Region]:
     """The solution regions of one file; AssignmentError on unbalanced markers."""
     text = path.read_text()
+    if "# BEGIN SOLUTION" not in text and "# END SOLUTION" not in text:
+        return []  # no marker (most files): no need to tokenize
     lines = text.splitlines(keepends=True)
     functions = None
     regions, open_at = [], None
