@@ -19,9 +19,11 @@ depth (5); Mitsuba uses its default independent sampler.
 Each renderer runs in a fresh process with 2 threads / 2 worker processes
 (`python -m rtpy render ... -j 2 --backend numpy`; a child of this script imports
 Mitsuba, renders and writes the image), --repeat times, alternating; the whole
-process is timed (interpreter, imports, scene load, rendering, writing), and each
-round's Mitsuba/rtpy time ratio is the paths/s ratio at equal spp; the median is
-reported.
+process is timed (interpreter, imports, scene load, rendering, writing). rtpy
+renders with its independent sampler, as Mitsuba does, so both do the same work:
+each round's Mitsuba/rtpy time ratio is the paths/s ratio at equal spp, and the
+median is reported. --sampler NAME adds a third renderer to every round, rtpy with
+that sampler, whose error is the one compared with Mitsuba's.
 
 The images are compared with one reference, rtpy's cached high-spp render
 (rtpy.testing.reference, 4 independent renders of the numpy backend): first
@@ -43,6 +45,7 @@ import sys
 import tempfile
 import time
 import tomllib
+from functools import partial
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -146,21 +149,19 @@ def timed(command: list[str]) -> float:
 
 
 def rtpy_command(
-    out: Path, width: int, spp: int, max_depth: int, seed: int, workers: int, sampler=None
+    out: Path, width: int, spp: int, max_depth: int, seed: int, workers: int, sampler: str
 ):
-    """`python -m rtpy render` of the scene with the numpy backend (and --sampler
-    `sampler` unless None), the linear image to `out`."""
+    """`python -m rtpy render` of the scene with the numpy backend and `sampler`, the
+    linear image to `out`."""
     return [
         sys.executable, "-m", "rtpy", "render", SCENE, "--backend", "numpy", "-q",
         "--width", str(width), "--spp", str(spp), "--max-depth", str(max_depth),
         "--seed", str(seed), "-j", str(workers), "-o", str(out.with_suffix(".png")),
-        "--linear", str(out), *(["--sampler", sampler] if sampler else []),
+        "--linear", str(out), "--sampler", sampler,
     ]  # fmt: skip
 
 
-def mitsuba_command(
-    out: Path, width: int, spp: int, max_depth: int, seed: int, threads: int, sampler=None
-):
+def mitsuba_command(out: Path, width: int, spp: int, max_depth: int, seed: int, threads: int):
     """This script's child rendering with Mitsuba (its own independent sampler)."""
     return [
         sys.executable, __file__, "--child", str(out), str(width), str(spp), str(max_depth),
@@ -185,8 +186,12 @@ def compare(
     ref_spp: int,
     sampler: str | None = None,
 ) -> dict:
-    """Run both renderers `repeat` times, alternating; the measurements as a dict.
-    rtpy renders with `sampler` (None: its default, the independent sampler)."""
+    """Run the renderers `repeat` times, alternating; the measurements as a dict.
+
+    rtpy renders with the independent sampler, as Mitsuba does: the paths/s ratio
+    compares the same work. With `sampler` naming another of rtpy's samplers, rtpy
+    also renders with it in every round, and the error at equal time compares that
+    one with Mitsuba's."""
     import numpy as np
 
     from rtpy.io.bundled import resolve_scene
@@ -196,16 +201,18 @@ def compare(
     reference = get_reference(
         resolve_scene(SCENE), width, max_depth, ref_spp, log=lambda m: print(m, file=sys.stderr)
     )
-    times = {"rtpy": [], "mitsuba": []}
-    images = {"rtpy": [], "mitsuba": []}
+    samplers = ["independent"] + ([sampler] if sampler and sampler != "independent" else [])
+    commands = {f"rtpy {s}": partial(rtpy_command, sampler=s) for s in samplers}
+    commands["mitsuba"] = mitsuba_command
+    times = {name: [] for name in commands}
+    images = {name: [] for name in commands}
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(repeat):
-            for name, make in (("rtpy", rtpy_command), ("mitsuba", mitsuba_command)):
-                out = Path(tmp) / f"{name}{r}.npy"
-                command = make(out, width, spp, max_depth, r + 1, workers, sampler)
-                times[name].append(timed(command))
+            for k, (name, make) in enumerate(commands.items()):
+                out = Path(tmp) / f"{k}-{r}.npy"
+                times[name].append(timed(make(out, width, spp, max_depth, r + 1, workers)))
                 images[name].append(np.load(out))
-    ratios = sorted(m / t for m, t in zip(times["mitsuba"], times["rtpy"], strict=True))
+    ratios = sorted(m / t for m, t in zip(times["mitsuba"], times["rtpy independent"], strict=True))
     result = {
         "width": width,
         "spp": spp,
@@ -213,25 +220,28 @@ def compare(
         "workers": workers,
         "repeat": repeat,
         "reference": reference.source,
-        "sampler": sampler or "its default",
         "paths": width * reference.image.shape[0] * spp,
         "ratio": ratios[len(ratios) // 2],
+        "against": f"rtpy {samplers[-1]}",  # the rtpy row whose error is compared
+        "renderers": {},
     }
-    for name in times:
+    for name in commands:
         stack = np.stack(images[name])
         seconds = float(np.median(times[name]))
         rmse = float(np.median([error(im, reference) for im in stack]))
-        result[name] = {"seconds": seconds, "rmse": rmse, "efficiency": 1 / (rmse**2 * seconds)}
-        if name == "mitsuba" and repeat > 1:
-            test = block_z_test(
-                stack.mean(axis=0),
-                stack.var(axis=0, ddof=1) / repeat,
-                reference.image,
-                reference.variance,
-                ALPHA,
-            )
-            result["agree"] = test.passed
-            result["agreement"] = "agree" if test.passed else test.worst("rtpy's reference")
+        efficiency = 1 / (rmse**2 * seconds)
+        result["renderers"][name] = {"seconds": seconds, "rmse": rmse, "efficiency": efficiency}
+    if repeat > 1:
+        stack = np.stack(images["mitsuba"])
+        test = block_z_test(
+            stack.mean(axis=0),
+            stack.var(axis=0, ddof=1) / repeat,
+            reference.image,
+            reference.variance,
+            ALPHA,
+        )
+        result["agree"] = test.passed
+        result["agreement"] = "agree" if test.passed else test.worst("rtpy's reference")
     return result
 
 
@@ -245,23 +255,29 @@ def format_result(r: dict) -> list[str]:
         "| renderer | seconds | paths/s | RMSE | efficiency 1/(MSE s) |",
         "|---|---|---|---|---|",
     ]
-    rtpy_label = f"rtpy numpy ({r['sampler']} sampler)"
-    for name, label in (("rtpy", rtpy_label), ("mitsuba", "Mitsuba 3 scalar_rgb (independent)")):
-        m = r[name]
+    for name, m in r["renderers"].items():
+        if name == "mitsuba":
+            label = "Mitsuba 3 scalar_rgb (independent sampler)"
+        else:
+            label = f"rtpy numpy ({name.removeprefix('rtpy ')} sampler)"
         lines.append(
             f"| {label} | {m['seconds']:.2f} | {r['paths'] / m['seconds']:,.0f} "
             f"| {m['rmse']:.4g} | {m['efficiency']:,.0f} |"
         )
     lines.append("")
-    lines.append(f"paths/s ratio rtpy / Mitsuba: {r['ratio']:.2f}x (median of per-round ratios)")
+    lines.append(
+        f"paths/s ratio rtpy / Mitsuba, both with the independent sampler: {r['ratio']:.2f}x "
+        "(median of per-round ratios)"
+    )
+    against = r["against"]
     if r.get("agree") is None:
         lines.append("agreement not tested (needs --repeat 2 or more): errors not compared")
     elif r["agree"]:
-        eff = r["rtpy"]["efficiency"] / r["mitsuba"]["efficiency"]
+        eff = r["renderers"][against]["efficiency"] / r["renderers"]["mitsuba"]["efficiency"]
         lines.append(
             f"Mitsuba's mean agrees with the reference ({r['reference']}; block z-test, "
-            f"alpha {ALPHA}): efficiency ratio rtpy / Mitsuba {eff:.2f}x, so at equal time "
-            f"rtpy's RMSE is {1 / math.sqrt(eff):.2f} of Mitsuba's"
+            f"alpha {ALPHA}): efficiency ratio {against} / Mitsuba {eff:.2f}x, so at equal "
+            f"time {against}'s RMSE is {1 / math.sqrt(eff):.2f} of Mitsuba's"
         )
     else:
         lines.append(f"Mitsuba's image differs from rtpy's: {r['agreement']}; errors not compared")
@@ -276,7 +292,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--workers", type=int, default=2, help="rtpy processes, Mitsuba threads")
     parser.add_argument("--reference-spp", type=int, default=4096)
-    parser.add_argument("--sampler", help="rtpy render --sampler NAME")
+    parser.add_argument(
+        "--sampler", help="also render rtpy with --sampler NAME; its error is compared"
+    )
     parser.add_argument("--quick", action="store_true", help="32x32, 16 spp, 2 rounds")
     args = parser.parse_args(argv)
     from rtpy.bench.machine import compile_bytecode
