@@ -12,7 +12,8 @@ efficiency on the bench scenes.
 - 2-worker scaling: `python -m rtpy render cornell --backend numpy --spp 64` with
   -j 1 and -j 2 at 128x128 and 256x256, whole process (wall clock), alternating
   rounds; the median of the rounds' -j 1 / -j 2 ratios, and the same for the
-  render alone (the seconds the command reports);
+  render alone (the seconds the command reports), beside the machine's ceiling
+  for both (measure_scaling);
 - Mitsuba: scripts/bench_mitsuba.py's comparison (skipped with a message when
   Mitsuba is not installed);
 - the course: scripts/bench_course.py's scalar backend against the course's week-8
@@ -23,7 +24,9 @@ efficiency on the bench scenes.
   reference for cornell (at 1024 spp the reference's own noise would hide the
   low-discrepancy sampler's error).
 
-Every measurement runs whole processes one after another, never two at once; the
+Every measurement runs whole processes one after another, never two at once, but
+for the machine's ceiling of the 2-worker ratios: two -j 1 renders run together, in
+every round of the scaling, show how much two processes slow each other down. The
 machine and its load average before and after are printed, since other work on a
 shared machine slows everything. --write-doc writes the tables into docs/bench.md
 (the section between this script's markers) and the plot into docs/bench/speed.png.
@@ -158,18 +161,37 @@ def measure_startup(repeat: int, tmp: Path) -> list[tuple[str, float]]:
     return [(step, statistics.median(times)) for step, times in steps.items()]
 
 
+def concurrent_renders(width: int, spp: int, tmp: Path) -> list[float]:
+    """The seconds each of two `-j 1` renders reports when both run at once: what the
+    machine gives two processes that share nothing but its cores, caches and memory."""
+    commands = [render_command(width, spp, 1, tmp / f"c{k}.png") for k in range(2)]
+    children = [subprocess.Popen(c, stderr=subprocess.PIPE, text=True) for c in commands]
+    errors = [child.communicate()[1] for child in children]
+    for command, child, err in zip(commands, children, errors, strict=True):
+        if child.returncode != 0:
+            raise subprocess.CalledProcessError(child.returncode, command, stderr=err)
+    return [float(REPORTED.search(err).group(1)) for err in errors]
+
+
 def measure_scaling(sizes: tuple[int, ...], spp: int, repeat: int, tmp: Path) -> list[dict]:
     """Per image size: -j 1 and -j 2 whole-process seconds (medians), and the medians of
-    the rounds' ratios, whole process and render alone."""
+    the rounds' ratios, whole process and render alone; and this machine's ceiling for
+    them, from two -j 1 renders run at once (each takes longer than alone: that
+    slowdown caps 2 workers' render at 2 x alone / together, and with the -j 1
+    process's time outside its render, S, the whole process at (S + R) / (S + R / cap)
+    for its render's seconds R)."""
     runs = {(w, j): [] for w in sizes for j in (1, 2)}
+    together = {w: [] for w in sizes}
     for _ in range(repeat):
         for width in sizes:
             for workers in (1, 2):
                 seconds, err = wall(render_command(width, spp, workers, tmp / "r.png"))
                 runs[(width, workers)].append((seconds, float(REPORTED.search(err).group(1))))
+            together[width].append(statistics.fmean(concurrent_renders(width, spp, tmp)))
     rows = []
     for width in sizes:
         one, two = runs[(width, 1)], runs[(width, 2)]
+        caps = [2.0 * r / pair for (_, r), pair in zip(one, together[width], strict=True)]
         rows.append(
             {
                 "width": width,
@@ -179,6 +201,13 @@ def measure_scaling(sizes: tuple[int, ...], spp: int, repeat: int, tmp: Path) ->
                 "ratio": statistics.median(a[0] / b[0] for a, b in zip(one, two, strict=True)),
                 "render_ratio": statistics.median(
                     a[1] / b[1] for a, b in zip(one, two, strict=True)
+                ),
+                "slowdown": statistics.median(
+                    pair / r - 1.0 for (_, r), pair in zip(one, together[width], strict=True)
+                ),
+                "render_cap": statistics.median(caps),
+                "whole_cap": statistics.median(
+                    w / (w - r + r / cap) for (w, r), cap in zip(one, caps, strict=True)
                 ),
             }
         )
@@ -226,14 +255,24 @@ def format_report(startup, scaling, mitsuba, course, course_note, samplers) -> l
     lines += [f"| {step} | {seconds:.3f} |" for step, seconds in startup]
     lines += ["", "2-worker scaling, cornell, numpy backend, whole process:", ""]
     lines += [
-        "| image | spp | -j 1 s | -j 2 s | ratio | render alone |",
-        "|---|---|---|---|---|---|",
+        "| image | spp | -j 1 s | -j 2 s | ratio | render alone "
+        "| two -j 1 at once | ceiling, render alone | ceiling, whole |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in scaling:
         lines.append(
             f"| {r['width']}x{r['width']} | {r['spp']} | {r['j1']:.2f} | {r['j2']:.2f} "
-            f"| {r['ratio']:.2f}x | {r['render_ratio']:.2f}x |"
+            f"| {r['ratio']:.2f}x | {r['render_ratio']:.2f}x "
+            f"| each {100 * r['slowdown']:+.1f} % | {r['render_cap']:.2f}x "
+            f"| {r['whole_cap']:.2f}x |"
         )
+    lines += [
+        "",
+        "The ceilings are this machine's: two -j 1 renders run at once each take longer "
+        "than one alone, which caps 2 workers' render at 2 x alone / together; the whole "
+        "process's ceiling adds the -j 1 command's time outside its render (start-up, "
+        "writing).",
+    ]
     lines += ["", "rtpy numpy against Mitsuba 3:", ""]
     lines += bench_mitsuba.format_result(mitsuba) if mitsuba else [bench_mitsuba.MISSING]
     lines += ["", "Scalar backend against the course's week-8 code:", "", course_note]
@@ -242,7 +281,8 @@ def format_report(startup, scaling, mitsuba, course, course_note, samplers) -> l
 
 
 def plot(scaling, mitsuba, course, path: Path) -> bool:
-    """The headline ratios against their goals as bars; False without matplotlib."""
+    """The headline ratios against their goals (and the 2-worker ratios against this
+    machine's ceiling) as bars; False without matplotlib."""
     try:
         import matplotlib
 
@@ -255,9 +295,14 @@ def plot(scaling, mitsuba, course, path: Path) -> bool:
     names = [r[0] for r in rows]
     ax.barh(names, [r[1] for r in rows], color="tab:blue", label="measured")
     ax.scatter([r[2] for r in rows], names, marker="|", s=400, color="black", label="goal")
+    caps = {f"2 workers, cornell {r['width']}x{r['width']}": r["whole_cap"] for r in scaling}
+    capped = [name for name in names if name in caps]
+    ax.scatter(
+        [caps[n] for n in capped], capped, marker="x", color="tab:red", label="machine's ceiling"
+    )
     ax.invert_yaxis()
     ax.set_xlabel("ratio (x)")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=2, frameon=False)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=3, frameon=False)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=100)
