@@ -4,6 +4,9 @@ images they render are unbiased (block z-tests against the closed-form scenes)."
 
 from __future__ import annotations
 
+import collections
+import itertools
+import math
 import random
 
 import numpy as np
@@ -43,10 +46,32 @@ def points_2d(sampler, pixel: int, dim: int, n: int) -> np.ndarray:
 # --- the building blocks ---------------------------------------------------------------
 
 
-@pytest.mark.parametrize("n", [1, 2, 3, 5, 16, 17, 100])
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 16, 17, 32, 33, 100])
 def test_permute_is_a_permutation(n):
-    for p in (0, 1, 0xDEADBEEF):
+    for p in (0, 1, 0xDEADBEEF, 2**64 - 1):
         assert sorted(permute(i, n, p) for i in range(n)) == list(range(n))
+
+
+def permutation_p(perms: list[tuple[int, ...]], n: int) -> float:
+    """p-value of the permutations `perms` of range(n) being uniform over all n! (a
+    chi-square test over the n! cells)."""
+    cells = math.factorial(n)
+    counts = collections.Counter(perms)
+    expected = len(perms) / cells
+    x2 = sum((counts[q] - expected) ** 2 / expected for q in itertools.permutations(range(n)))
+    return chi2_sf(x2, cells - 1)
+
+
+def test_permute_gives_every_permutation_alike():
+    """Over random seeds, each of the n! permutations comes out equally often (20 times
+    each expected). A hashed bijection of the next power of two (Kensler's) gives only 8
+    of the 24 permutations of 4 elements."""
+    rng = random.Random(6)
+    ns = (3, 4, 5)
+    for n in ns:
+        seeds = [rng.getrandbits(64) for _ in range(20 * math.factorial(n))]
+        perms = [tuple(permute(i, n, p) for i in range(n)) for p in seeds]
+        assert permutation_p(perms, n) > bonferroni_alpha(ALPHA, len(ns)), n
 
 
 def test_reverse_bits32():
@@ -120,6 +145,32 @@ def test_stratified_has_one_point_per_stratum(spp):
             assert sorted(cells) == list(range(spp))
         ones = np.array([sampler.value_1d(pixel, i, dim) for i in range(spp)])
         assert sorted((ones * spp).astype(int)) == list(range(spp))
+
+
+def test_stratified_pairs_the_strata_of_two_dimensions_at_random():
+    """Padding, spp 4: the permutation that takes each sample's stratum in one dimension
+    to its stratum in another is, over pixels, uniform over all 24 (20 pixels each
+    expected). A restricted family of permutations ties the dimensions together: with
+    Kensler's, the column of the pixel position fixes the column of the light sample
+    (same or opposite for all four samples), and one permutation for every dimension
+    pairs stratum k with stratum k."""
+    sampler = StratifiedSampler(seed=8, spp=4)
+    pixels = range(480)
+
+    def strata(pixel: int, dim: int) -> list[int]:
+        """Each sample's stratum: its cell of the 2 x 2 grid, or of the 4 strata (1D)."""
+        if dim == LIGHT_CHOICE:
+            return [int(sampler.value_1d(pixel, k, dim) * 4) for k in range(4)]
+        return [int(y * 2) * 2 + int(x * 2) for x, y in points_2d(sampler, pixel, dim, 4)]
+
+    cells = {dim: [strata(p, dim) for p in pixels] for dim in (PIXEL, LIGHT_CHOICE, LIGHT, BRDF)}
+    pairs = ((PIXEL, LIGHT_CHOICE), (PIXEL, LIGHT), (LIGHT, BRDF))
+    for a, b in pairs:
+        perms = [
+            tuple(sb[sa.index(c)] for c in range(4))
+            for sa, sb in zip(cells[a], cells[b], strict=True)
+        ]
+        assert permutation_p(perms, 4) > bonferroni_alpha(ALPHA, len(pairs)), (a, b)
 
 
 # --- uniform and independent -----------------------------------------------------------

@@ -42,11 +42,11 @@ def test_building_blocks_equal_the_scalar_ones():
     assert [list(a) for a in zip(*batch.sobol_2d(v), strict=True)] == [
         list(scalar.sobol_2d(int(x))) for x in v
     ]
-    for n in (1, 6, 17):
-        i = np.arange(n)
-        assert batch.permute(i, n, seeds[2]).tolist() == [
-            scalar.permute(k, n, int(seeds[2])) for k in range(n)
-        ]
+    for n in (1, 4, 17, 40):  # 40: the swap bits from a hash (n > 32)
+        for p in (3, 0xFEDCBA9876543210):
+            assert batch.permute(np.arange(n), n, np.uint64(p)).tolist() == [
+                scalar.permute(k, n, p) for k in range(n)
+            ]
     assert batch.hash_key(3, np.arange(4), 5).tolist() == [
         scalar.hash_key(3, k, 5) for k in range(4)
     ]
