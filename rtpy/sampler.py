@@ -302,8 +302,10 @@ class SobolSampler(Sampler):
     def _point(self, pixel: int, index: int, dim: int) -> tuple[int, int, int]:
         """(x, y) of the scrambled, shuffled Sobol point as 32-bit fractions, and the
         hash the scrambling seeds came from."""
+        if not 0 <= index <= MASK32:
+            raise ValueError(f"index must be in [0, 2^32) (the Sobol points), got {index}")
         h = hash_key(self.seed, pixel, dim)
-        shuffled = owen_scramble(index & MASK32, h & MASK32)
+        shuffled = owen_scramble(index, h & MASK32)
         x, y = sobol_2d(shuffled)
         return x, y, mix64(h)
 

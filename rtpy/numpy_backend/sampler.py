@@ -167,8 +167,11 @@ class SobolSampler(Sampler):
     name = "sobol"
 
     def _point(self, pixel, index, dim):
+        index = np.asarray(index)
+        if index.size and not (0 <= index.min() and index.max() <= 0xFFFFFFFF):
+            raise ValueError("index must be in [0, 2^32) (the Sobol points)")
         h = hash_key(self.seed, pixel, dim)
-        shuffled = owen_scramble(np.asarray(index).astype(U64) & MASK32, h & MASK32)
+        shuffled = owen_scramble(index.astype(U64), h & MASK32)
         x, y = sobol_2d(shuffled)
         return x, y, mix64(h)
 
