@@ -148,34 +148,34 @@ def sobol_2d(index: int) -> tuple[int, int]:
     return reverse_bits32(index), y
 
 
+def permute_rounds(n: int) -> int:
+    """The rounds permute() takes for n elements. Its distance (total variation) from
+    a uniformly random permutation shrinks by a factor of about 0.6 per round: below
+    0.3% for every n <= 7 with these counts (computed exactly); the rounds a given
+    distance needs grow with log n (Hoang, Morris and Rogaway 2012)."""
+    return 8 + 2 * (n - 1).bit_length()
+
+
 def permute(i: int, n: int, p: int) -> int:
-    """Element i of a random permutation of range(n) chosen by the 32-bit seed p,
-    computed alone (Kensler, "Correlated Multi-Jittered Sampling", Pixar 2013: a
-    hash that is a bijection on the next power of two, cycle-walked into range(n))."""
-    w = n - 1
-    for s in (1, 2, 4, 8, 16):
-        w |= w >> s
-    while True:
-        i ^= p
-        i = (i * 0xE170893D) & MASK32
-        i ^= p >> 16
-        i ^= (i & w) >> 4
-        i ^= p >> 8
-        i = (i * 0x0929EB3F) & MASK32
-        i ^= p >> 23
-        i ^= (i & w) >> 1
-        i = (i * (1 | p >> 27)) & MASK32
-        i = (i * 0x6935FA69) & MASK32
-        i ^= (i & w) >> 11
-        i = (i * 0x74DCB303) & MASK32
-        i ^= (i & w) >> 2
-        i = (i * 0x9E501CC3) & MASK32
-        i ^= (i & w) >> 2
-        i = (i * 0xC860A3DF) & MASK32
-        i &= w
-        i ^= i >> 5
-        if i < n:
-            return (i + p) % n
+    """Element i of a random permutation of range(n) chosen by the 64-bit seed p,
+    computed alone: the swap-or-not shuffle (Hoang, Morris and Rogaway, "An
+    Enciphering Scheme Based on a Card Shuffle", CRYPTO 2012). Round r pairs each x
+    with K - x (mod n) and swaps the pair or not by a random bit of the pair. K and
+    the bits come from the round's hash h (splitmix64's stream from state p): K from
+    its high 32 bits (scaled to [0, n) by a product, as Lemire's bounded integers),
+    the bit of the pair's larger member x from bit x of its low 32 bits, or from a
+    hash of h and x when n > 32. Each round is an involution, so the result is a
+    permutation, and every permutation can come out (a hashed bijection of the next
+    power of two, as Kensler's, reaches only 8 of the 24 permutations of 4 elements,
+    which pairs the strata of two dimensions by a few fixed patterns)."""
+    for r in range(permute_rounds(n)):
+        h = mix64((p + (r + 1) * GOLDEN) & MASK64)
+        partner = (((h >> 32) * n >> 32) - i) % n
+        x = max(i, partner)
+        swap = h >> x & 1 if n <= 32 else mix64(h ^ x) >> 63
+        if swap:
+            i = partner
+    return i
 
 
 def grid_2d(spp: int) -> tuple[int, int]:
@@ -279,7 +279,7 @@ class StratifiedSampler(Sampler):
         """(stratum of the sample, the hash its jitter comes from)."""
         if not 0 <= index < self.spp:
             raise ValueError(f"index must be in [0, spp = {self.spp}), got {index}")
-        p = hash_key(self.seed, pixel, dim) & MASK32
+        p = hash_key(self.seed, pixel, dim)
         return permute(index, strata, p), hash_key(self.seed, pixel, index, dim)
 
     def value_1d(self, pixel: int, index: int, dim: int) -> float:
@@ -302,8 +302,10 @@ class SobolSampler(Sampler):
     def _point(self, pixel: int, index: int, dim: int) -> tuple[int, int, int]:
         """(x, y) of the scrambled, shuffled Sobol point as 32-bit fractions, and the
         hash the scrambling seeds came from."""
+        if not 0 <= index <= MASK32:
+            raise ValueError(f"index must be in [0, 2^32) (the Sobol points), got {index}")
         h = hash_key(self.seed, pixel, dim)
-        shuffled = owen_scramble(index & MASK32, h & MASK32)
+        shuffled = owen_scramble(index, h & MASK32)
         x, y = sobol_2d(shuffled)
         return x, y, mix64(h)
 

@@ -4,6 +4,9 @@ images they render are unbiased (block z-tests against the closed-form scenes)."
 
 from __future__ import annotations
 
+import collections
+import itertools
+import math
 import random
 
 import numpy as np
@@ -12,6 +15,7 @@ import pytest
 import rtpy
 from rtpy.sampler import (
     BRDF,
+    LAYOUT,
     LENS,
     LIGHT,
     LIGHT_CHOICE,
@@ -28,7 +32,7 @@ from rtpy.sampler import (
     sobol_2d,
 )
 from rtpy.testing.analytic_scenes import analytic_scene
-from rtpy.testing.statistics import block_z_test, bonferroni_alpha, chi2_sf
+from rtpy.testing.statistics import block_z_test, bonferroni_alpha, chi2_sf, normal_quantile
 
 from .tiers import slow_except
 
@@ -43,10 +47,32 @@ def points_2d(sampler, pixel: int, dim: int, n: int) -> np.ndarray:
 # --- the building blocks ---------------------------------------------------------------
 
 
-@pytest.mark.parametrize("n", [1, 2, 3, 5, 16, 17, 100])
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 16, 17, 32, 33, 100])
 def test_permute_is_a_permutation(n):
-    for p in (0, 1, 0xDEADBEEF):
+    for p in (0, 1, 0xDEADBEEF, 2**64 - 1):
         assert sorted(permute(i, n, p) for i in range(n)) == list(range(n))
+
+
+def permutation_p(perms: list[tuple[int, ...]], n: int) -> float:
+    """p-value of the permutations `perms` of range(n) being uniform over all n! (a
+    chi-square test over the n! cells)."""
+    cells = math.factorial(n)
+    counts = collections.Counter(perms)
+    expected = len(perms) / cells
+    x2 = sum((counts[q] - expected) ** 2 / expected for q in itertools.permutations(range(n)))
+    return chi2_sf(x2, cells - 1)
+
+
+def test_permute_gives_every_permutation_alike():
+    """Over random seeds, each of the n! permutations comes out equally often (20 times
+    each expected). A hashed bijection of the next power of two (Kensler's) gives only 8
+    of the 24 permutations of 4 elements."""
+    rng = random.Random(6)
+    ns = (3, 4, 5)
+    for n in ns:
+        seeds = [rng.getrandbits(64) for _ in range(20 * math.factorial(n))]
+        perms = [tuple(permute(i, n, p) for i in range(n)) for p in seeds]
+        assert permutation_p(perms, n) > bonferroni_alpha(ALPHA, len(ns)), n
 
 
 def test_reverse_bits32():
@@ -122,6 +148,32 @@ def test_stratified_has_one_point_per_stratum(spp):
         assert sorted((ones * spp).astype(int)) == list(range(spp))
 
 
+def test_stratified_pairs_the_strata_of_two_dimensions_at_random():
+    """Padding, spp 4: the permutation that takes each sample's stratum in one dimension
+    to its stratum in another is, over pixels, uniform over all 24 (20 pixels each
+    expected). A restricted family of permutations ties the dimensions together: with
+    Kensler's, the column of the pixel position fixes the column of the light sample
+    (same or opposite for all four samples), and one permutation for every dimension
+    pairs stratum k with stratum k."""
+    sampler = StratifiedSampler(seed=8, spp=4)
+    pixels = range(480)
+
+    def strata(pixel: int, dim: int) -> list[int]:
+        """Each sample's stratum: its cell of the 2 x 2 grid, or of the 4 strata (1D)."""
+        if dim == LIGHT_CHOICE:
+            return [int(sampler.value_1d(pixel, k, dim) * 4) for k in range(4)]
+        return [int(y * 2) * 2 + int(x * 2) for x, y in points_2d(sampler, pixel, dim, 4)]
+
+    cells = {dim: [strata(p, dim) for p in pixels] for dim in (PIXEL, LIGHT_CHOICE, LIGHT, BRDF)}
+    pairs = ((PIXEL, LIGHT_CHOICE), (PIXEL, LIGHT), (LIGHT, BRDF))
+    for a, b in pairs:
+        perms = [
+            tuple(sb[sa.index(c)] for c in range(4))
+            for sa, sb in zip(cells[a], cells[b], strict=True)
+        ]
+        assert permutation_p(perms, 4) > bonferroni_alpha(ALPHA, len(pairs)), (a, b)
+
+
 # --- uniform and independent -----------------------------------------------------------
 
 
@@ -147,22 +199,59 @@ def test_the_last_stratum_stays_below_one():
     assert last[2] == 1.0 - 2.0**-53  # n = 3 hits the bound: (2 + u) / 3 rounds to 1
 
 
+def coordinates(sampler, pixel: int, index: int) -> dict[tuple[int, int], float]:
+    """Every number of a pixel sample that LAYOUT serves, by (dimension, coordinate)."""
+    values = {}
+    for dim, size in LAYOUT:
+        if size == 1:
+            values[dim, 0] = sampler.value_1d(pixel, index, dim)
+        else:
+            values[dim, 0], values[dim, 1] = sampler.value_2d(pixel, index, dim)
+    return values
+
+
 @pytest.mark.parametrize("name", list(SAMPLERS))
 def test_values_are_uniform_and_independent_across_pixels_and_dimensions(name):
-    """Over many pixels: one sample's value in one dimension is uniform (a sampler
-    that shares its scrambling between pixels gives every pixel the same point), and
-    the values of two dimensions of a sample are independent (a sampler that pads
-    with the same shuffle in each dimension pairs them up)."""
+    """Sample 2 of 1024 pixels: each number the layout serves is uniform (32 bins, finer
+    than the 4 strata: a stratum's points must spread over all of it), and every two of
+    them are independent (4 x 4 bins). A sampler that shares its scrambling between
+    pixels gives every pixel the same point; two dimensions (or the x and y of one)
+    that share a seed or a jitter give related numbers."""
     sampler = SAMPLERS[name](seed=9, spp=4)
-    pixels = range(1024)
-    checks = [
-        [sampler.value_1d(p, 0, LIGHT_CHOICE) for p in pixels],
-        [sampler.value_2d(p, 1, LIGHT)[1] for p in pixels],
-        [(sampler.value_1d(p, 2, LIGHT_CHOICE), sampler.value_2d(p, 2, BRDF)[0]) for p in pixels],
-    ]
-    alpha = bonferroni_alpha(ALPHA, len(checks))
-    for values in checks:
-        assert chi_square_p(np.array(values).T, 4) > alpha
+    samples = [coordinates(sampler, p, 2) for p in range(1024)]
+    values = {c: np.array([v[c] for v in samples]) for c in samples[0]}
+    pairs = list(itertools.combinations(values, 2))
+    alpha = bonferroni_alpha(ALPHA, len(values) + len(pairs))
+    for c, v in values.items():
+        assert chi_square_p(v, 32) > alpha, c
+    for a, b in pairs:
+        assert chi_square_p(np.array([values[a], values[b]]), 4) > alpha, (a, b)
+
+
+@pytest.mark.parametrize("name", STRATIFYING)
+def test_two_dimensions_of_a_pixel_are_paired_no_worse_than_independent_numbers(name):
+    """Padding, spp 4: c, the number of a pixel's samples in the lower half of two
+    dimensions at once, is 1 on average; over pixels E (c - 1)^2 must be below 3/4, its
+    value for independent numbers (binomial: 4 x 1/4 x 3/4). A uniformly random
+    pairing of stratified values gives 1/3, Burley's nested shuffle 1/2; dimensions
+    whose strata are tied together (no shuffle, one shuffle for all dimensions,
+    permutations from a small family) give c = 0 or 2 in most pixels, near 1. One-sided
+    z-test of the mean over 600 pixels, the variance from their spread."""
+    sampler = SAMPLERS[name](seed=10, spp=4)
+    pixels = [[coordinates(sampler, p, k) for k in range(4)] for p in range(600)]
+    pairs = [((PIXEL, 0), (LIGHT, 0)), ((LIGHT_CHOICE, 0), (LIGHT, 0)), ((PIXEL, 1), (BRDF, 1))]
+    z = normal_quantile(2.0 * bonferroni_alpha(ALPHA, len(pairs)))  # one-sided
+    for a, b in pairs:
+        c = np.array([sum(v[a] < 0.5 and v[b] < 0.5 for v in samples) for samples in pixels])
+        d = (c - 1.0) ** 2
+        assert d.mean() + z * d.std(ddof=1) / math.sqrt(len(d)) < 0.75, (a, b, d.mean())
+
+
+def test_the_largest_32_bit_fraction_stays_below_one(monkeypatch):
+    """A scrambled Sobol coordinate of 2^32 - 1 (one in 2^32 of them) is a float below 1."""
+    monkeypatch.setattr(rtpy.sampler, "owen_scramble", lambda v, seed: 0xFFFFFFFF)
+    sampler = SobolSampler(seed=1)
+    assert max(sampler.value_1d(3, 0, LIGHT_CHOICE), *sampler.value_2d(3, 0, LIGHT)) < 1.0
 
 
 @pytest.mark.parametrize("name", list(SAMPLERS))
@@ -197,6 +286,8 @@ def test_bad_arguments_are_refused():
         StratifiedSampler(spp=0)
     with pytest.raises(ValueError, match="index"):
         StratifiedSampler(spp=4).value_1d(0, 4, 0)
+    with pytest.raises(ValueError, match="index"):  # would repeat point 0
+        SobolSampler().value_2d(0, 2**32, 0)
     with pytest.raises(ValueError, match="sampler"):
         rtpy.RenderSettings(sampler="halton")
     assert IndependentSampler(1).value_1d(0, 0, 0) != IndependentSampler(1).value_1d(1, 0, 0)
@@ -280,6 +371,26 @@ def test_scalar_images_are_the_same_for_any_worker_count(sampler="stratified"):
     one = rtpy.render(scene, workers=1, **settings).linear
     two = rtpy.render(scene, workers=2, **settings).linear
     assert np.array_equal(one, two)
+
+
+def test_batches_take_each_sample_index_once(monkeypatch):
+    """The renderer splits spp 4 into 4 batches (units of work); across them the sampler
+    is asked for each pixel's samples 0, 1, 2, 3 once each (Unit.first_sample), so a
+    pixel's samples are the same points however they are split."""
+    asked = []
+
+    class Recording(StratifiedSampler):
+        def value_2d(self, pixel, index, dim):
+            if dim == PIXEL:
+                asked.append((pixel, index))
+            return super().value_2d(pixel, index, dim)
+
+    monkeypatch.setitem(SAMPLERS, "stratified", Recording)
+    scene = rtpy.load_scene("cornell")
+    camera = scene.camera.with_width(4)
+    rtpy.render(scene, camera=camera, spp=4, sampler="stratified", integrator="jittered")
+    pixels = range(camera.width * camera.height)
+    assert sorted(asked) == [(p, k) for p in pixels for k in range(4)]
 
 
 def test_independent_is_the_default():

@@ -18,7 +18,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..sampler import (
+    GOLDEN,
     LIGHT_CHOICE,
+    MASK64,
     ONE_MINUS_EPSILON,
     PIXEL,
     SAMPLERS,
@@ -26,6 +28,7 @@ from ..sampler import (
     TWO_TO_MINUS_32,
     TWO_TO_MINUS_53,
     grid_2d,
+    permute_rounds,
 )
 
 U64, U32 = np.uint64, np.uint32
@@ -90,40 +93,20 @@ def sobol_2d(index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def permute(i: np.ndarray, n: int, p: np.ndarray) -> np.ndarray:
-    """rtpy.sampler.permute of arrays i and p (uint32), cycle-walking each element."""
-    w = n - 1
-    for s in (1, 2, 4, 8, 16):
-        w |= w >> s
-    w = U32(w)
-    p = np.broadcast_to(p.astype(U32), np.shape(i)).copy()
-    i = np.asarray(i).astype(U32)
-    out = np.empty_like(i)
-    todo = np.arange(i.size)
-    while todo.size:
-        k, q = i[todo], p[todo]
-        k ^= q
-        k *= U32(0xE170893D)
-        k ^= q >> U32(16)
-        k ^= (k & w) >> U32(4)
-        k ^= q >> U32(8)
-        k *= U32(0x0929EB3F)
-        k ^= q >> U32(23)
-        k ^= (k & w) >> U32(1)
-        k *= U32(1) | (q >> U32(27))
-        k *= U32(0x6935FA69)
-        k ^= (k & w) >> U32(11)
-        k *= U32(0x74DCB303)
-        k ^= (k & w) >> U32(2)
-        k *= U32(0x9E501CC3)
-        k ^= (k & w) >> U32(2)
-        k *= U32(0xC860A3DF)
-        k &= w
-        k ^= k >> U32(5)
-        i[todo] = k
-        done = k < U32(n)
-        out[todo[done]] = ((k[done].astype(np.int64) + q[done]) % n).astype(U32)
-        todo = todo[~done]
-    return out.astype(np.int64)
+    """rtpy.sampler.permute of arrays i (int) and p (uint64), broadcast together, in
+    uint64 arithmetic: K - x (mod n) as the smaller of K + n - x and that minus n
+    (which wraps to a huge number when it would be negative)."""
+    i, p = np.broadcast_arrays(np.asarray(i).astype(U64), np.asarray(p).astype(U64))
+    n64, one = U64(n), U64(1)
+    with np.errstate(over="ignore"):
+        for r in range(permute_rounds(n)):
+            h = mix64(p + U64((r + 1) * GOLDEN & MASK64))
+            d = ((h >> U64(32)) * n64 >> U64(32)) + n64 - i
+            partner = np.minimum(d, d - n64)
+            x = np.maximum(i, partner)
+            swap = (h >> x) & one if n <= 32 else mix64(h ^ x) >> U64(63)
+            i = np.where(swap.astype(bool), partner, i)
+    return i.astype(np.int64)
 
 
 class Sampler:
@@ -164,7 +147,7 @@ class StratifiedSampler(Sampler):
         index = np.asarray(index)
         if index.size and not (0 <= index.min() and index.max() < self.spp):
             raise ValueError(f"index must be in [0, spp = {self.spp})")
-        p = hash_key(self.seed, pixel, dim) & MASK32
+        p = hash_key(self.seed, pixel, dim)
         return permute(index, strata, p), hash_key(self.seed, pixel, index, dim)
 
     def value_1d(self, pixel, index, dim):
@@ -184,8 +167,11 @@ class SobolSampler(Sampler):
     name = "sobol"
 
     def _point(self, pixel, index, dim):
+        index = np.asarray(index)
+        if index.size and not (0 <= index.min() and index.max() <= 0xFFFFFFFF):
+            raise ValueError("index must be in [0, 2^32) (the Sobol points)")
         h = hash_key(self.seed, pixel, dim)
-        shuffled = owen_scramble(np.asarray(index).astype(U64) & MASK32, h & MASK32)
+        shuffled = owen_scramble(index.astype(U64), h & MASK32)
         x, y = sobol_2d(shuffled)
         return x, y, mix64(h)
 

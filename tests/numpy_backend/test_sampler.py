@@ -9,6 +9,7 @@ import pytest
 
 import rtpy
 from rtpy import sampler as scalar
+from rtpy.numpy_backend import renderer
 from rtpy.numpy_backend import sampler as batch
 from rtpy.numpy_backend.sampler import BATCH_SAMPLERS, LaneSampler, first_hit_generator
 from rtpy.sampler import BRDF, LENS, LIGHT, LIGHT_CHOICE, PIXEL, SAMPLERS
@@ -42,11 +43,11 @@ def test_building_blocks_equal_the_scalar_ones():
     assert [list(a) for a in zip(*batch.sobol_2d(v), strict=True)] == [
         list(scalar.sobol_2d(int(x))) for x in v
     ]
-    for n in (1, 6, 17):
-        i = np.arange(n)
-        assert batch.permute(i, n, seeds[2]).tolist() == [
-            scalar.permute(k, n, int(seeds[2])) for k in range(n)
-        ]
+    for n in (1, 4, 17, 40):  # 40: the swap bits from a hash (n > 32)
+        for p in (3, 0xFEDCBA9876543210):
+            assert batch.permute(np.arange(n), n, np.uint64(p)).tolist() == [
+                scalar.permute(k, n, p) for k in range(n)
+            ]
     assert batch.hash_key(3, np.arange(4), 5).tolist() == [
         scalar.hash_key(3, k, 5) for k in range(4)
     ]
@@ -55,6 +56,42 @@ def test_building_blocks_equal_the_scalar_ones():
         assert batch.jittered(n - 1, u, n).tolist() == [
             scalar.jittered(int(k) - 1, u, int(k)) for k in n
         ]
+
+
+def test_the_largest_32_bit_fraction_stays_below_one(monkeypatch):
+    """A scrambled Sobol coordinate of 2^32 - 1 (one in 2^32 of them) is a float below 1."""
+    monkeypatch.setattr(batch, "owen_scramble", lambda v, seed: np.full_like(v, 0xFFFFFFFF))
+    sobol = BATCH_SAMPLERS["sobol"](seed=1)
+    assert sobol.value_1d(PIXELS, INDICES, LIGHT_CHOICE).max() < 1.0
+    assert sobol.value_2d(PIXELS, INDICES, LIGHT).max() < 1.0
+
+
+def test_sobol_refuses_indices_past_2_to_the_32():
+    with pytest.raises(ValueError, match="index"):  # would repeat point 0
+        BATCH_SAMPLERS["sobol"]().value_1d(np.zeros(2, dtype=int), np.array([0, 2**32]), 0)
+
+
+def test_passes_take_each_sample_index_once(monkeypatch):
+    """Units of 8 camera paths: spp 4 over 4 x 4 pixels takes 4 passes, and across them
+    the sampler is asked for each pixel's samples 0, 1, 2, 3 once each
+    (Unit.first_sample), so a pixel's samples are the same points however they are
+    split."""
+    asked = []
+
+    class Recording(BATCH_SAMPLERS["stratified"]):
+        def value_2d(self, pixel, index, dim):
+            if dim == PIXEL:
+                asked.extend(zip(pixel.tolist(), index.tolist(), strict=True))
+            return super().value_2d(pixel, index, dim)
+
+    monkeypatch.setitem(BATCH_SAMPLERS, "stratified", Recording)
+    monkeypatch.setattr(renderer, "MAX_RAYS", 8)
+    scene = rtpy.load_scene("cornell")
+    camera = scene.camera.with_width(4)
+    settings = {"spp": 4, "sampler": "stratified", "integrator": "jittered"}
+    rtpy.render(scene, camera=camera, backend="numpy", **settings)
+    pixels = range(camera.width * camera.height)
+    assert sorted(asked) == [(p, k) for p in pixels for k in range(4)]
 
 
 def make_lane_sampler(seed: int = 2) -> LaneSampler:
