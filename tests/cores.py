@@ -7,7 +7,6 @@ reported on the test (and the parameters) it belongs to.
 
 from __future__ import annotations
 
-import functools
 import multiprocessing
 import os
 from collections.abc import Callable
@@ -27,10 +26,10 @@ def on_every_core(function: Callable[[T], R], items: list[T]) -> list[R]:
     return [function(x) for x in items]
 
 
-def _check(checks: dict[str, Callable[..., Any]], job: tuple[str, dict]) -> Any:
-    test_name, params = job
+def _check(call: tuple[Callable[..., Any], dict]) -> Any:
+    check, params = call
     try:
-        return checks[test_name](**params)
+        return check(**params)
     except AssertionError as error:  # raised again by outcome(), on its own test
         return error
 
@@ -39,7 +38,9 @@ def selected_checks(request, checks: dict[str, Callable[..., R]]) -> dict[str, R
     """For a module-scoped fixture: node id -> the outcome of checks[test](**params) for
     every test of the fixture's module named in `checks` that this session runs, with
     that test's parameters (or the AssertionError it raised). All of them run on every
-    core, the tests in the order of `checks` (list the longest first)."""
+    core, the tests in the order of `checks` (list the longest first); tests whose check
+    is the same function with the same parameters share one run of it. The checks are
+    module-level functions (the forked workers receive them pickled)."""
     order = list(checks)
     items = sorted(
         (
@@ -49,9 +50,16 @@ def selected_checks(request, checks: dict[str, Callable[..., R]]) -> dict[str, R
         ),
         key=lambda item: order.index(item.originalname),
     )
-    jobs = [(item.originalname, dict(item.callspec.params)) for item in items]
-    outcomes = on_every_core(functools.partial(_check, checks), jobs)
-    return {item.nodeid: outcome for item, outcome in zip(items, outcomes, strict=True)}
+    calls = [(checks[item.originalname], _params(item)) for item in items]
+    keys = [(check, repr(sorted(params.items()))) for check, params in calls]
+    distinct = dict(zip(keys, calls, strict=True))
+    outcomes = dict(zip(distinct, on_every_core(_check, list(distinct.values())), strict=True))
+    return {item.nodeid: outcomes[key] for item, key in zip(items, keys, strict=True)}
+
+
+def _params(item) -> dict:
+    callspec = getattr(item, "callspec", None)
+    return dict(callspec.params) if callspec is not None else {}
 
 
 def outcome(outcomes: dict[str, R], request) -> R:
