@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import traceback
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -31,6 +32,9 @@ def _check(call: tuple[Callable[..., Any], dict]) -> Any:
     try:
         return check(**params)
     except AssertionError as error:  # raised again by outcome(), on its own test
+        if not str(error):  # a bare assert of a helper: its traceback stays here
+            frame = traceback.extract_tb(error.__traceback__)[-1]
+            error.args = (f"{frame.filename}:{frame.lineno}: {frame.line}",)
         return error
 
 
