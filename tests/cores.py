@@ -13,6 +13,8 @@ import traceback
 from collections.abc import Callable
 from typing import Any, TypeVar
 
+import pytest
+
 T, R = TypeVar("T"), TypeVar("R")
 
 
@@ -59,6 +61,17 @@ def selected_checks(request, checks: dict[str, Callable[..., R]]) -> dict[str, R
     distinct = dict(zip(keys, calls, strict=True))
     outcomes = dict(zip(distinct, on_every_core(_check, list(distinct.values())), strict=True))
     return {item.nodeid: outcomes[key] for item, key in zip(items, keys, strict=True)}
+
+
+def module_outcomes(checks: dict[str, Callable[..., Any]]):
+    """A module-scoped fixture, named by the test module's variable that holds it:
+    selected_checks(request, checks)."""
+
+    @pytest.fixture(scope="module")
+    def outcomes(request) -> dict[str, Any]:
+        return selected_checks(request, checks)
+
+    return outcomes
 
 
 def _params(item) -> dict:

@@ -46,7 +46,7 @@ from rtpy.testing import (
 from rtpy.testing.statistics import block_z_test
 from rtpy.vec3 import Color, Vec3
 
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from ..materials.test_rough_dielectric import InvertedScaling
 from ..tiers import slow_except
 
@@ -394,21 +394,16 @@ def ball_image_and_albedo(backend: str):
     return image, directional_albedo(m, 0.0, n_samples=2000, inside=True)
 
 
-@pytest.fixture(scope="module")
-def heavy(request) -> dict:
-    """node id -> the renders and samples of each selected test, on every core, the
-    longest first."""
-    return selected_checks(
-        request,
-        {
-            "test_light_leaving_a_glass_block": block_image_and_albedo,
-            "test_a_camera_inside_glass_sees_the_outside_eta_squared_brighter": (
-                ball_image_and_albedo
-            ),
-            "test_total_internal_reflection_from_inside": samples_from_inside,
-            "test_ior_to_one_makes_the_surface_invisible": pane_or_not,
-        },
-    )
+# node id -> the renders and samples of each selected test, on every core, the longest
+# first.
+heavy = module_outcomes(
+    {
+        "test_light_leaving_a_glass_block": block_image_and_albedo,
+        "test_a_camera_inside_glass_sees_the_outside_eta_squared_brighter": (ball_image_and_albedo),
+        "test_total_internal_reflection_from_inside": samples_from_inside,
+        "test_ior_to_one_makes_the_surface_invisible": pane_or_not,
+    }
+)
 
 
 def test_a_camera_inside_glass_sees_the_transport_direction():

@@ -27,7 +27,7 @@ from rtpy.materials import MATERIALS
 from rtpy.render_settings import SETTINGS
 
 from ..commands import modules_imported_by, read_until, rtpy_command, run_cli
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
@@ -67,24 +67,19 @@ def cli_version() -> subprocess.CompletedProcess:
     return run_cli("--version")
 
 
-@pytest.fixture(scope="module")
-def commands(request) -> dict:
-    """node id -> what the command of each selected test gave, all of them run at once
-    (each child process starts Python and imports rtpy: most of their time)."""
-    return selected_checks(
-        request,
-        {
-            "test_scenes_lists_every_bundled_scene_with_its_description": cli_scenes,
-            "test_bad_options_exit_2_and_write_nothing": cli_render_small_in_an_empty_directory,
-            "test_argparse_errors_exit_2": cli_render_three_balls,
-            "test_unknown_scene_name_exits_2": cli_render_cornel,
-            "test_no_command_prints_the_full_help_naming_the_program_as_run": (
-                cli_without_a_command
-            ),
-            "test_errors_name_the_program_as_run": cli_render_without_a_scene,
-            "test_version_is_the_installed_package_version": cli_version,
-        },
-    )
+# node id -> what the command of each selected test gave, all of them run at once (each
+# child process starts Python and imports rtpy: most of their time).
+commands = module_outcomes(
+    {
+        "test_scenes_lists_every_bundled_scene_with_its_description": cli_scenes,
+        "test_bad_options_exit_2_and_write_nothing": cli_render_small_in_an_empty_directory,
+        "test_argparse_errors_exit_2": cli_render_three_balls,
+        "test_unknown_scene_name_exits_2": cli_render_cornel,
+        "test_no_command_prints_the_full_help_naming_the_program_as_run": (cli_without_a_command),
+        "test_errors_name_the_program_as_run": cli_render_without_a_scene,
+        "test_version_is_the_installed_package_version": cli_version,
+    }
+)
 
 
 def test_scenes_lists_every_bundled_scene_with_its_description(commands, request):

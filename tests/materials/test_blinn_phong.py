@@ -25,7 +25,7 @@ from rtpy.materials import Blinn, BlinnPhong
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from ..vectors import dot3
 from . import directions
@@ -210,21 +210,18 @@ def albedo_at_normal_incidence(n: float) -> float:
     return directions.polar_integral(f_cos, NORMAL, peak=NORMAL)
 
 
-@pytest.fixture(scope="module")
-def heavy(request) -> dict:
-    """node id -> the sampling and quadratures of each selected test, on every core,
-    the longest first."""
-    return selected_checks(
-        request,
-        {
-            "test_energy_at_normal_incidence_matches_the_closed_form": albedo_at_normal_incidence,
-            "test_the_half_vectors_follow_the_cos_power_density": half_vector_cosines,
-            "test_pdf_integrates_to_the_fraction_of_samples_not_absorbed": (
-                pdf_integral_and_alive_fraction
-            ),
-            "test_scattering_weight_is_brdf_cos_over_pdf": check_weights,
-        },
-    )
+# node id -> the sampling and quadratures of each selected test, on every core, the
+# longest first.
+heavy = module_outcomes(
+    {
+        "test_energy_at_normal_incidence_matches_the_closed_form": albedo_at_normal_incidence,
+        "test_the_half_vectors_follow_the_cos_power_density": half_vector_cosines,
+        "test_pdf_integrates_to_the_fraction_of_samples_not_absorbed": (
+            pdf_integral_and_alive_fraction
+        ),
+        "test_scattering_weight_is_brdf_cos_over_pdf": check_weights,
+    }
+)
 
 
 # --- extremes -------------------------------------------------------------------------

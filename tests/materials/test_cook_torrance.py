@@ -30,7 +30,7 @@ from rtpy.io.values import ROUGHNESS
 from rtpy.materials import CookTorrance
 from rtpy.vec3 import Color, Vec3
 
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from ..vectors import angle, cross3, dot3, unit3
 from .directions import (
@@ -410,20 +410,17 @@ def lobe_albedos(dist: str, a: float) -> tuple[list[float], float]:
     return albedos, albedo_by_quadrature(plastic, 0.0)
 
 
-@pytest.fixture(scope="module")
-def heavy(request) -> dict:
-    """node id -> the quadratures and sampling of each selected test, on every core,
-    the longest first."""
-    return selected_checks(
-        request,
-        {
-            "test_mean_sample_weight_is_the_albedo_by_quadrature": (
-                check_mean_weight_against_quadrature
-            ),
-            "test_the_lobe_reflects_at_most_everything": lobe_albedos,
-            "test_G1_matches_D_by_smiths_projected_area_identity": projected_area,
-        },
-    )
+# node id -> the quadratures and sampling of each selected test, on every core, the
+# longest first.
+heavy = module_outcomes(
+    {
+        "test_mean_sample_weight_is_the_albedo_by_quadrature": (
+            check_mean_weight_against_quadrature
+        ),
+        "test_the_lobe_reflects_at_most_everything": lobe_albedos,
+        "test_G1_matches_D_by_smiths_projected_area_identity": projected_area,
+    }
+)
 
 
 # --- construction and scene files ----------------------------------------------------------

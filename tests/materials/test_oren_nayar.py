@@ -23,7 +23,7 @@ from rtpy.materials import Lambertian, OrenNayar
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from ..vectors import dot3
 from .directions import (
     ALBEDO,
@@ -233,16 +233,13 @@ def albedo_by_quadrature(sigma: float, theta_o: float) -> float:
     return hemisphere_integral(f_cos, theta_breaks, phi_breaks)
 
 
-@pytest.fixture(scope="module")
-def heavy(request) -> dict:
-    """node id -> the sampling and quadratures of each selected test, on every core."""
-    return selected_checks(
-        request,
-        {
-            "test_scattering_weight_is_brdf_cos_over_pdf": check_weights,
-            "test_directional_albedo": albedo_by_quadrature,
-        },
-    )
+# node id -> the sampling and quadratures of each selected test, on every core.
+heavy = module_outcomes(
+    {
+        "test_scattering_weight_is_brdf_cos_over_pdf": check_weights,
+        "test_directional_albedo": albedo_by_quadrature,
+    }
+)
 
 
 # --- extremes -------------------------------------------------------------------------

@@ -26,7 +26,7 @@ from rtpy.materials.phong import cosine_power_pdf, sample_cosine_power
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from ..vectors import dot3
 from .directions import (
@@ -251,21 +251,18 @@ def lobe_albedos(n: float) -> list[float]:
     return [albedo(theta_o) for theta_o in (0.0, 30.0, 60.0, 85.0)]
 
 
-@pytest.fixture(scope="module")
-def heavy(request) -> dict:
-    """node id -> the sampling and quadratures of each selected test, on every core,
-    the longest first."""
-    return selected_checks(
-        request,
-        {
-            "test_energy_the_normalised_lobe_reflects_at_most_everything": lobe_albedos,
-            "test_pdf_integrates_to_the_fraction_of_samples_not_absorbed": (
-                pdf_integral_and_alive_fraction
-            ),
-            "test_the_highlight_is_drawn_around_the_mirror_direction": highlight_samples,
-            "test_scattering_weight_is_brdf_cos_over_pdf": check_weights,
-        },
-    )
+# node id -> the sampling and quadratures of each selected test, on every core, the
+# longest first.
+heavy = module_outcomes(
+    {
+        "test_energy_the_normalised_lobe_reflects_at_most_everything": lobe_albedos,
+        "test_pdf_integrates_to_the_fraction_of_samples_not_absorbed": (
+            pdf_integral_and_alive_fraction
+        ),
+        "test_the_highlight_is_drawn_around_the_mirror_direction": highlight_samples,
+        "test_scattering_weight_is_brdf_cos_over_pdf": check_weights,
+    }
+)
 
 
 # --- extremes -------------------------------------------------------------------------

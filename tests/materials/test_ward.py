@@ -32,7 +32,7 @@ from rtpy.materials import Ward
 from rtpy.onb import ONB
 from rtpy.vec3 import Color, Vec3
 
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from ..vectors import angle, cross3, dot3, unit3
 from . import directions
@@ -357,20 +357,17 @@ def lobe_albedos(ax: float, ay: float) -> list[float]:
     return [albedo_by_quadrature(m, math.radians(t)) for t in (0.0, 30.0, 60.0, 80.0, 89.0)]
 
 
-@pytest.fixture(scope="module")
-def heavy(request) -> dict:
-    """node id -> the quadratures and sampling of each selected test, on every core,
-    the longest first."""
-    return selected_checks(
-        request,
-        {
-            "test_mean_sample_weight_is_the_albedo_by_quadrature": (
-                check_mean_weight_against_quadrature
-            ),
-            "test_the_lobe_reflects_at_most_everything_away_from_the_horizon": lobe_albedos,
-            "test_the_half_vector_density_is_normalised": half_vector_density_integral,
-        },
-    )
+# node id -> the quadratures and sampling of each selected test, on every core, the
+# longest first.
+heavy = module_outcomes(
+    {
+        "test_mean_sample_weight_is_the_albedo_by_quadrature": (
+            check_mean_weight_against_quadrature
+        ),
+        "test_the_lobe_reflects_at_most_everything_away_from_the_horizon": lobe_albedos,
+        "test_the_half_vector_density_is_normalised": half_vector_density_integral,
+    }
+)
 
 
 def test_wards_normalisation_exceeds_1_at_the_horizon():

@@ -12,7 +12,7 @@ from rtpy.materials import Lambertian, Mirror
 from rtpy.testing import chi2_test, draw_samples
 from rtpy.vec3 import Color
 
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from .materials_to_check import (
     DiffuseTransmitter,
@@ -71,27 +71,24 @@ def transmitter_chi2s(inside: bool):
     )
 
 
-@pytest.fixture(scope="module")
-def results(request) -> dict:
-    """node id -> the chi-square results of each selected test, all on every core, the
-    longest first; the narrow lobe tested twice at the same angle runs once."""
-    return selected_checks(
-        request,
-        {
-            "test_chi2_accepts_an_extremely_narrow_lobe_at_normal_incidence": (
-                extremely_narrow_lobe_chi2
-            ),
-            "test_pdf_integral_is_exact_for_narrow_lobes": lobe_chi2,
-            "test_chi2_accepts_a_correct_narrow_lobe": lobe_chi2,
-            "test_chi2_accepts_lambertian": lambertian_chi2,
-            "test_chi2_rejects_unannounced_absorption": secret_absorber_chi2,
-            "test_chi2_rejects_sampling_that_does_not_match_the_pdf": uniform_sampler_chi2,
-            "test_chi2_rejects_a_misnormalised_pdf": misnormalised_chi2,
-            "test_chi2_covers_the_whole_sphere": transmitter_chi2s,
-            "test_chi2_counts_absorbed_samples_as_a_category": half_sampler_chi2,
-            "test_chi2_is_deterministic_for_a_seed": seeded_chi2s,
-        },
-    )
+# node id -> the chi-square results of each selected test, all on every core, the
+# longest first; the narrow lobe tested twice at the same angle runs once.
+results = module_outcomes(
+    {
+        "test_chi2_accepts_an_extremely_narrow_lobe_at_normal_incidence": (
+            extremely_narrow_lobe_chi2
+        ),
+        "test_pdf_integral_is_exact_for_narrow_lobes": lobe_chi2,
+        "test_chi2_accepts_a_correct_narrow_lobe": lobe_chi2,
+        "test_chi2_accepts_lambertian": lambertian_chi2,
+        "test_chi2_rejects_unannounced_absorption": secret_absorber_chi2,
+        "test_chi2_rejects_sampling_that_does_not_match_the_pdf": uniform_sampler_chi2,
+        "test_chi2_rejects_a_misnormalised_pdf": misnormalised_chi2,
+        "test_chi2_covers_the_whole_sphere": transmitter_chi2s,
+        "test_chi2_counts_absorbed_samples_as_a_category": half_sampler_chi2,
+        "test_chi2_is_deterministic_for_a_seed": seeded_chi2s,
+    }
+)
 
 
 def exact_mass_above_horizon(exponent: float, theta_axis_deg: float) -> float:

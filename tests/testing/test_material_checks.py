@@ -11,7 +11,7 @@ from rtpy.materials import Lambertian
 from rtpy.testing import check_energy, check_weights, directional_albedo
 from rtpy.vec3 import Color
 
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from .materials_to_check import (
     DiffuseTransmitter,
     ForgetsPdf,
@@ -142,19 +142,14 @@ def energy_on_both_sides():
     )
 
 
-@pytest.fixture(scope="module")
-def heavy(request) -> dict:
-    """node id -> the albedos and checks of each selected test, on every core, the
-    longest first."""
-    return selected_checks(
-        request,
-        {
-            "test_directional_albedo_by_sampling_and_quadrature": lambertian_and_lobe_albedos,
-            "test_check_energy_accepts_correct_materials": energy_of_correct_materials,
-            "test_check_energy_on_both_sides": energy_on_both_sides,
-            "test_directional_albedo_of_a_material_that_transmits": transmitter_albedos,
-            "test_check_energy_catches_sampling_that_misses_part_of_the_brdf": (
-                half_sampler_checks
-            ),
-        },
-    )
+# node id -> the albedos and checks of each selected test, on every core, the longest
+# first.
+heavy = module_outcomes(
+    {
+        "test_directional_albedo_by_sampling_and_quadrature": lambertian_and_lobe_albedos,
+        "test_check_energy_accepts_correct_materials": energy_of_correct_materials,
+        "test_check_energy_on_both_sides": energy_on_both_sides,
+        "test_directional_albedo_of_a_material_that_transmits": transmitter_albedos,
+        "test_check_energy_catches_sampling_that_misses_part_of_the_brdf": (half_sampler_checks),
+    }
+)
