@@ -15,9 +15,12 @@ def rtpy_command(*args: str) -> list[str]:
     return [sys.executable, "-m", "rtpy", *args]
 
 
-def run_cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
-    """`python -m rtpy ARGS` to its end; the timeout only ends a child that hangs."""
-    return subprocess.run(rtpy_command(*args), capture_output=True, text=True, timeout=timeout)
+def run_cli(*args: str, timeout: float = 120, cwd=None) -> subprocess.CompletedProcess:
+    """`python -m rtpy ARGS` to its end (in the directory cwd, else the current one); the
+    timeout only ends a child that hangs."""
+    return subprocess.run(
+        rtpy_command(*args), capture_output=True, text=True, timeout=timeout, cwd=cwd
+    )
 
 
 def read_until(proc: subprocess.Popen, done, timeout: float = 120) -> str:

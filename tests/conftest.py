@@ -9,8 +9,17 @@ whether it runs alone or in the whole suite.
 Before -m "not slow" deselects anything, the collected test files are recorded with
 whether each has a test outside the slow tier (tests/test_layout.py checks that
 every one has).
+
+A full collection of the garbage collector walks every tracked object, and the
+session holds a large heap to its end (the imported modules, the collected tests,
+hypothesis's state): each one takes tens of milliseconds, and they come often (every
+in-process pytest run of the grading tests forces one). So the objects alive after
+the imports, after collection and after each test file's last teardown are frozen
+(gc.freeze) right after a collection: the collector then walks only what the tests
+create since. The collection first means no garbage is kept, only what is alive.
 """
 
+import gc
 import importlib
 import multiprocessing
 import os
@@ -32,9 +41,29 @@ for module in pkgutil.walk_packages(rtpy.__path__, "rtpy."):
         importlib.import_module(module.name)
 
 
+def freeze_what_lives() -> None:
+    gc.collect()
+    gc.freeze()
+
+
+freeze_what_lives()
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     record_fast_tests(config, items)
+
+
+def pytest_collection_finish(session):
+    freeze_what_lives()
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_runtest_teardown(item, nextitem):
+    """After pytest's teardown of the last test of a file (its module-scoped fixtures
+    finalized)."""
+    if nextitem is None or nextitem.path != item.path:
+        freeze_what_lives()
 
 
 START_METHODS = ["fork", "spawn", "forkserver"]

@@ -7,11 +7,13 @@ reported on the test (and the parameters) it belongs to.
 
 from __future__ import annotations
 
-import functools
 import multiprocessing
 import os
+import traceback
 from collections.abc import Callable
 from typing import Any, TypeVar
+
+import pytest
 
 T, R = TypeVar("T"), TypeVar("R")
 
@@ -27,11 +29,14 @@ def on_every_core(function: Callable[[T], R], items: list[T]) -> list[R]:
     return [function(x) for x in items]
 
 
-def _check(checks: dict[str, Callable[..., Any]], job: tuple[str, dict]) -> Any:
-    test_name, params = job
+def _check(call: tuple[Callable[..., Any], dict]) -> Any:
+    check, params = call
     try:
-        return checks[test_name](**params)
+        return check(**params)
     except AssertionError as error:  # raised again by outcome(), on its own test
+        if not str(error):  # a bare assert of a helper: its traceback stays here
+            frame = traceback.extract_tb(error.__traceback__)[-1]
+            error.args = (f"{frame.filename}:{frame.lineno}: {frame.line}",)
         return error
 
 
@@ -39,7 +44,9 @@ def selected_checks(request, checks: dict[str, Callable[..., R]]) -> dict[str, R
     """For a module-scoped fixture: node id -> the outcome of checks[test](**params) for
     every test of the fixture's module named in `checks` that this session runs, with
     that test's parameters (or the AssertionError it raised). All of them run on every
-    core, the tests in the order of `checks` (list the longest first)."""
+    core, the tests in the order of `checks` (list the longest first); tests whose check
+    is the same function with the same parameters share one run of it. The checks are
+    module-level functions (the forked workers receive them pickled)."""
     order = list(checks)
     items = sorted(
         (
@@ -49,9 +56,27 @@ def selected_checks(request, checks: dict[str, Callable[..., R]]) -> dict[str, R
         ),
         key=lambda item: order.index(item.originalname),
     )
-    jobs = [(item.originalname, dict(item.callspec.params)) for item in items]
-    outcomes = on_every_core(functools.partial(_check, checks), jobs)
-    return {item.nodeid: outcome for item, outcome in zip(items, outcomes, strict=True)}
+    calls = [(checks[item.originalname], _params(item)) for item in items]
+    keys = [(check, repr(sorted(params.items()))) for check, params in calls]
+    distinct = dict(zip(keys, calls, strict=True))
+    outcomes = dict(zip(distinct, on_every_core(_check, list(distinct.values())), strict=True))
+    return {item.nodeid: outcomes[key] for item, key in zip(items, keys, strict=True)}
+
+
+def module_outcomes(checks: dict[str, Callable[..., Any]]):
+    """A module-scoped fixture, named by the test module's variable that holds it:
+    selected_checks(request, checks)."""
+
+    @pytest.fixture(scope="module")
+    def outcomes(request) -> dict[str, Any]:
+        return selected_checks(request, checks)
+
+    return outcomes
+
+
+def _params(item) -> dict:
+    callspec = getattr(item, "callspec", None)
+    return dict(callspec.params) if callspec is not None else {}
 
 
 def outcome(outcomes: dict[str, R], request) -> R:

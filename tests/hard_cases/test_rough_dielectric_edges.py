@@ -46,6 +46,7 @@ from rtpy.testing import (
 from rtpy.testing.statistics import block_z_test
 from rtpy.vec3 import Color, Vec3
 
+from ..cores import module_outcomes, outcome
 from ..materials.test_rough_dielectric import InvertedScaling
 from ..tiers import slow_except
 
@@ -164,13 +165,17 @@ def pane_scene(ior: float | None) -> tuple[Scene, Camera]:
 
 
 @pytest.mark.parametrize("ior", slow_except([1.0, 1.0 + 1e-4], 1.0))
-def test_ior_to_one_makes_the_surface_invisible(ior):
+def test_ior_to_one_makes_the_surface_invisible(heavy, request, ior):
     """At ior 1 nothing reflects (F = 0) and refraction goes straight on through
     every facet; with the small roughness the microfacets' masking loses nothing
     the renders can see."""
-    without = renders(*pane_scene(None), 32)
-    test = same_expectation(renders(*pane_scene(ior), 32), without)
+    test = outcome(heavy, request)
     assert test.passed, f"pane of ior {ior}: " + test.worst("no pane")
+
+
+def pane_or_not(ior: float):
+    """same_expectation of the renders with a pane of ior `ior` and without a pane."""
+    return same_expectation(renders(*pane_scene(ior), 32), renders(*pane_scene(None), 32))
 
 
 @pytest.mark.slow
@@ -215,21 +220,28 @@ def test_grazing_incidence_from_both_sides(glass, inside):
 # --- total internal reflection --------------------------------------------------------
 
 
-def test_total_internal_reflection_from_inside():
+def test_total_internal_reflection_from_inside(heavy, request):
     """Beyond the critical angle (41.8 degrees for ior 1.5) smooth-ish glass seen from
     inside passes nothing: every sample reflects, with F = 1 and a weight of about 1;
     just inside the critical angle light passes. Schlick's approximation would let
     light through beyond it (it knows no critical angle)."""
-    m = GLASSES[0]
-    for theta in (50.0, 60.0, 85.0):
-        s = draw_samples(m, theta, 10_000, inside=True)
+    beyond, a, within = outcome(heavy, request)
+    for theta, s in beyond.items():
         assert s.scattered.any() and not s.transmitted.any()
         if theta < 85.0:  # at 85 degrees masking blocks some of the reflection
             assert s.scattered.all()
             assert np.mean(s.weights[:, 0]) == pytest.approx(1.0, abs=2e-3)
-    a = directional_albedo(m, 60.0, n_samples=2000, inside=True)
     assert a.transmitted == (0.0, 0.0, 0.0) and a.lost[0] == pytest.approx(0.0, abs=1e-3)
-    assert draw_samples(m, 40.0, 2000, inside=True).transmitted.mean() > 0.3
+    assert within.transmitted.mean() > 0.3
+
+
+def samples_from_inside():
+    """Anti-glare glass from inside: ({theta: 10,000 samples} beyond the critical angle,
+    the directional albedo at 60 degrees, 2000 samples at 40 degrees)."""
+    m = GLASSES[0]
+    beyond = {theta: draw_samples(m, theta, 10_000, inside=True) for theta in (50.0, 60.0, 85.0)}
+    a = directional_albedo(m, 60.0, n_samples=2000, inside=True)
+    return beyond, a, draw_samples(m, 40.0, 2000, inside=True)
 
 
 # --- light leaving a glass block, and a camera inside glass -----------------------------------
@@ -267,20 +279,26 @@ def check_closed_form(image: np.ndarray, expected: float, allowance: float) -> N
         ("numpy", True, 2),
     ),
 )
-def test_light_leaving_a_glass_block(backend, nee, glass):
+def test_light_leaving_a_glass_block(heavy, request, backend, nee, glass):
     """Radiance Le inside the glass leaves it as Le * (the surface's transmitted albedo
     from outside), which for smooth glass at normal incidence is Le (1 - F0) / eta^2:
     the camera sees the emitter 2.25 times dimmer than in air, less what the surface
     reflects. With light sampling, the emitter behind the surface is sampled through
     it and MIS shares it with the samples of the BSDF."""
+    image, a = outcome(heavy, request)
+    check_closed_form(image, 3.0 * a.transmitted[0], 3.0 * 10 * a.quadrature_error + 1e-4)
+    if glass == 0:  # nearly smooth: (1 - F0) / eta^2, less a hair of masking
+        assert a.transmitted[0] == pytest.approx(0.96 / 2.25, rel=1e-3)
+
+
+def block_image_and_albedo(backend: str, nee: bool, glass: int):
+    """The render of the block with the light inside, and the glass's directional albedo
+    at normal incidence from outside."""
     m = GLASSES[glass]
     scene, camera = block_with_light_inside(m, 3.0)
     spp = 256 if backend == "numpy" else 32
     image = render(scene, camera, backend, spp=spp, max_depth=4, nee=nee, seed=5)
-    a = directional_albedo(m, 0.0, n_samples=5000)
-    check_closed_form(image, 3.0 * a.transmitted[0], 3.0 * 10 * a.quadrature_error + 1e-4)
-    if glass == 0:  # nearly smooth: (1 - F0) / eta^2, less a hair of masking
-        assert a.transmitted[0] == pytest.approx(0.96 / 2.25, rel=1e-3)
+    return image, directional_albedo(m, 0.0, n_samples=5000)
 
 
 def test_a_bsdf_for_importance_makes_the_light_in_the_block_too_bright():
@@ -355,19 +373,37 @@ def inside_a_glass_ball(material) -> tuple[Scene, Camera]:
 
 
 @pytest.mark.parametrize("backend", slow_except(["numpy", "scalar"], "numpy"))
-def test_a_camera_inside_glass_sees_the_outside_eta_squared_brighter(backend):
+def test_a_camera_inside_glass_sees_the_outside_eta_squared_brighter(heavy, request, backend):
     """Every camera ray meets the ball at normal incidence from inside and refracts out
     with weight eta^2 (1 - F0), or reflects (F0) to the other side and tries again:
     L = eta^2 (1 - F0) (1 + F0 + F0^2 + ...) = eta^2, the radiance of an equilibrium in
     a medium of index eta. The masking of anti-glare glass loses less than 1e-4."""
+    image, a = outcome(heavy, request)
+    lost = a.lost[0]
+    assert abs(lost) < 1e-4
+    check_closed_form(image, 2.25, 2.25 * (2.0 * abs(lost) + 10.0 * a.quadrature_error) + 1e-4)
+
+
+def ball_image_and_albedo(backend: str):
+    """The render from the centre of the anti-glare glass ball, and the glass's
+    directional albedo at normal incidence from inside."""
     m = GLASSES[0]
     scene, camera = inside_a_glass_ball(m)
     spp = 256 if backend == "numpy" else 32
     image = render(scene, camera, backend, spp=spp, max_depth=12, seed=3)
-    a = directional_albedo(m, 0.0, n_samples=2000, inside=True)
-    lost = a.lost[0]
-    assert abs(lost) < 1e-4
-    check_closed_form(image, 2.25, 2.25 * (2.0 * abs(lost) + 10.0 * a.quadrature_error) + 1e-4)
+    return image, directional_albedo(m, 0.0, n_samples=2000, inside=True)
+
+
+# node id -> the renders and samples of each selected test, on every core, the longest
+# first.
+heavy = module_outcomes(
+    {
+        "test_light_leaving_a_glass_block": block_image_and_albedo,
+        "test_a_camera_inside_glass_sees_the_outside_eta_squared_brighter": (ball_image_and_albedo),
+        "test_total_internal_reflection_from_inside": samples_from_inside,
+        "test_ior_to_one_makes_the_surface_invisible": pane_or_not,
+    }
+)
 
 
 def test_a_camera_inside_glass_sees_the_transport_direction():

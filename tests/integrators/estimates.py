@@ -28,6 +28,8 @@ from rtpy import (
 from rtpy.sampling import make_generator, use_generator
 from rtpy.testing.statistics import bonferroni_z
 
+from ..cores import on_every_core
+
 ALPHA = 1e-4
 
 
@@ -76,11 +78,18 @@ def sample_mean(integrator, ray, scene, n, seed) -> tuple[float, float]:
 
 def per_ray_z(scene, rays, a, b, n_a, n_b, seed_a, seed_b, while_b=contextlib.nullcontext):
     """For each ray: (z of mean_a - mean_b, mean_a, se_a, mean_b, se_b), the b
-    estimates made inside the context while_b()."""
-    out = []
-    for k, ray in enumerate(rays):
-        m1, s1 = sample_mean(a, ray, scene, n_a, seed=seed_a + k)
-        with while_b():
-            m2, s2 = sample_mean(b, ray, scene, n_b, seed=seed_b + k)
-        out.append(((m1 - m2) / math.hypot(s1, s2), m1, s1, m2, s2))
-    return out
+    estimates made inside the context while_b() (a module-level one: the estimates
+    run on every core)."""
+    jobs = [(a, ray, scene, n_a, seed_a + k, contextlib.nullcontext) for k, ray in enumerate(rays)]
+    jobs += [(b, ray, scene, n_b, seed_b + k, while_b) for k, ray in enumerate(rays)]
+    means = on_every_core(_sample_mean_inside, jobs)
+    return [
+        ((m1 - m2) / math.hypot(s1, s2), m1, s1, m2, s2)
+        for (m1, s1), (m2, s2) in zip(means[: len(rays)], means[len(rays) :], strict=True)
+    ]
+
+
+def _sample_mean_inside(job) -> tuple[float, float]:
+    integrator, ray, scene, n, seed, context = job
+    with context():
+        return sample_mean(integrator, ray, scene, n, seed)

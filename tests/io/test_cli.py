@@ -9,6 +9,7 @@ import select
 import signal
 import subprocess
 import sys
+import tempfile
 import tomllib
 from pathlib import Path
 
@@ -26,13 +27,63 @@ from rtpy.materials import MATERIALS
 from rtpy.render_settings import SETTINGS
 
 from ..commands import modules_imported_by, read_until, rtpy_command, run_cli
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
 
 
-def test_scenes_lists_every_bundled_scene_with_its_description():
-    result = run_cli("scenes")
+# --- the commands that need no files of the test's, run at once on every core ------------
+
+
+def cli_scenes() -> subprocess.CompletedProcess:
+    return run_cli("scenes")
+
+
+def cli_render_small_in_an_empty_directory(extra, message) -> tuple:
+    """(the finished command, the names of the files in the directory it ran in)."""
+    with tempfile.TemporaryDirectory() as directory:
+        result = run_cli("render", "week08_three_balls", *SMALL, *extra, cwd=directory)
+        return result, os.listdir(directory)
+
+
+def cli_render_three_balls(extra) -> subprocess.CompletedProcess:
+    return run_cli("render", "week08_three_balls", *extra)
+
+
+def cli_render_cornel() -> subprocess.CompletedProcess:
+    return run_cli("render", "cornel")
+
+
+def cli_without_a_command() -> subprocess.CompletedProcess:
+    return run_cli()
+
+
+def cli_render_without_a_scene() -> subprocess.CompletedProcess:
+    return run_cli("render")
+
+
+def cli_version() -> subprocess.CompletedProcess:
+    return run_cli("--version")
+
+
+# node id -> what the command of each selected test gave, all of them run at once (each
+# child process starts Python and imports rtpy: most of their time).
+commands = module_outcomes(
+    {
+        "test_scenes_lists_every_bundled_scene_with_its_description": cli_scenes,
+        "test_bad_options_exit_2_and_write_nothing": cli_render_small_in_an_empty_directory,
+        "test_argparse_errors_exit_2": cli_render_three_balls,
+        "test_unknown_scene_name_exits_2": cli_render_cornel,
+        "test_no_command_prints_the_full_help_naming_the_program_as_run": (cli_without_a_command),
+        "test_errors_name_the_program_as_run": cli_render_without_a_scene,
+        "test_version_is_the_installed_package_version": cli_version,
+    }
+)
+
+
+def test_scenes_lists_every_bundled_scene_with_its_description(commands, request):
+    result = outcome(commands, request)
     assert result.returncode == 0
     lines = result.stdout.strip().splitlines()
     names = [name for name, _ in bundled_scenes()]
@@ -149,13 +200,12 @@ def write(tmp_path: Path, text: str) -> Path:
         (["-o", "no/such/dir/x.png"], "does not exist"),
     ),
 )
-def test_bad_options_exit_2_and_write_nothing(tmp_path, monkeypatch, extra, message):
-    monkeypatch.chdir(tmp_path)
-    result = run_cli("render", "week08_three_balls", *SMALL, *extra)
+def test_bad_options_exit_2_and_write_nothing(commands, request, extra, message):
+    result, written = outcome(commands, request)
     assert result.returncode == 2
     assert message in result.stderr
     assert "Traceback" not in result.stderr
-    assert list(tmp_path.iterdir()) == []
+    assert written == []
 
 
 @pytest.mark.parametrize(
@@ -165,8 +215,8 @@ def test_bad_options_exit_2_and_write_nothing(tmp_path, monkeypatch, extra, mess
         ["--spp", "-3"],
     ),
 )
-def test_argparse_errors_exit_2(extra):
-    result = run_cli("render", "week08_three_balls", *extra)
+def test_argparse_errors_exit_2(commands, request, extra):
+    result = outcome(commands, request)
     assert result.returncode == 2 and "Traceback" not in result.stderr
 
 
@@ -202,8 +252,8 @@ def test_bad_scene_file_exits_2_with_file_table_and_key(tmp_path):
     assert not out.exists()
 
 
-def test_unknown_scene_name_exits_2():
-    result = run_cli("render", "cornel")
+def test_unknown_scene_name_exits_2(commands, request):
+    result = outcome(commands, request)
     assert result.returncode == 2 and "cornell" in result.stderr
 
 
@@ -470,8 +520,8 @@ def test_a_plugin_render_on_two_workers_is_the_same_under_every_start_method(tmp
     np.testing.assert_array_equal(images["forkserver"], images["fork"])
 
 
-def test_no_command_prints_the_full_help_naming_the_program_as_run():
-    result = run_cli()
+def test_no_command_prints_the_full_help_naming_the_program_as_run(commands, request):
+    result = outcome(commands, request)
     assert result.returncode == 0 and result.stderr == ""
     assert result.stdout.startswith("usage: python -m rtpy ")
     for command in ["render", "scenes", "bench", "assignment", "grade"]:
@@ -479,20 +529,20 @@ def test_no_command_prints_the_full_help_naming_the_program_as_run():
     assert "'python -m rtpy COMMAND --help'" in result.stdout
 
 
-def test_errors_name_the_program_as_run(capsys):
+def test_errors_name_the_program_as_run(commands, request, capsys):
     with pytest.raises(SystemExit) as exit_:
         main(["render"], prog="rtpy")
     assert exit_.value.code == 2
     err = capsys.readouterr().err
     assert err.startswith("usage: rtpy render ") and "rtpy render: error:" in err
-    result = run_cli("render")
+    result = outcome(commands, request)
     assert result.returncode == 2 and "python -m rtpy render: error:" in result.stderr
 
 
-def test_version_is_the_installed_package_version(capsys):
+def test_version_is_the_installed_package_version(commands, request):
     from importlib.metadata import version
 
-    result = run_cli("--version")
+    result = outcome(commands, request)
     assert result.returncode == 0 and result.stdout.strip() == f"python -m rtpy {version('rtpy')}"
     assert rtpy.__version__ == version("rtpy")
 

@@ -25,6 +25,7 @@ from rtpy.materials import Blinn, BlinnPhong
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from ..vectors import dot3
 from . import directions
@@ -120,30 +121,43 @@ def test_reciprocity(kd, ks, n, ta, pa, tb, pb):
 )
 @pytest.mark.parametrize("theta_o", [0.0, 40.0, 80.0])
 @pytest.mark.slow
-def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, n, theta_o):
+def test_scattering_weight_is_brdf_cos_over_pdf(heavy, request, kd, ks, n, theta_o):
+    reflected = outcome(heavy, request)
+    assert reflected > 300  # for n = 0 most reflections about h go below the surface
+
+
+def check_weights(kd: float, ks: float, n: float, theta_o: float) -> int:
+    """check_scattering of 1500 samples; the number of them reflected above."""
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
     wo = direction(NORMAL, theta_o, 30.0)
     brdf, pdf = partial(expected_brdf, kd, ks, n, wo), partial(expected_pdf, kd, ks, n, wo)
-    cosines = directions.check_scattering(m, wo, brdf, pdf, 1500, (7, int(theta_o)))
-    assert len(cosines) > 300  # for n = 0 most reflections about h go below the surface
+    return len(directions.check_scattering(m, wo, brdf, pdf, 1500, (7, int(theta_o))))
 
 
 @pytest.mark.parametrize("n", slow_except([50.0, 200.0, 1000.0], 200.0))
-def test_the_half_vectors_follow_the_cos_power_density(n):
+def test_the_half_vectors_follow_the_cos_power_density(heavy, request, n):
     """kd = 0 at normal incidence: wi is wo reflected about h, and h = half(wo, wi) has
     E[n . h] = (n + 1) / (n + 2) and E[(n . h)^2] = (n + 1) / (n + 3) (these lobes keep
     every wi above the surface)."""
+    absorbed, cs = outcome(heavy, request)
+    assert absorbed == 0
+    k = len(cs)
+    for power, mean in ((1, (n + 1) / (n + 2)), (2, (n + 1) / (n + 3))):
+        values = cs**power
+        assert abs(values.mean() - mean) < 5.0 * values.std() / math.sqrt(k) + 1e-12
+
+
+def half_vector_cosines(n: float) -> tuple[int, np.ndarray]:
+    """20,000 samples at normal incidence with kd = 0: (how many were absorbed, n . h of
+    the others)."""
     m = BlinnPhong(kd=0.0, ks=1.0, exponent=n)
     hit = make_hit(m)
     wo = NORMAL
     with use_generator(make_generator(5, int(n))):
         samples = [m.scattering(view_ray(wo), hit) for _ in range(20000)]
-    assert all(s is not None for s in samples)
-    cs = np.array([dot3(NORMAL, half(wo, s.scattered_ray.direction.tolist())) for s in samples])
-    k = len(cs)
-    for power, mean in ((1, (n + 1) / (n + 2)), (2, (n + 1) / (n + 3))):
-        values = cs**power
-        assert abs(values.mean() - mean) < 5.0 * values.std() / math.sqrt(k) + 1e-12
+    kept = [s for s in samples if s is not None]
+    cs = np.array([dot3(NORMAL, half(wo, s.scattered_ray.direction.tolist())) for s in kept])
+    return len(samples) - len(kept), cs
 
 
 @pytest.mark.parametrize(
@@ -153,10 +167,17 @@ def test_the_half_vectors_follow_the_cos_power_density(n):
     ),
 )
 @pytest.mark.slow
-def test_pdf_integrates_to_the_fraction_of_samples_not_absorbed(kd, n, theta_o):
+def test_pdf_integrates_to_the_fraction_of_samples_not_absorbed(heavy, request, kd, n, theta_o):
     """A half vector facing away from the viewer, or a reflection below the surface,
     gives no sample, and pdf() counts neither: over the sphere pdf() integrates to the
     probability that scattering() returns a sample."""
+    total, alive, k = outcome(heavy, request)
+    assert 0.0 < total < 1.0
+    assert abs(alive - total) < 5.0 * math.sqrt(total * (1.0 - total) / k)
+
+
+def pdf_integral_and_alive_fraction(kd: float, n: float, theta_o: float):
+    """(pdf() over the sphere, the fraction of k samples not absorbed, k = 20,000)."""
     m = BlinnPhong(Color(*ALBEDO), kd=kd, ks=1.0 - kd, exponent=n)
     wo = direction(NORMAL, theta_o, 0.0)
     below = tuple(-x for x in wo)
@@ -164,15 +185,20 @@ def test_pdf_integrates_to_the_fraction_of_samples_not_absorbed(kd, n, theta_o):
         lambda wi: model_pdf(m, wo, wi), below, peak=mirror(wo, NORMAL)
     )
     k = 20000
-    alive = directions.alive_fraction(m, wo, k, seed=int(n + theta_o))
-    assert 0.0 < total < 1.0
-    assert abs(alive - total) < 5.0 * math.sqrt(total * (1.0 - total) / k)
+    return total, directions.alive_fraction(m, wo, k, seed=int(n + theta_o)), k
 
 
 @pytest.mark.parametrize("n", slow_except([0.0, 1.0, 2.0, 10.0, 100.0], 10.0))
-def test_energy_at_normal_incidence_matches_the_closed_form(n):
+def test_energy_at_normal_incidence_matches_the_closed_form(heavy, request, n):
     """(n + 8) / (8 pi) only approximates the normalisation: at normal incidence the lobe
     reflects the closed-form amount, 1 for n = 0 and up to ~7.5 % more near n = 10."""
+    albedo = outcome(heavy, request)
+    assert albedo == pytest.approx(lobe_albedo_at_normal_incidence(n), abs=1e-6)
+    assert albedo < 1.08
+
+
+def albedo_at_normal_incidence(n: float) -> float:
+    """The lobe's directional albedo at normal incidence, by quadrature."""
     m = BlinnPhong(Color(*ALBEDO), kd=0.0, ks=1.0, exponent=n)
     hit = make_hit(m)
     wo = NORMAL
@@ -181,9 +207,21 @@ def test_energy_at_normal_incidence_matches_the_closed_form(n):
         cos_i = dot3(wi, NORMAL)
         return m.BRDF(view_ray(wo), light_ray(wi), hit).e0 * cos_i if cos_i > 0 else 0.0
 
-    albedo = directions.polar_integral(f_cos, NORMAL, peak=NORMAL)
-    assert albedo == pytest.approx(lobe_albedo_at_normal_incidence(n), abs=1e-6)
-    assert albedo < 1.08
+    return directions.polar_integral(f_cos, NORMAL, peak=NORMAL)
+
+
+# node id -> the sampling and quadratures of each selected test, on every core, the
+# longest first.
+heavy = module_outcomes(
+    {
+        "test_energy_at_normal_incidence_matches_the_closed_form": albedo_at_normal_incidence,
+        "test_the_half_vectors_follow_the_cos_power_density": half_vector_cosines,
+        "test_pdf_integrates_to_the_fraction_of_samples_not_absorbed": (
+            pdf_integral_and_alive_fraction
+        ),
+        "test_scattering_weight_is_brdf_cos_over_pdf": check_weights,
+    }
+)
 
 
 # --- extremes -------------------------------------------------------------------------

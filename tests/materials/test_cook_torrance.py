@@ -30,6 +30,7 @@ from rtpy.io.values import ROUGHNESS
 from rtpy.materials import CookTorrance
 from rtpy.vec3 import Color, Vec3
 
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from ..vectors import angle, cross3, dot3, unit3
 from .directions import (
@@ -261,10 +262,16 @@ def test_G1_lies_in_0_1_and_is_1_at_normal_incidence(dist, a):
         ("beckmann", 0.05, 40.0),
     ),
 )
-def test_G1_matches_D_by_smiths_projected_area_identity(dist, a, theta_o_deg):
+def test_G1_matches_D_by_smiths_projected_area_identity(heavy, request, dist, a, theta_o_deg):
     """Integral of G1(wo) max(0, wo . h) D(h) d(w_h) = cos(theta_o): the visible
     facets, projected onto the view direction, cover exactly the visible surface.
     This holds only when G1 is the Smith term belonging to D."""
+    projected = outcome(heavy, request)
+    assert projected == pytest.approx(math.cos(math.radians(theta_o_deg)), abs=2e-4)
+
+
+def projected_area(dist: str, a: float, theta_o_deg: float) -> float:
+    """G1(wo) times the integral of max(0, wo . h) D(h) over the half vectors."""
     m = CookTorrance(roughness=a, distribution=dist)
     t_o = math.radians(theta_o_deg)
     wo = (math.sin(t_o), 0.0, math.cos(t_o))
@@ -274,8 +281,7 @@ def test_G1_matches_D_by_smiths_projected_area_identity(dist, a, theta_o_deg):
         h = (s * math.cos(p), s * math.sin(p), math.cos(t))
         return max(0.0, dot3(wo, h)) * D(m, h)
 
-    projected = G1(m, wo) * hemisphere_integral(integrand, a, n_phi=512, phi_offset=0.003)
-    assert projected == pytest.approx(math.cos(t_o), abs=2e-4)
+    return G1(m, wo) * hemisphere_integral(integrand, a, n_phi=512, phi_offset=0.003)
 
 
 def test_schlick_fresnel_at_normal_and_grazing_incidence():
@@ -318,10 +324,14 @@ def test_scattering_weight_is_brdf_cos_over_pdf(dist, kd, ks, a, theta_o):
 @pytest.mark.parametrize("dist", DISTRIBUTIONS)
 @pytest.mark.parametrize("a, theta_o_deg", [(0.05, 30.0), (0.3, 0.0), (0.3, 70.0), (1.0, 45.0)])
 @pytest.mark.slow
-def test_mean_sample_weight_is_the_albedo_by_quadrature(dist, a, theta_o_deg):
+def test_mean_sample_weight_is_the_albedo_by_quadrature(heavy, request, dist, a, theta_o_deg):
     """The mean of BRDF * cos / pdf over the sampler's directions (absorbed samples
     count 0) estimates the directional albedo exactly when the sampler draws with
     the density pdf() claims: compare with quadrature."""
+    outcome(heavy, request)
+
+
+def check_mean_weight_against_quadrature(dist: str, a: float, theta_o_deg: float) -> None:
     m = CookTorrance(kd=0.0, ks=1.0, roughness=a, distribution=dist, f0=Color(1.0, 1.0, 1.0))
     t_o = math.radians(theta_o_deg)
     wo = direction(t_o, 0.8)
@@ -377,11 +387,10 @@ def test_tiny_roughness_and_grazing_angles_give_finite_values(dist, a):
 @pytest.mark.parametrize(
     "dist, a", slow_except(product(DISTRIBUTIONS, [0.05, 0.2, 0.5, 1.0]), ("beckmann", 1.0))
 )
-def test_the_lobe_reflects_at_most_everything(dist, a):
+def test_the_lobe_reflects_at_most_everything(heavy, request, dist, a):
     """kd = 0, ks = 1 and F = 1 (f0 white): the directional albedo is <= 1 at every
     viewing angle (single scattering loses energy; nothing creates it)."""
-    m = CookTorrance(kd=0.0, ks=1.0, roughness=a, distribution=dist, f0=Color(1.0, 1.0, 1.0))
-    albedos = [albedo_by_quadrature(m, math.radians(t)) for t in (0.0, 30.0, 60.0, 80.0, 89.0)]
+    albedos, plastic = outcome(heavy, request)
     for value in albedos:
         assert 0.0 < value <= 1.0 + 1e-3
     if a <= 0.05:
@@ -389,8 +398,29 @@ def test_the_lobe_reflects_at_most_everything(dist, a):
     if a == 1.0:
         assert albedos[0] < 0.9  # a very rough one loses what bounces between facets
     # The plastic default (F0 = 0.04) reflects little head-on.
+    assert plastic < 0.05
+
+
+def lobe_albedos(dist: str, a: float) -> tuple[list[float], float]:
+    """The lobe's directional albedo with F = 1 at 0, 30, 60, 80 and 89 degrees, and
+    head-on with the plastic default F0."""
+    m = CookTorrance(kd=0.0, ks=1.0, roughness=a, distribution=dist, f0=Color(1.0, 1.0, 1.0))
+    albedos = [albedo_by_quadrature(m, math.radians(t)) for t in (0.0, 30.0, 60.0, 80.0, 89.0)]
     plastic = CookTorrance(kd=0.0, ks=1.0, roughness=a, distribution=dist)
-    assert albedo_by_quadrature(plastic, 0.0) < 0.05
+    return albedos, albedo_by_quadrature(plastic, 0.0)
+
+
+# node id -> the quadratures and sampling of each selected test, on every core, the
+# longest first.
+heavy = module_outcomes(
+    {
+        "test_mean_sample_weight_is_the_albedo_by_quadrature": (
+            check_mean_weight_against_quadrature
+        ),
+        "test_the_lobe_reflects_at_most_everything": lobe_albedos,
+        "test_G1_matches_D_by_smiths_projected_area_identity": projected_area,
+    }
+)
 
 
 # --- construction and scene files ----------------------------------------------------------

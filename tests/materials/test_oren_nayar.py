@@ -23,6 +23,7 @@ from rtpy.materials import Lambertian, OrenNayar
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
+from ..cores import module_outcomes, outcome
 from ..vectors import dot3
 from .directions import (
     ALBEDO,
@@ -151,18 +152,23 @@ def test_sigma_zero_is_exactly_lambertian():
 @pytest.mark.parametrize("sigma", [0.0, 20.0, 60.0, 89.0])
 @pytest.mark.parametrize("theta_o", [0.0, 45.0, 85.0, 89.99])
 @pytest.mark.slow
-def test_scattering_weight_is_brdf_cos_over_pdf(sigma, theta_o):
-    m = OrenNayar(Color(*ALBEDO), sigma=sigma)
-    wo = direction(NORMAL, theta_o, 75.0)
+def test_scattering_weight_is_brdf_cos_over_pdf(heavy, request, sigma, theta_o):
     n = 2000
-    brdf = partial(expected_brdf, sigma, wo)
-    cosines = check_scattering(
-        m, wo, brdf, lambda wi: dot3(wi, NORMAL) / math.pi, n, (5, int(theta_o))
-    )
+    cosines = outcome(heavy, request)
     assert len(cosines) == n  # nothing is absorbed
     cos_sum = sum(cosines)
     # Cosine-weighted: E[cos] = 2/3, variance 1/2 - 4/9.
     assert abs(cos_sum / n - 2 / 3) < 5 * math.sqrt((0.5 - 4 / 9) / n)
+
+
+def check_weights(sigma: float, theta_o: float) -> list[float]:
+    """check_scattering of 2000 samples; the cosines of those reflected."""
+    m = OrenNayar(Color(*ALBEDO), sigma=sigma)
+    wo = direction(NORMAL, theta_o, 75.0)
+    brdf = partial(expected_brdf, sigma, wo)
+    return check_scattering(
+        m, wo, brdf, lambda wi: dot3(wi, NORMAL) / math.pi, 2000, (5, int(theta_o))
+    )
 
 
 # --- energy ---------------------------------------------------------------------------
@@ -198,10 +204,21 @@ def hemisphere_integral(f, theta_breaks, phi_breaks):
 
 @pytest.mark.parametrize("sigma", [10.0, 20.0, 60.0])
 @pytest.mark.parametrize("theta_o", [0.0, 30.0, 70.0, 89.99])
-def test_directional_albedo(sigma, theta_o):
+def test_directional_albedo(heavy, request, sigma, theta_o):
     """The integral of BRDF * cos over the hemisphere: A * albedo at normal incidence,
     rising toward (A + B / 2) * albedo at grazing. The qualitative model does not
     conserve energy exactly: for small sigma, A + B / 2 is a little above 1."""
+    value = outcome(heavy, request)
+    assert value == pytest.approx(expected_albedo_factor(sigma, theta_o), rel=1e-6)
+    a, b = coefficients(sigma)
+    if theta_o == 0.0:
+        assert value == pytest.approx(a, rel=1e-9)
+    assert a - 1e-9 <= value <= a + 0.5 * b + 1e-6
+
+
+def albedo_by_quadrature(sigma: float, theta_o: float) -> float:
+    """The directional albedo of a white Oren-Nayar surface, by Gauss-Legendre cells
+    between the kinks of the integrand."""
     m = OrenNayar(Color(1.0, 1.0, 1.0), sigma=sigma)
     hit = make_hit(m)
     wo = direction(NORMAL, theta_o, 0.0)
@@ -213,12 +230,16 @@ def test_directional_albedo(sigma, theta_o):
     to = math.radians(theta_o)
     theta_breaks = sorted({0.0, to, 0.5 * math.pi, *(k * math.pi / 12 for k in range(7))})
     phi_breaks = [k * math.pi / 4 for k in range(9)]  # kinks of max(0, cos) at pi/2, 3 pi/2
-    value = hemisphere_integral(f_cos, theta_breaks, phi_breaks)
-    assert value == pytest.approx(expected_albedo_factor(sigma, theta_o), rel=1e-6)
-    a, b = coefficients(sigma)
-    if theta_o == 0.0:
-        assert value == pytest.approx(a, rel=1e-9)
-    assert a - 1e-9 <= value <= a + 0.5 * b + 1e-6
+    return hemisphere_integral(f_cos, theta_breaks, phi_breaks)
+
+
+# node id -> the sampling and quadratures of each selected test, on every core.
+heavy = module_outcomes(
+    {
+        "test_scattering_weight_is_brdf_cos_over_pdf": check_weights,
+        "test_directional_albedo": albedo_by_quadrature,
+    }
+)
 
 
 # --- extremes -------------------------------------------------------------------------

@@ -26,6 +26,7 @@ from rtpy.materials.phong import cosine_power_pdf, sample_cosine_power
 from rtpy.sampling import make_generator, use_generator
 from rtpy.vec3 import Color
 
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from ..vectors import dot3
 from .directions import (
@@ -131,12 +132,16 @@ def test_reciprocity(kd, ks, n, ta, pa, tb, pb):
 )
 @pytest.mark.parametrize("theta_o", [0.0, 40.0, 80.0])
 @pytest.mark.slow
-def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, n, theta_o):
+def test_scattering_weight_is_brdf_cos_over_pdf(heavy, request, kd, ks, n, theta_o):
+    assert outcome(heavy, request) > 500
+
+
+def check_weights(kd: float, ks: float, n: float, theta_o: float) -> int:
+    """check_scattering of 1500 samples; the number of them reflected above."""
     m = Phong(Color(*ALBEDO), kd=kd, ks=ks, exponent=n)
     wo = direction(NORMAL, theta_o, 30.0)
     brdf, pdf = partial(expected_brdf, kd, ks, n, wo), partial(expected_pdf, kd, ks, n, wo)
-    cosines = check_scattering(m, wo, brdf, pdf, 1500, (7, int(theta_o)))
-    assert len(cosines) > 500
+    return len(check_scattering(m, wo, brdf, pdf, 1500, (7, int(theta_o))))
 
 
 @pytest.mark.parametrize("n", [0.0, 1.0, 8.0, 100.0])
@@ -164,18 +169,26 @@ def check_cos_power_moments(samples: np.ndarray, n: float, side, up, axis) -> No
     "n, theta_o",
     slow_except([(1.0, 0.0), (8.0, 0.0), (100.0, 50.0), (1000.0, 80.0)], (100.0, 50.0)),
 )
-def test_the_highlight_is_drawn_around_the_mirror_direction(n, theta_o):
+def test_the_highlight_is_drawn_around_the_mirror_direction(heavy, request, n, theta_o):
     """kd = 0: scattering() draws the cosine power around m, the mirror direction of
     wo (where the lobe stays above the surface, as here, nothing is absorbed)."""
+    absorbed, wi = outcome(heavy, request)
+    assert absorbed == 0
+    axis = mirror(direction(NORMAL, theta_o, 30.0), NORMAL)
+    check_cos_power_moments(wi, n, *frame(axis), axis)
+
+
+def highlight_samples(n: float, theta_o: float) -> tuple[int, np.ndarray]:
+    """20,000 samples with kd = 0: (how many were absorbed, the directions (k, 3) of
+    the others)."""
     m = Phong(kd=0.0, ks=1.0, exponent=n)
     hit = make_hit(m)
     wo = direction(NORMAL, theta_o, 30.0)
-    axis = mirror(wo, NORMAL)
     with use_generator(make_generator(11, int(n))):
         samples = [m.scattering(view_ray(wo), hit) for _ in range(20000)]
-    assert all(s is not None for s in samples)
-    wi = np.array([s.scattered_ray.direction.tolist() for s in samples])
-    check_cos_power_moments(wi, n, *frame(axis), axis)
+    kept = [s for s in samples if s is not None]
+    wi = np.array([s.scattered_ray.direction.tolist() for s in kept])
+    return len(samples) - len(kept), wi
 
 
 @pytest.mark.parametrize("n", [0.0, 0.5, 1.0, 30.0, 1000.0, 1e4])
@@ -189,22 +202,40 @@ def test_cosine_power_pdf_integrates_to_one_over_the_sphere(n):
     "kd, n, theta_o",
     slow_except([(0.0, 1.0, 45.0), (0.0, 30.0, 85.0), (0.4, 8.0, 70.0)], (0.4, 8.0, 70.0)),
 )
-def test_pdf_integrates_to_the_fraction_of_samples_not_absorbed(kd, n, theta_o):
+def test_pdf_integrates_to_the_fraction_of_samples_not_absorbed(heavy, request, kd, n, theta_o):
     """Samples below the surface are absorbed, and pdf() is 0 there: over the sphere
     pdf() integrates to the probability that scattering() returns a sample."""
-    m = Phong(Color(*ALBEDO), kd=kd, ks=1.0 - kd, exponent=n)
-    wo = direction(NORMAL, theta_o, 0.0)
-    total = sphere_integral(lambda wi: model_pdf(m, wo, wi), mirror(wo, NORMAL))
-    k = 20000
-    alive = alive_fraction(m, wo, k, seed=int(n + theta_o))
+    total, alive, k = outcome(heavy, request)
     assert 0.0 < total < 1.0
     assert abs(alive - total) < 5.0 * math.sqrt(total * (1.0 - total) / k)
 
 
+def pdf_integral_and_alive_fraction(kd: float, n: float, theta_o: float):
+    """(pdf() over the sphere, the fraction of k samples not absorbed, k = 20,000)."""
+    m = Phong(Color(*ALBEDO), kd=kd, ks=1.0 - kd, exponent=n)
+    wo = direction(NORMAL, theta_o, 0.0)
+    total = sphere_integral(lambda wi: model_pdf(m, wo, wi), mirror(wo, NORMAL))
+    k = 20000
+    return total, alive_fraction(m, wo, k, seed=int(n + theta_o)), k
+
+
 @pytest.mark.parametrize("n", slow_except([0.0, 0.8, 1.0, 8.0, 30.0, 1000.0], 8.0))
-def test_energy_the_normalised_lobe_reflects_at_most_everything(n):
+def test_energy_the_normalised_lobe_reflects_at_most_everything(heavy, request, n):
     """Integral of the specular f_r * cos(theta_i) over the hemisphere (the directional
     albedo of the lobe with ks = 1): exactly 1 at normal incidence, less elsewhere."""
+    head_on, *albedos = outcome(heavy, request)
+    assert head_on == pytest.approx(1.0, abs=1e-6)
+    previous = 1.0
+    for a in albedos:
+        assert 0.0 < a <= 1.0 + 1e-6
+        if n > 0.0:
+            # The lobe comes nearer the horizon, so a larger part of it is cut off.
+            assert a <= previous + 1e-6
+        previous = a
+
+
+def lobe_albedos(n: float) -> list[float]:
+    """The lobe's directional albedo (ks = 1) at 0, 30, 60 and 85 degrees."""
     m = Phong(Color(*ALBEDO), kd=0.0, ks=1.0, exponent=n)
     hit = make_hit(m)
 
@@ -217,15 +248,21 @@ def test_energy_the_normalised_lobe_reflects_at_most_everything(n):
 
         return sphere_integral(f_cos, mirror(wo, NORMAL))
 
-    assert albedo(0.0) == pytest.approx(1.0, abs=1e-6)
-    previous = 1.0
-    for theta_o in (30.0, 60.0, 85.0):
-        a = albedo(theta_o)
-        assert 0.0 < a <= 1.0 + 1e-6
-        if n > 0.0:
-            # The lobe comes nearer the horizon, so a larger part of it is cut off.
-            assert a <= previous + 1e-6
-        previous = a
+    return [albedo(theta_o) for theta_o in (0.0, 30.0, 60.0, 85.0)]
+
+
+# node id -> the sampling and quadratures of each selected test, on every core, the
+# longest first.
+heavy = module_outcomes(
+    {
+        "test_energy_the_normalised_lobe_reflects_at_most_everything": lobe_albedos,
+        "test_pdf_integrates_to_the_fraction_of_samples_not_absorbed": (
+            pdf_integral_and_alive_fraction
+        ),
+        "test_the_highlight_is_drawn_around_the_mirror_direction": highlight_samples,
+        "test_scattering_weight_is_brdf_cos_over_pdf": check_weights,
+    }
+)
 
 
 # --- extremes -------------------------------------------------------------------------

@@ -32,6 +32,7 @@ from rtpy.materials import Ward
 from rtpy.onb import ONB
 from rtpy.vec3 import Color, Vec3
 
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from ..vectors import angle, cross3, dot3, unit3
 from . import directions
@@ -207,14 +208,18 @@ WIDTH_PAIRS = [(0.001, 0.001), (0.05, 0.05), (0.2, 0.2), (0.05, 0.4), (1.0, 0.1)
 
 
 @pytest.mark.parametrize("ax, ay", WIDTH_PAIRS)
-def test_the_half_vector_density_is_normalised(ax, ay):
+def test_the_half_vector_density_is_normalised(heavy, request, ax, ay):
+    assert outcome(heavy, request) == pytest.approx(1.0, abs=1e-6)
+
+
+def half_vector_density_integral(ax: float, ay: float) -> float:
     m = Ward(alpha_x=ax, alpha_y=ay)
 
     def integrand(t, p):
         s = math.sin(t)
         return m.half_vector_pdf(AXES, Vec3(s * math.cos(p), s * math.sin(p), math.cos(t)))
 
-    assert hemisphere_integral(integrand, min(ax, ay), n_phi=256) == pytest.approx(1.0, abs=1e-6)
+    return hemisphere_integral(integrand, min(ax, ay), n_phi=256)
 
 
 @pytest.mark.parametrize("ax, ay", WIDTH_PAIRS)
@@ -277,10 +282,14 @@ def test_scattering_weight_is_brdf_cos_over_pdf(kd, ks, ax, ay, theta_o):
     ],
 )
 @pytest.mark.slow
-def test_mean_sample_weight_is_the_albedo_by_quadrature(ax, ay, theta_o_deg, phi_o):
+def test_mean_sample_weight_is_the_albedo_by_quadrature(heavy, request, ax, ay, theta_o_deg, phi_o):
     """The mean of BRDF * cos / pdf over the sampler's directions (absorbed samples
     count 0) is the directional albedo exactly when the sampler draws with the
     density pdf() claims."""
+    outcome(heavy, request)
+
+
+def check_mean_weight_against_quadrature(ax: float, ay: float, theta_o_deg: float, phi_o: float):
     m = Ward(kd=0.0, ks=1.0, alpha_x=ax, alpha_y=ay)
     t_o = math.radians(theta_o_deg)
     expected = albedo_by_quadrature(m, t_o, phi_o, n_phi=256)
@@ -331,16 +340,34 @@ def test_the_lobe_at_grazing_angles_is_large_but_finite():
     "ax, ay",
     slow_except([(0.05, 0.05), (0.2, 0.2), (0.5, 0.5), (1.0, 1.0), (0.05, 0.4)], (0.05, 0.4)),
 )
-def test_the_lobe_reflects_at_most_everything_away_from_the_horizon(ax, ay):
+def test_the_lobe_reflects_at_most_everything_away_from_the_horizon(heavy, request, ax, ay):
     """kd = 0, ks = 1: the directional albedo is <= 1 for views up to 89 degrees."""
-    m = Ward(kd=0.0, ks=1.0, alpha_x=ax, alpha_y=ay)
-    albedos = [albedo_by_quadrature(m, math.radians(t)) for t in (0.0, 30.0, 60.0, 80.0, 89.0)]
+    albedos = outcome(heavy, request)
     for value in albedos:
         assert 0.0 < value <= 1.0
     if ax == ay == 0.05:
         assert albedos[0] == pytest.approx(1.0, abs=0.01)  # narrow lobes: nearly ks head-on
         # ... and about cos(theta_o) at an angle (Ward's 1 / sqrt(cos cos) normalisation).
         assert albedos[1] == pytest.approx(math.cos(math.radians(30.0)), abs=0.01)
+
+
+def lobe_albedos(ax: float, ay: float) -> list[float]:
+    """The lobe's directional albedo (kd = 0, ks = 1) at 0, 30, 60, 80 and 89 degrees."""
+    m = Ward(kd=0.0, ks=1.0, alpha_x=ax, alpha_y=ay)
+    return [albedo_by_quadrature(m, math.radians(t)) for t in (0.0, 30.0, 60.0, 80.0, 89.0)]
+
+
+# node id -> the quadratures and sampling of each selected test, on every core, the
+# longest first.
+heavy = module_outcomes(
+    {
+        "test_mean_sample_weight_is_the_albedo_by_quadrature": (
+            check_mean_weight_against_quadrature
+        ),
+        "test_the_lobe_reflects_at_most_everything_away_from_the_horizon": lobe_albedos,
+        "test_the_half_vector_density_is_normalised": half_vector_density_integral,
+    }
+)
 
 
 def test_wards_normalisation_exceeds_1_at_the_horizon():

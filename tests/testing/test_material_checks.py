@@ -11,6 +11,7 @@ from rtpy.materials import Lambertian
 from rtpy.testing import check_energy, check_weights, directional_albedo
 from rtpy.vec3 import Color
 
+from ..cores import module_outcomes, outcome
 from .materials_to_check import (
     DiffuseTransmitter,
     ForgetsPdf,
@@ -47,20 +48,38 @@ def test_check_weights_sees_both_sides(inside):
     assert not result and "pdf() = 0.0" in result.detail
 
 
-def test_directional_albedo_by_sampling_and_quadrature():
-    a = directional_albedo(Lambertian(Color(0.8, 0.5, 0.25)), 45.0, n_samples=1000)
+def test_directional_albedo_by_sampling_and_quadrature(heavy, request):
+    a, lobe = outcome(heavy, request)
     assert a.sampled == pytest.approx((0.8, 0.5, 0.25), rel=1e-12)
     assert a.quadrature == pytest.approx((0.8, 0.5, 0.25), rel=1e-7)
     # A Phong lobe at 60 degrees: the part of the lobe above the surface times
     # (n+2)/(n+1) <cos theta_i>; for n = 1e4 the lobe is a near-delta at 60 degrees.
-    a = directional_albedo(PhongLobe(1e4), 60.0, n_samples=20_000)
-    assert a.quadrature[0] == pytest.approx(0.5, abs=1e-4)
-    assert a.sampled[0] == pytest.approx(a.quadrature[0], abs=5 * a.standard_error[0] + 1e-6)
+    assert lobe.quadrature[0] == pytest.approx(0.5, abs=1e-4)
+    assert lobe.sampled[0] == pytest.approx(
+        lobe.quadrature[0], abs=5 * lobe.standard_error[0] + 1e-6
+    )
 
 
-def test_check_energy_accepts_correct_materials():
-    assert check_energy(Lambertian(Color(1.0, 1.0, 1.0)), 30.0, n_samples=2000)
-    assert check_energy(PhongLobe(10.0, kd=0.5, ks=0.5), 30.0, n_samples=20_000)
+def lambertian_and_lobe_albedos():
+    """A Lambertian's at 45 degrees, and a Phong lobe's (n = 1e4) at 60 degrees."""
+    return (
+        directional_albedo(Lambertian(Color(0.8, 0.5, 0.25)), 45.0, n_samples=1000),
+        directional_albedo(PhongLobe(1e4), 60.0, n_samples=20_000),
+    )
+
+
+def test_check_energy_accepts_correct_materials(heavy, request):
+    white, lobe = outcome(heavy, request)
+    assert white
+    assert lobe
+
+
+def energy_of_correct_materials():
+    """check_energy of a white Lambertian and of a Phong lobe (n = 10) with kd = ks = 0.5."""
+    return (
+        check_energy(Lambertian(Color(1.0, 1.0, 1.0)), 30.0, n_samples=2000),
+        check_energy(PhongLobe(10.0, kd=0.5, ks=0.5), 30.0, n_samples=20_000),
+    )
 
 
 def test_check_energy_catches_an_albedo_above_one():
@@ -70,31 +89,67 @@ def test_check_energy_catches_an_albedo_above_one():
     assert not result and "> 1" in result.detail
 
 
-def test_check_energy_catches_sampling_that_misses_part_of_the_brdf():
+def test_check_energy_catches_sampling_that_misses_part_of_the_brdf(heavy, request):
     # HalfSampler passes the chi2 and weights checks: only the energy check sees
     # that the mean weight (albedo / 2) is not the integral of BRDF * cos (albedo).
-    assert check_weights(HalfSampler(), 30.0)
-    result = check_energy(HalfSampler(), 30.0, n_samples=20_000)
+    weights, result = outcome(heavy, request)
+    assert weights
     assert not result and "disagrees" in result.detail
 
 
+def half_sampler_checks():
+    """check_weights and check_energy of HalfSampler at 30 degrees."""
+    return check_weights(HalfSampler(), 30.0), check_energy(HalfSampler(), 30.0, n_samples=20_000)
+
+
 @pytest.mark.parametrize("inside", [False, True])
-def test_directional_albedo_of_a_material_that_transmits(inside):
-    a = directional_albedo(DiffuseTransmitter(0.3, 0.5), 50.0, n_samples=2000, inside=inside)
+def test_directional_albedo_of_a_material_that_transmits(heavy, request, inside):
+    a, one_sided = outcome(heavy, request)
     assert a.two_sided
     assert a.sampled == pytest.approx((0.8, 0.8, 0.8), rel=1e-12)  # every weight is r + t
     assert a.reflected == pytest.approx((0.3, 0.3, 0.3), rel=1e-7)
     assert a.transmitted == pytest.approx((0.5, 0.5, 0.5), rel=1e-7)
     assert a.transmitted_power == pytest.approx((0.5, 0.5, 0.5), rel=1e-7)  # reciprocal
     assert a.lost == pytest.approx((0.2, 0.2, 0.2), rel=1e-6)
-    one_sided = directional_albedo(DiffuseTransmitter(), 50.0, n_samples=2000, two_sided=False)
     assert one_sided.quadrature == pytest.approx((0.3, 0.3, 0.3), rel=1e-7)
 
 
-def test_check_energy_on_both_sides():
-    assert check_energy(DiffuseTransmitter(0.3, 0.5), 30.0, n_samples=2000, inside=True)
-    result = check_energy(DiffuseTransmitter(0.6, 0.6), 30.0, n_samples=2000)
-    assert not result and "> 1" in result.detail and "transmitted 0.6000" in result.detail
+def transmitter_albedos(inside: bool):
+    """DiffuseTransmitter(0.3, 0.5)'s from the side `inside`, then the default one's
+    on one side only (from outside)."""
+    return (
+        directional_albedo(DiffuseTransmitter(0.3, 0.5), 50.0, n_samples=2000, inside=inside),
+        directional_albedo(DiffuseTransmitter(), 50.0, n_samples=2000, two_sided=False),
+    )
+
+
+def test_check_energy_on_both_sides(heavy, request):
+    inside, too_bright, one_sided = outcome(heavy, request)
+    assert inside
+    assert not too_bright
+    assert "> 1" in too_bright.detail and "transmitted 0.6000" in too_bright.detail
     # The transmitted half, left out of the quadrature, is missing from it.
-    result = check_energy(DiffuseTransmitter(), 30.0, n_samples=2000, two_sided=False)
-    assert not result and "disagrees" in result.detail
+    assert not one_sided and "disagrees" in one_sided.detail
+
+
+def energy_on_both_sides():
+    """check_energy of a correct transmitter from inside, of one that reflects and
+    transmits 0.6 each, and of the default one checked on one side only."""
+    return (
+        check_energy(DiffuseTransmitter(0.3, 0.5), 30.0, n_samples=2000, inside=True),
+        check_energy(DiffuseTransmitter(0.6, 0.6), 30.0, n_samples=2000),
+        check_energy(DiffuseTransmitter(), 30.0, n_samples=2000, two_sided=False),
+    )
+
+
+# node id -> the albedos and checks of each selected test, on every core, the longest
+# first.
+heavy = module_outcomes(
+    {
+        "test_directional_albedo_by_sampling_and_quadrature": lambertian_and_lobe_albedos,
+        "test_check_energy_accepts_correct_materials": energy_of_correct_materials,
+        "test_check_energy_on_both_sides": energy_on_both_sides,
+        "test_directional_albedo_of_a_material_that_transmits": transmitter_albedos,
+        "test_check_energy_catches_sampling_that_misses_part_of_the_brdf": (half_sampler_checks),
+    }
+)
