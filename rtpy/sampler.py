@@ -163,8 +163,9 @@ def permute(i: int, n: int, p: int) -> int:
     with K - x (mod n) and swaps the pair or not by a random bit of the pair. K and
     the bits come from the round's hash h (splitmix64's stream from state p): K from
     its high 32 bits (scaled to [0, n) by a product, as Lemire's bounded integers),
-    the bit of the pair's larger member x from bit x of its low 32 bits, or from a
-    hash of h and x when n > 32. Each round is an involution, so the result is a
+    the bit of the pair's larger member x from bit x mod 32 of word x // 32 (word 0
+    is h's low 32 bits, word w > 0 those of a hash of h + w). Each round is an
+    involution, so the result is a
     permutation, and every permutation can come out (a hashed bijection of the next
     power of two, as Kensler's, reaches only 8 of the 24 permutations of 4 elements,
     which pairs the strata of two dimensions by a few fixed patterns)."""
@@ -172,8 +173,8 @@ def permute(i: int, n: int, p: int) -> int:
         h = mix64((p + (r + 1) * GOLDEN) & MASK64)
         partner = (((h >> 32) * n >> 32) - i) % n
         x = max(i, partner)
-        swap = h >> x & 1 if n <= 32 else mix64(h ^ x) >> 63
-        if swap:
+        word = h if x < 32 else mix64((h + (x >> 5)) & MASK64)
+        if word >> (x & 31) & 1:
             i = partner
     return i
 

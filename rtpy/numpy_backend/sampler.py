@@ -92,21 +92,46 @@ def sobol_2d(index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return reverse_bits32(index), y
 
 
+def low32(h: np.ndarray) -> np.ndarray:
+    """The low 32 bits of uint64 values, as uint32."""
+    return (h & MASK32).astype(np.uint32)
+
+
 def permute(i: np.ndarray, n: int, p: np.ndarray) -> np.ndarray:
-    """rtpy.sampler.permute of arrays i (int) and p (uint64), broadcast together, in
-    uint64 arithmetic: K - x (mod n) as the smaller of K + n - x and that minus n
-    (which wraps to a huge number when it would be negative)."""
-    i, p = np.broadcast_arrays(np.asarray(i).astype(U64), np.asarray(p).astype(U64))
-    n64, one = U64(n), U64(1)
+    """rtpy.sampler.permute of arrays i (int) and p (uint64), broadcast together. A
+    round's hashes depend on p alone, which repeats along the samples of a pixel: they
+    are made once per run of equal p (K and a table of the words of each run) and
+    gathered per element, where the arithmetic is in uint32 (n <= 2^31): K - x (mod n)
+    as the smaller of K + n - x and that minus n (which wraps to a huge number when it
+    would be negative)."""
+    i, p = np.broadcast_arrays(np.asarray(i), np.asarray(p).astype(U64))
+    shape, i, p = i.shape, i.ravel().astype(np.uint32), p.ravel()
+    changes = np.ones(p.size, dtype=bool)
+    np.not_equal(p[1:], p[:-1], out=changes[1:])
+    starts = np.flatnonzero(changes)
+    run = np.repeat(np.arange(starts.size), np.diff(starts, append=p.size))  # of equal p
+    p = p.take(starts)
+    words = max(1, (n + 31) >> 5)  # 32-bit words: a bit for each pair's larger member
+    first = run * words  # each element's row in the table of words
+    n32 = np.uint32(n)
     with np.errstate(over="ignore"):
         for r in range(permute_rounds(n)):
             h = mix64(p + U64((r + 1) * GOLDEN & MASK64))
-            d = ((h >> U64(32)) * n64 >> U64(32)) + n64 - i
-            partner = np.minimum(d, d - n64)
+            k = (h >> U64(32)) * U64(n) >> U64(32)
+            d = k.astype(np.uint32).take(run) + n32 - i
+            partner = np.minimum(d, d - n32)
             x = np.maximum(i, partner)
-            swap = (h >> x) & one if n <= 32 else mix64(h ^ x) >> U64(63)
-            i = np.where(swap.astype(bool), partner, i)
-    return i.astype(np.int64)
+            if words == 1:
+                word = low32(h).take(run)
+            elif p.size * words <= i.size:  # a table of every run's words, gathered
+                table = np.stack([h] + [mix64(h + U64(w)) for w in range(1, words)], axis=1)
+                word = low32(table).ravel().take(first + (x >> np.uint32(5)))
+            else:  # runs too short for a table: each element's own word
+                h, w = h.take(run), (x >> np.uint32(5)).astype(U64)
+                word = low32(np.where(w == U64(0), h, mix64(h + w)))
+            swap = (word >> (x & np.uint32(31))) & np.uint32(1)
+            i ^= (i ^ partner) & (np.uint32(0) - swap)  # partner where swap is 1
+    return i.astype(np.int64).reshape(shape)
 
 
 class Sampler:

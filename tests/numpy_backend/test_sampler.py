@@ -48,6 +48,15 @@ def test_building_blocks_equal_the_scalar_ones():
             assert batch.permute(np.arange(n), n, np.uint64(p)).tolist() == [
                 scalar.permute(k, n, p) for k in range(n)
             ]
+    # A pixel's samples share p: its hashes come from a table made once per run of equal
+    # p, or per sample when the runs are short. Both give the scalar permutation.
+    rng = np.random.default_rng(5)
+    for n, run in ((4, 1), (4, 5), (40, 1), (40, 3), (100, 1), (100, 8)):
+        p = np.repeat(rng.integers(0, 2**63, 60, dtype=np.uint64), run)
+        k = rng.integers(0, n, p.size)
+        assert batch.permute(k, n, p).tolist() == [
+            scalar.permute(int(a), n, int(b)) for a, b in zip(k, p, strict=True)
+        ]
     assert batch.hash_key(3, np.arange(4), 5).tolist() == [
         scalar.hash_key(3, k, 5) for k in range(4)
     ]
