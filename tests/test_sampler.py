@@ -53,14 +53,17 @@ def test_permute_is_a_permutation(n):
         assert sorted(permute(i, n, p) for i in range(n)) == list(range(n))
 
 
+def even_counts_p(counts: np.ndarray) -> float:
+    """p-value of counts over cells that are equally likely (Pearson's chi-square)."""
+    expected = counts.sum() / len(counts)
+    return chi2_sf(float(((counts - expected) ** 2 / expected).sum()), len(counts) - 1)
+
+
 def permutation_p(perms: list[tuple[int, ...]], n: int) -> float:
     """p-value of the permutations `perms` of range(n) being uniform over all n! (a
     chi-square test over the n! cells)."""
-    cells = math.factorial(n)
     counts = collections.Counter(perms)
-    expected = len(perms) / cells
-    x2 = sum((counts[q] - expected) ** 2 / expected for q in itertools.permutations(range(n)))
-    return chi2_sf(x2, cells - 1)
+    return even_counts_p(np.array([counts[q] for q in itertools.permutations(range(n))]))
 
 
 def test_permute_gives_every_permutation_alike():
@@ -184,9 +187,7 @@ def chi_square_p(values: np.ndarray, bins: int) -> float:
     cells = np.zeros(len(values[0]), dtype=np.int64)
     for row in values:
         cells = cells * bins + np.minimum((row * bins).astype(np.int64), bins - 1)
-    counts = np.bincount(cells, minlength=bins ** len(values))
-    expected = len(cells) / len(counts)
-    return chi2_sf(float(((counts - expected) ** 2 / expected).sum()), len(counts) - 1)
+    return even_counts_p(np.bincount(cells, minlength=bins ** len(values)))
 
 
 def test_the_last_stratum_stays_below_one():
