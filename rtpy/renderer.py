@@ -38,6 +38,7 @@ from .workers import run_on_workers
 
 TILE_SIZE = 16
 MAX_BATCHES = 8  # samples per pixel are split into at most this many batches
+MAX_PASS_SPP = 16  # plan_bands: passes longer than MAX_BATCHES' share only to fill a unit
 
 
 @dataclass(frozen=True)
@@ -74,12 +75,15 @@ def plan_units(
 def plan_bands(width: int, height: int, spp: int, paths_per_unit: int) -> list[Unit]:
     """All units of work, batch-major, each of at most paths_per_unit camera paths and
     of about that many whatever the image size and spp. A batch is a pass over the
-    whole image with as few samples per pixel as fill one unit (one sample when the
-    image holds more pixels than a unit holds paths), so an interrupted render has
-    the same samples in every pixel, give or take a pass. A pass is cut into bands of
+    whole image, so an interrupted render has the same samples in every pixel, give or
+    take a pass. A pass holds as many samples per pixel as fill one unit, and at
+    least spp / MAX_BATCHES of them up to MAX_PASS_SPP: a unit returns one sum per
+    pixel, and fewer, longer passes return less per path. A pass is cut into bands of
     whole rows of equal height or, where one row holds more paths than a unit, each
     row into pieces of equal width."""
-    spp_per_pass = max(1, min(spp, paths_per_unit // (width * height)))
+    fill = paths_per_unit // (width * height)
+    longer = min(math.ceil(spp / MAX_BATCHES), MAX_PASS_SPP, paths_per_unit)
+    spp_per_pass = min(spp, max(1, fill, longer))
     n_batches = math.ceil(spp / spp_per_pass)
     pixels = max(1, paths_per_unit // math.ceil(spp / n_batches))  # per unit
     if pixels >= width:

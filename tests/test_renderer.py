@@ -3,6 +3,7 @@ one loop that drives any backend."""
 
 from __future__ import annotations
 
+import math
 import re
 import sys
 
@@ -13,7 +14,15 @@ from hypothesis import strategies as st
 
 import rtpy
 from rtpy import Camera, Color, DiffuseLight, Lambertian, Metal, Scene, Sphere, Vec3
-from rtpy.renderer import Backend, PixelSums, Renderer, plan_bands, plan_units
+from rtpy.renderer import (
+    MAX_BATCHES,
+    MAX_PASS_SPP,
+    Backend,
+    PixelSums,
+    Renderer,
+    plan_bands,
+    plan_units,
+)
 
 
 @pytest.mark.parametrize("width,height,spp", [(1, 1, 1), (16, 16, 16), (37, 21, 5), (40, 3, 64)])
@@ -38,6 +47,12 @@ def test_bands_cover_every_pixel_once_per_batch_within_the_path_budget(
     np.testing.assert_array_equal(counts, spp)
     assert len({frozenset(r) for r in regions.values()}) == 1  # the same regions every batch
     assert [u.batch for u in units] == sorted(u.batch for u in units)
+    # As few passes as hold `wanted` samples per pixel each: enough to fill a unit, and
+    # at least spp / MAX_BATCHES up to MAX_PASS_SPP, within the budget
+    fill = paths_per_unit // (width * height)
+    longer = min(math.ceil(spp / MAX_BATCHES), MAX_PASS_SPP, paths_per_unit)
+    wanted = min(spp, max(1, fill, longer))
+    assert len(regions) == math.ceil(spp / wanted)
 
 
 def test_units_run_batch_by_batch():
