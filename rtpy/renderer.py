@@ -38,7 +38,7 @@ from .workers import run_on_workers
 
 TILE_SIZE = 16
 MAX_BATCHES = 8  # samples per pixel are split into at most this many batches
-MAX_PASS_SPP = 16  # plan_bands: passes longer than MAX_BATCHES' share only to fill a unit
+MAX_PASS_SPP = 16  # plan_bands: spp / MAX_BATCHES samples a pass, at most this (but to fill a unit)
 
 
 @dataclass(frozen=True)
