@@ -55,6 +55,24 @@ def test_bands_cover_every_pixel_once_per_batch_within_the_path_budget(
     assert len(regions) == math.ceil(spp / wanted)
 
 
+@pytest.mark.parametrize(
+    "width,height,spp,passes,pass_spp,bands",
+    [
+        (1920, 1080, 1, 1, 1, 32),  # more pixels than a unit holds paths: 1 spp
+        (256, 256, 64, 8, 8, 8),  # an eighth of the samples a pass: 8 x 8192 pixels
+        (256, 256, 4096, 256, 16, 16),  # at most 16 a pass: 16 x 4096 pixels
+        (48, 48, 20000, 715, 28, 1),  # a small image: 28 spp fill a unit of 2304 pixels
+    ],
+)
+def test_bands_as_docs_numpy_backend_describes_them(width, height, spp, passes, pass_spp, bands):
+    """docs/numpy-backend.md's examples and test_cli's Ctrl-C render, counted by hand, for
+    units of 65,536 paths."""
+    units = plan_bands(width, height, spp, 65536)
+    assert len({u.batch for u in units}) == passes
+    assert max(u.spp for u in units) == pass_spp
+    assert len({u.region for u in units}) == bands
+
+
 def test_units_run_batch_by_batch():
     """Every tile gets its first batch before any tile gets a second one, so an
     interrupted render covers the whole image."""
