@@ -36,6 +36,9 @@ def add_assignment_commands(sub, seconds) -> None:
     g = sub.add_parser("grade", help="run a week's graders and print the score")
     g.add_argument("week", metavar="WEEK", help=WEEK_HELP)
     g.add_argument("--json", metavar="RESULTS.json", help="Gradescope results file")
+    g.add_argument(
+        "--hidden", action="store_true", help="also the hidden checks (rtpy's own repository)"
+    )
 
 
 def command_assignment(args: argparse.Namespace) -> int:
@@ -47,7 +50,7 @@ def command_assignment(args: argparse.Namespace) -> int:
     try:
         week = None if getattr(args, "week", None) is None else check_week(args.week)
         if args.command == "grade":
-            return command_grade(week, args.json)
+            return command_grade(week, args.json, args.hidden)
         if args.assignment_command == "map-tests":
             weeks = map_tests(files=tuple(args.files))
             print(f"rtpy: {len(weeks)} test files need solution regions", file=sys.stderr)
@@ -82,15 +85,16 @@ def write_assignment(args: argparse.Namespace, week: str):
         raise WriteError(out, err) from err
 
 
-def command_grade(week: str, json_path: str | None) -> int:
+def command_grade(week: str, json_path: str | None, hidden: bool = False) -> int:
     """0 when every grader passes, 1 otherwise."""
-    from ..grading.graders import grade, score_table, write_json
+    from ..grading.graders import grade
+    from ..grading.results import score_table, write_results
 
     if json_path:
         check_writable(json_path)
-    results = grade(week)
+    results = grade(week, hidden=hidden)
     print(score_table(results))
     if json_path:
-        write_json(results, json_path)
-    passed = results["score"] == results["max_score"] and "output" not in results
+        write_results(json_path, results)
+    passed = bool(results["tests"]) and results["score"] == results["max_score"]
     return 0 if passed else 1

@@ -1,0 +1,186 @@
+"""Probes: what a grader asks the student's code to compute, run where that code runs.
+
+A grader is two halves. Its **probe** is a function here or in the week's
+`assignments/weekNN/probes.py`: it takes plain data (numbers, lists, arrays), builds
+rtpy objects from them, calls the student's methods and returns plain data. Its
+**verdict** is the pytest test in `assignments/weekNN/test_weekNN.py` (or hidden/),
+run by the judge, which calls the probe by name and decides from what comes back:
+
+    @probe(returns=List(Record(t=Maybe(Float))))       # in probes.py: runs in the child
+    def sphere_hit_t(cases):
+        return [{"t": Sphere(vec(c["center"]), c["radius"], M).hit_t(...)} for c in cases]
+
+    def test_sphere_hit_t(probe):                       # in test_week04.py: the judge
+        got = probe.sphere_hit_t(cases=cases)
+        assert ..., "Sphere.hit_t (rtpy/sphere.py): ..."
+
+Probes are public (they ship to students): they say what is called, never with which
+inputs nor what is expected. `returns` is the answer's form (rtpy.grading.protocol):
+the judge checks every answer against it before a verdict sees it. A probe that
+renders is registered with renders=True, so that a failed render can point to the
+component graders that failed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .protocol import Array, Bool, List, Schema, Vec
+
+__all__ = [
+    "MATERIALS",
+    "PROBES",
+    "SCENES",
+    "Probe",
+    "color",
+    "floats",
+    "make_material",
+    "probe",
+    "scene_builder",
+    "vec",
+]
+
+
+@dataclass(frozen=True)
+class Probe:
+    name: str
+    function: Callable
+    returns: Schema
+    renders: bool = False
+
+
+PROBES: dict[str, Probe] = {}
+SCENES: dict[str, Callable] = {}  # name -> function(**params) -> Scene, for render probes
+MATERIALS: dict[str, type] = {}  # extra material classes a probe may build by name
+
+
+def probe(returns: Schema, renders: bool = False):
+    """Register the decorated function as the probe of its name."""
+
+    def register(function: Callable) -> Callable:
+        name = function.__name__
+        if name in PROBES and PROBES[name].function is not function:
+            raise ValueError(f"two probes are called {name!r}")
+        PROBES[name] = Probe(name, function, returns, renders)
+        return function
+
+    return register
+
+
+def scene_builder(function: Callable) -> Callable:
+    """Register a function that builds a scene (from plain parameters) by its name."""
+    SCENES[function.__name__] = function
+    return function
+
+
+# --- between plain data and rtpy objects ---------------------------------------------
+def vec(values):
+    """A Vec3 from three numbers."""
+    from ..vec3 import Vec3
+
+    x, y, z = (float(v) for v in values)
+    return Vec3(x, y, z)
+
+
+def color(values):
+    """A Color from three numbers."""
+    from ..vec3 import Color
+
+    r, g, b = (float(v) for v in values)
+    return Color(r, g, b)
+
+
+def floats(v) -> list[float]:
+    """A Vec3 or Color (or any three numbers) as three floats."""
+    x, y, z = v
+    return [float(x), float(y), float(z)]
+
+
+COLOR_PARAMETERS = {"albedo", "f0", "emit", "le", "color"}
+
+
+def make_material(spec: dict):
+    """The material of a spec {"type": class name in rtpy.materials (or MATERIALS),
+    parameter: value, ...}; colours are given as three numbers."""
+    import rtpy.materials as materials
+
+    params = dict(spec)
+    name = params.pop("type")
+    cls = MATERIALS.get(name) or getattr(materials, name, None)
+    if not isinstance(cls, type):
+        raise ValueError(f"no material class {name!r}")
+    for key in COLOR_PARAMETERS & set(params):
+        params[key] = color(params[key])
+    return cls(**params)
+
+
+# --- probes every week may use ---------------------------------------------------------
+@probe(returns=Array((None, None, None, 3)), renders=True)
+def render(scene: str, seeds: list, settings: dict, params: dict | None = None):
+    """(R, H, W, 3) linear renders of SCENES[scene](**params), one per seed, with the
+    scalar backend in this process."""
+    import rtpy
+
+    built = SCENES[scene](**(params or {}))
+    images = [
+        rtpy.render(built, seed=int(s), quiet=True, workers=1, **settings).linear for s in seeds
+    ]
+    return np.stack(images)
+
+
+@probe(returns=Bool)
+def material_is_specular(material: dict):
+    return bool(make_material(material).is_specular)
+
+
+SAMPLES = Array((None, 8))  # per draw: direction (3), weight (3), pdf, status
+
+
+@probe(returns=SAMPLES)
+def material_draw(
+    material: dict, incident_deg: float, n: int, seed: int, phi_deg: float, inside: bool, tag: int
+):
+    """n draws of scattering() in the test setup of rtpy.testing (see its subject.py)."""
+    from ..testing.subject import LocalMaterial
+
+    s = LocalMaterial(make_material(material)).draw(
+        float(incident_deg), int(n), seed=int(seed), phi_deg=float(phi_deg),
+        inside=bool(inside), tag=int(tag),
+    )  # fmt: skip
+    return np.column_stack([s.directions, s.weights, s.pdfs, s.status.astype(float)])
+
+
+@probe(returns=Array((None, 3)))
+def material_brdf(material: dict, wo, wi, inside: bool):
+    from ..testing.subject import LocalMaterial
+
+    m = LocalMaterial(make_material(material))
+    return np.asarray(m.brdf(np.asarray(wo), np.asarray(wi), inside=bool(inside)), dtype=float)
+
+
+@probe(returns=Array((None,)))
+def material_pdf(material: dict, wo, wi, inside: bool):
+    from ..testing.subject import LocalMaterial
+
+    m = LocalMaterial(make_material(material))
+    return np.asarray(m.pdf(np.asarray(wo), np.asarray(wi), inside=bool(inside)), dtype=float)
+
+
+@probe(returns=List(Vec))
+def radiance(scene: str, rays: list, settings: dict, params: dict | None = None, seed: int = 0):
+    """integrator.compute_scattering(ray, scene) for each ray [origin, direction], the
+    integrator the settings name (RenderSettings), rtpy's generator seeded with seed."""
+    from ..integrators import make_integrator
+    from ..ray import Ray
+    from ..render_settings import RenderSettings
+    from ..sampling import make_generator, use_generator
+
+    built = SCENES[scene](**(params or {}))
+    integrator = make_integrator(RenderSettings(**settings))
+    with use_generator(make_generator(int(seed))):
+        return [
+            floats(integrator.compute_scattering(Ray(vec(o), vec(d)), built)) for o, d in rays
+        ]

@@ -1,0 +1,406 @@
+"""The judge's side of the process that runs a student's code (rtpy.grading.child).
+
+`Child` starts that process, sends it one request at a time and reads its reply, with
+a deadline: a child that is late, dies, closes the pipe or breaks the protocol is
+stopped (its whole process group, and on Linux as root every process of the sandbox
+user), and the call raises ChildFailure; the next call starts a new child. Only plain
+data crosses (rtpy.grading.protocol). The child's own output is read into a bounded
+buffer for the instructor's log, so printing cannot flood or block anything.
+
+Isolation (`Isolation`): as root (Gradescope), the child runs as an unprivileged user
+(SANDBOX_USER) in a work copy it can read but not change, with its own temporary
+folder, limits on CPU time, memory, file size and processes (setrlimit), a scrubbed
+environment, Python's isolated mode, and its own session. Such a child cannot signal
+the judge, read what is readable by root alone (the autograder's source: graders,
+hidden checks, references; results/) or write anything outside its folder. Without
+root (a laptop) the same protocol, limits and session, but the user is the judge's:
+docs/instructors.md says what that leaves open.
+
+`InProcess` runs the probes in the judge's own process, through the same codec: for
+rtpy's tests, where planted mistakes patch rtpy in place, and for making references.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .child import BOOT, ProbeTimeout, error_reply, load_probes, serve
+from .protocol import ProtocolError, decode, encode, printable, read_frame, write_frame
+
+SANDBOX_USER = "rtpy-sandbox"
+GRACE = 5.0  # seconds past a probe's own time limit before the child is killed
+START_TIMEOUT = 60.0  # seconds for the child to import rtpy and the probes
+OUTPUT_LIMIT = 64 * 1024  # characters of the child's output kept (the first and the last)
+
+
+class ChildFailure(Exception):
+    """The child did not answer: it was too slow, died or broke the protocol. Its
+    message is the judge's own, for the student."""
+
+
+class StudentError(Exception):
+    """The student's code raised (or returned what cannot be sent); the message is
+    worded by the judge."""
+
+    def __init__(self, message: str, where: tuple[str, str, int] | None = None) -> None:
+        super().__init__(message)
+        self.where = where
+
+
+@dataclass
+class Isolation:
+    """How the child is confined. user: the name of the unprivileged user to run as
+    (used only by a root judge); memory_mb, cpu_seconds, file_mb, processes: its
+    resource limits (None: no limit)."""
+
+    user: str | None = None
+    memory_mb: int | None = 4096
+    cpu_seconds: int | None = None
+    file_mb: int | None = 64
+    processes: int | None = 64
+    home: Path | None = None  # the child's HOME and TMPDIR (its user's, when it has one)
+
+    def preexec(self):
+        """The function subprocess runs in the child before it starts Python."""
+        import resource
+
+        limits = [
+            (resource.RLIMIT_CORE, 0),
+            (resource.RLIMIT_AS, self.memory_mb and self.memory_mb * 2**20),
+            (resource.RLIMIT_CPU, self.cpu_seconds),
+            (resource.RLIMIT_FSIZE, self.file_mb and self.file_mb * 2**20),
+        ]
+        if self.user is not None:  # per user: meaningful only for a user of its own
+            limits.append((resource.RLIMIT_NPROC, self.processes))
+
+        def apply() -> None:
+            for kind, value in limits:
+                if value is not None:
+                    resource.setrlimit(kind, (value, value))
+
+        return apply
+
+
+def sandbox_ids(user: str | None) -> tuple[int, int] | None:
+    """(uid, gid) of `user` when this process is root and the user exists, else None."""
+    if user is None or not hasattr(os, "geteuid") or os.geteuid() != 0:
+        return None
+    import pwd
+
+    try:
+        entry = pwd.getpwnam(user)
+    except KeyError:
+        return None
+    return entry.pw_uid, entry.pw_gid
+
+
+def child_environment(work: Path, home: Path | None) -> dict[str, str]:
+    """The scrubbed environment of the child: nothing of the judge's but a minimal PATH."""
+    env = {
+        "PATH": "/usr/local/bin:/usr/bin:/bin",
+        "LANG": "C.UTF-8",
+        "PYTHONDONTWRITEBYTECODE": "1",
+        "PYTHONIOENCODING": "utf-8",
+        "OPENBLAS_NUM_THREADS": "1",
+        "OMP_NUM_THREADS": "1",
+        "MKL_NUM_THREADS": "1",
+        "MPLBACKEND": "Agg",
+    }
+    if home is not None:
+        env.update(HOME=str(home), TMPDIR=str(home))
+    if sys.platform == "win32":  # Python needs these to start there
+        for key in ("SYSTEMROOT", "SYSTEMDRIVE", "TEMP", "TMP"):
+            if key in os.environ:
+                env[key] = os.environ[key]
+    return env
+
+
+class Replies:
+    """The child's replies, read by a thread into a queue (portable: no select on
+    pipes), so the judge can wait for one with a deadline."""
+
+    def __init__(self, stream) -> None:
+        self.queue: queue.Queue = queue.Queue()
+        threading.Thread(target=self._read, args=(stream,), daemon=True).start()
+
+    def _read(self, stream) -> None:
+        while True:
+            try:
+                self.queue.put(read_frame(stream))
+            except (ProtocolError, OSError, ValueError) as err:
+                self.queue.put(ProtocolError(str(err)))
+                return
+
+    def get(self, deadline: float):
+        try:
+            item = self.queue.get(timeout=max(0.0, deadline - time.monotonic()))
+        except queue.Empty:
+            raise TimeoutError from None
+        if isinstance(item, Exception):
+            raise item
+        return item
+
+
+@dataclass
+class Child:
+    """The student's process, started on first use.
+
+    work: the folder holding the rtpy the student's code is part of; config: what the
+    child needs (task_files, task_functions, probe_modules: paths inside work)."""
+
+    work: Path
+    config: dict
+    isolation: Isolation = field(default_factory=Isolation)
+    python: str = sys.executable
+    log: list[str] = field(default_factory=list)  # for the instructor
+    _proc: subprocess.Popen | None = None
+    _replies: Replies | None = None
+    _output: list[bytes] = field(default_factory=list)
+    _next_id: int = 0
+
+    # --- the process -------------------------------------------------------------
+    def start(self) -> None:
+        home = self.isolation.home
+        config_path = (home or self.work) / "child-config.json"
+        config_path.write_text(json.dumps(self.config), encoding="utf-8")
+        command = [self.python, "-I", "-c", BOOT, str(self.work), str(config_path)]
+        options: dict = {}
+        ids = sandbox_ids(self.isolation.user)
+        if ids is not None:
+            options.update(user=ids[0], group=ids[1], extra_groups=[])
+        if os.name == "posix":
+            options.update(start_new_session=True, preexec_fn=self.isolation.preexec())
+        self._proc = subprocess.Popen(
+            command,
+            cwd=self.work,
+            env=child_environment(self.work, home),
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            **options,
+        )
+        self._replies = Replies(self._proc.stdout)
+        self._output = []
+        threading.Thread(target=self._drain, args=(self._proc.stderr,), daemon=True).start()
+
+    def _drain(self, stream) -> None:
+        """Keep the first and the last OUTPUT_LIMIT // 2 bytes of the child's output."""
+        kept, tail = 0, b""
+        for chunk in iter(lambda: stream.read1(65536), b""):
+            if kept < OUTPUT_LIMIT // 2:
+                self._output.append(chunk[: OUTPUT_LIMIT // 2 - kept])
+                kept += len(self._output[-1])
+            else:
+                tail = (tail + chunk)[-OUTPUT_LIMIT // 2 :]
+        if tail:
+            self._output.append(b"\n[...]\n" + tail)
+
+    def output(self) -> str:
+        return b"".join(self._output).decode("utf-8", errors="replace")
+
+    def stop(self) -> None:
+        """End the child and everything it started."""
+        proc, self._proc = self._proc, None
+        if proc is None:
+            return
+        try:
+            proc.stdin.close()
+        except OSError:
+            pass
+        kill_tree(proc, self.isolation.user)
+        output = self.output().strip()
+        if output:
+            self.log.append(f"the student's process printed:\n{output[-4000:]}")
+
+    # --- one request ----------------------------------------------------------------
+    def call(self, probe: str, inputs: dict, seconds: float):
+        """The probe's value for inputs, computed within `seconds`; StudentError when
+        the student's code raised, ChildFailure when the child did not answer."""
+        deadline = time.monotonic() + seconds + GRACE
+        if self._proc is None:
+            self.start()
+            deadline += START_TIMEOUT
+        self._next_id += 1
+        request = {"id": self._next_id, "probe": probe, "inputs": inputs, "seconds": seconds}
+        try:
+            write_frame(self._proc.stdin, encode(request))
+        except OSError:
+            raise ChildFailure(self._ended("before it was asked anything")) from None
+        try:
+            reply = self._replies.get(deadline)
+        except TimeoutError:
+            self.stop()
+            raise ChildFailure(f"did not finish within {seconds:g} s: stopped") from None
+        except ProtocolError as err:
+            raise ChildFailure(self._ended(str(err))) from None
+        return answer(reply, self._next_id, self)
+
+    def _ended(self, what: str) -> str:
+        """The judge's words for a child that stopped answering (it is stopped)."""
+        proc = self._proc
+        status = None
+        if proc is not None:
+            try:
+                status = proc.wait(timeout=2.0)
+            except subprocess.TimeoutExpired:
+                pass
+        self.stop()
+        if status is None:
+            return "the grading process broke the protocol, and was stopped"
+        if status < 0:
+            name = signal.Signals(-status).name if -status in signal.valid_signals() else status
+            return f"the grading process was ended by signal {name} (the memory ran out?)"
+        return f"the grading process ended with exit status {status}"
+
+
+def answer(reply, request_id: int, child) -> object:
+    """The value of a reply, or the StudentError / ChildFailure it stands for."""
+    if not isinstance(reply, dict) or reply.get("id") != request_id:
+        child.stop()
+        raise ChildFailure("the grading process answered something that was not asked")
+    if "value" in reply and "error" not in reply:
+        return reply["value"]
+    raise student_error(reply.get("error"), child.config.get("task_files", []))
+
+
+NAME = re.compile(r"[A-Za-z_][\w.<>]{0,99}")
+FILE = re.compile(r"rtpy/[\w/]{1,150}\.py")
+
+
+def where_text(where, task_files) -> tuple[str, tuple[str, str, int] | None]:
+    """(" (raised in f (file, line n))", the frame) for a reported frame that names a
+    plausible function, an rtpy file and a line; ("", None) for anything else."""
+    if not (isinstance(where, list) and len(where) == 3):
+        return "", None
+    function, file, line = where
+    if not (isinstance(function, str) and NAME.fullmatch(function)):
+        return "", None
+    if not (isinstance(file, str) and (file in task_files or FILE.fullmatch(file))):
+        return "", None
+    if not (isinstance(line, int) and not isinstance(line, bool) and 0 < line < 10**6):
+        return "", None
+    return f"{function} ({file}, line {line})", (function, file, line)
+
+
+def student_error(error, task_files) -> Exception:
+    """The exception a reply's error stands for, worded by the judge: the student's
+    exception type and (bounded) message, with where it was raised."""
+    if not isinstance(error, dict):
+        return ChildFailure("the grading process sent an error the judge cannot read")
+    kind, where = error.get("kind"), error.get("where")
+    place, frame = where_text(where, task_files)
+    if kind == "timeout":
+        inside = f" (it was in {place})" if place else ""
+        return ChildFailure(
+            f"did not finish within its time limit{inside}: an endless loop, or code far "
+            "slower than it needs to be"
+        )
+    if kind == "unknown":
+        return ChildFailure("the grading process does not know this probe")
+    name = error.get("type")
+    name = name if isinstance(name, str) and NAME.fullmatch(name) else "an exception"
+    message = printable(error.get("message") if isinstance(error.get("message"), str) else "")
+    if kind == "unsendable":
+        return StudentError(f"returned a value that is not a number or a vector: {message}")
+    if name in ("AssertionError", "TaskReturnError"):
+        text = message or f"{name} in {place or 'the code'}"
+    elif name == "NotImplementedError" and "task:" in message:
+        text = f"NotImplementedError: {message}"  # a stub: the message names the task
+    else:
+        text = f"{name}: {message}" if message else name
+        if place:
+            text += f" (raised in {place})"
+    return StudentError(text, frame)
+
+
+def kill_tree(proc: subprocess.Popen, user: str | None) -> None:
+    """Kill proc's process group, then, as root with a sandbox user, every process of
+    that user (a descendant that left the group), and reap proc."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError, AttributeError):
+        proc.kill()
+    ids = sandbox_ids(user)
+    if ids is not None:
+        kill_user(ids[0])
+    proc.wait()
+
+
+def kill_user(uid: int) -> None:
+    """Kill every process of uid: a helper that becomes uid and signals -1 (all the
+    processes it may signal, that is its own user's), until none is left."""
+    for _ in range(5):
+        pid = os.fork()
+        if pid == 0:  # the helper
+            try:
+                os.setgid(os.getgid())
+                os.setuid(uid)
+                os.kill(-1, signal.SIGKILL)
+            finally:
+                os._exit(0)
+        os.waitpid(pid, 0)
+        if not user_processes(uid):
+            return
+
+
+def user_processes(uid: int) -> list[int]:
+    """The processes of uid (Linux's /proc; [] elsewhere)."""
+    found = []
+    proc = Path("/proc")
+    if not proc.is_dir():
+        return found
+    for entry in proc.iterdir():
+        if entry.name.isdigit():
+            try:
+                if entry.stat().st_uid == uid:
+                    found.append(int(entry.name))
+            except OSError:
+                continue
+    return found
+
+
+@dataclass
+class InProcess:
+    """The probes run in this process, through the same codec (for tests and for
+    making references): no isolation at all."""
+
+    config: dict
+    work: Path = field(default_factory=Path.cwd)
+    log: list[str] = field(default_factory=list)
+    _probes: dict | None = None
+
+    def call(self, probe: str, inputs: dict, seconds: float):
+        if self._probes is None:
+            self._probes = load_probes(self.config.get("probe_modules", []))
+        request = decode(encode({"id": 1, "probe": probe, "inputs": inputs, "seconds": seconds})[4:])
+        task_files = set(self.config.get("task_files", []))
+        timed = hasattr(signal, "SIGALRM") and threading.current_thread() is threading.main_thread()
+        previous = signal.signal(signal.SIGALRM, _on_alarm) if timed else None
+        try:
+            reply = serve(request, self._probes, self.work.resolve(), task_files)
+        finally:
+            if timed:
+                signal.signal(signal.SIGALRM, previous)
+        try:
+            frame = encode(reply)
+        except TypeError as exc:
+            error = error_reply(exc, "unsendable", self.work.resolve(), task_files)
+            frame = encode({"id": 1, "error": error})
+        return answer(decode(frame[4:]), 1, self)
+
+    def stop(self) -> None:
+        pass
+
+
+def _on_alarm(signum, frame) -> None:
+    raise ProbeTimeout
