@@ -186,7 +186,11 @@ def segment_hits_sphere(a, b, center, radius) -> bool:
 def test_direct_light_on_a_plane_is_exact(probe):
     """direct integrator: albedo/pi * I cos / d^2 on a plane, 0 in the shadow"""
     rng = np.random.default_rng(RNG_SEED + 1)
-    albedo, lp, intensity = np.array([0.6, 0.4, 0.9]), np.array([0.7, 2.0, 0.3]), np.array([3.0, 2.0, 1.0])
+    albedo, lp, intensity = (
+        np.array([0.6, 0.4, 0.9]),
+        np.array([0.7, 2.0, 0.3]),
+        np.array([3.0, 2.0, 1.0]),
+    )
     occluder = (np.array([0.5, 1.0, 0.2]), 0.3)
     rays, targets = [], []
     for k in range(30):
@@ -200,7 +204,9 @@ def test_direct_light_on_a_plane_is_exact(probe):
         targets.append(target)
     params = {"albedo": albedo, "light": lp, "intensity": intensity,
               "occluder": [occluder[0], occluder[1]]}  # fmt: skip
-    got = probe.radiance(scene="lit_plane", params=params, rays=rays, settings={"integrator": "direct"})
+    got = probe.radiance(
+        scene="lit_plane", params=params, rays=rays, settings={"integrator": "direct"}
+    )
     for target, value in zip(targets, got, strict=True):
         to_light = lp - target
         dist2 = to_light @ to_light

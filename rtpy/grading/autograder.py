@@ -5,15 +5,15 @@ The zip holds, at its root:
 - setup.sh: Gradescope runs it once, as root, when it builds the autograder's image.
   It finds a Python >= 3.11, installing python3.11 with apt-get when the image has
   none (Gradescope's Ubuntu 22.04 base image has 3.10), makes a virtual environment
-  in $AUTOGRADER_ROOT/venv and installs requirements.txt into it with pip;
+  in $AUTOGRADER_ROOT/venv and installs requirements.txt into it with pip, and makes
+  the unprivileged user the student's code runs as (rtpy.grading.sandbox);
 - run_autograder: run for every submission. It runs run_autograder.py with the
   environment's Python, else $PYTHON, else python3 (so it runs locally and in CI);
 - run_autograder.py: checks the Python version and runs rtpy.grading.autograder_run
   from repo/, and writes a results.json saying what is wrong when it cannot start;
 - requirements.txt: rtpy's dependencies and pytest, from pyproject.toml;
 - autograder.json: the week, its task files and task functions (from the solution
-  regions, so it follows the week's cut), the time limits, and every test with its
-  name, points and whether it is a hidden check;
+  regions, so it follows the week's cut) and the time limits;
 - repo/: the week's student repository as `assignment make` writes it (rtpy with that
   week's and later weeks' tasks as stubs, the scenes, assignments/weekNN/), without
   its tests and docs, plus assignments/weekNN/hidden/, which no student repository has.
@@ -23,8 +23,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import subprocess
-import sys
 import tempfile
 import tomllib
 import zipfile
@@ -33,7 +31,6 @@ from pathlib import Path
 from ..io.image import atomic_write, check_writable
 from .assignment import AssignmentError, check_week, find_regions, make_assignment, source_root
 from .autograder_run import CONFIG_FILE
-from .autograder_submission import child_environment
 
 TEST_TIMEOUT = 60.0  # seconds per test
 TOTAL_TIMEOUT = 480.0  # seconds for a whole submission (set Gradescope's limit above it)
@@ -71,6 +68,11 @@ fi
 "$ROOT/venv/bin/python" -m pip install --upgrade pip
 "$ROOT/venv/bin/python" -m pip install -r "$ROOT/source/requirements.txt"
 "$ROOT/venv/bin/python" -c "import numpy, PIL, tqdm, pytest"
+# The student's code runs as this user (rtpy.grading.sandbox.SANDBOX_USER), who can
+# run the environment's Python but cannot read the graders or write the results.
+id -u rtpy-sandbox >/dev/null 2>&1 ||
+  useradd --system --no-create-home --shell /usr/sbin/nologin rtpy-sandbox
+chmod -R a+rX "$ROOT/venv"
 """
 
 RUN_AUTOGRADER = """#!/bin/sh
@@ -133,25 +135,6 @@ def requirements(root: Path) -> str:
     return "".join(f"{d}\n" for d in [*project["dependencies"], *tests])
 
 
-def collect_tests(repo: Path, week: str, config: dict) -> list[dict]:
-    """The tests of assignments/weekNN (hidden checks included), collected in a child
-    process on the stubs: id, name, points, hidden."""
-    with tempfile.TemporaryDirectory(prefix="rtpy-collect-") as tmp:
-        events, config_path = Path(tmp) / "events.jsonl", Path(tmp) / CONFIG_FILE
-        config_path.write_text(json.dumps(config), encoding="utf-8")
-        command = [sys.executable, "-m", "rtpy.grading.autograder_child", "--collect"]
-        command += [str(events), str(config_path), f"assignments/week{week}"]
-        proc = subprocess.run(
-            command, cwd=repo, env=child_environment(repo), capture_output=True, text=True
-        )
-        found = [json.loads(line) for line in events.read_text().splitlines() if line.strip()]
-    collected = [e for e in found if e.get("event") == "collected"]
-    if not collected or collected[0]["errors"] or not collected[0]["tests"]:
-        errors = collected[0]["errors"] if collected else [proc.stderr[-2000:]]
-        raise AssignmentError(f"week {week}: the graders cannot be collected: {errors}")
-    return sorted(collected[0]["tests"], key=lambda t: t["hidden"])  # the graders first
-
-
 def write_repository(root: Path, week: str, dest: Path) -> None:
     """dest/repo: the student repository with the hidden checks, without LEFT_OUT."""
     repo = make_assignment(week, dest / "repo", root)
@@ -198,7 +181,6 @@ def build_autograder(
             "total_timeout": float(total_timeout),
             "import_timeout": IMPORT_TIMEOUT,
         }
-        config["tests"] = collect_tests(dest / "repo", week, config)
         files = {
             "setup.sh": SETUP_SH,
             "run_autograder": RUN_AUTOGRADER,

@@ -7,10 +7,11 @@ files; `take_task_files` copies those files (and nothing else) over the pristine
 copy of the assignment. A task file that cannot be used is put back to the
 assignment's stub and the reason is kept for the report:
 
-- missing from the submission, too large or not text;
+- missing from the submission, a symbolic link (or below one), too large or not text;
 - not valid Python (`compile_errors`: the SyntaxError's line);
-- importing it fails or hangs (`import_problem`, in a child process with a time
-  limit: the exception and the line in the student's file).
+- importing it fails or hangs (`import_problem`, in the sandboxed child process
+  (rtpy.grading.sandbox) with a time limit: the exception and the line in the
+  student's file).
 
 Files changed elsewhere in the submission are listed (`ignored_changes`) so the
 student learns that those edits do not count.
@@ -19,11 +20,8 @@ student learns that those edits do not count.
 from __future__ import annotations
 
 import filecmp
-import os
 import re
 import shutil
-import subprocess
-import sys
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,36 +31,6 @@ MAX_UNZIPPED_BYTES = 500_000_000
 MAX_DEPTH = 3  # how far below the submission folder the repository may be
 SKIPPED_FOLDERS = {"__MACOSX", ".git", "__pycache__", ".venv", "venv", "node_modules"}
 FRAME = re.compile(r'File "([^"]+)", line (\d+)')
-
-IMPORT_CHECK = """
-import faulthandler, importlib, pkgutil, sys
-faulthandler.dump_traceback_later(float(sys.argv[1]), exit=True)
-import rtpy
-for module in pkgutil.walk_packages(rtpy.__path__, "rtpy."):
-    if not module.name.endswith("__main__"):
-        importlib.import_module(module.name)
-"""
-
-
-# What a task file has no need for, and code that tampers with grading would use: the
-# autograder's stdout (the instructor's) lists the lines that match.
-SUSPICIOUS = re.compile(
-    r"\b(?:pytest|_pytest|rtpy\.grading|rtpy\.testing|sys\.modules|builtins|__import__|"
-    r"importlib|subprocess|inspect|_getframe|exec|eval|write_text|write_bytes|"
-    r"os\.(?:system|remove|rename|replace|unlink|write|kill|environ)|shutil|signal|"
-    r"faulthandler|atexit|setattr)\b"
-)
-
-
-def suspicious_lines(work: Path, files: list[str]) -> list[str]:
-    """file:line: code of the task files' lines that match SUSPICIOUS."""
-    found = []
-    for rel in files:
-        for number, line in enumerate((work / rel).read_text(encoding="utf-8").splitlines(), 1):
-            code = line.split("#", 1)[0]
-            if SUSPICIOUS.search(code):
-                found.append(f"{rel}:{number}: {line.strip()}")
-    return found
 
 
 class SubmissionError(Exception):
@@ -171,7 +139,7 @@ def take_task_files(base: Path, task_files: list[str], work: Path) -> Taken:
             source = _by_name(base, rel)
             if source is not None:
                 taken.notes.append(f"{rel}: taken from {source.relative_to(base).as_posix()}")
-        problem = _unusable(source)
+        problem = _unusable(source, base)
         if problem:
             taken.problems[rel] = problem
             continue
@@ -180,9 +148,18 @@ def take_task_files(base: Path, task_files: list[str], work: Path) -> Taken:
     return taken
 
 
-def _unusable(source: Path | None) -> str | None:
+def _unusable(source: Path | None, base: Path) -> str | None:
+    """Why the file at source cannot be taken, or None. A task file is read as a
+    regular file of the submission: a symbolic link, or a file below one, is refused
+    (it could name any file of the grading machine)."""
     if source is None:
         return "not in your submission"
+    rel = source.relative_to(base)
+    for k in range(1, len(rel.parts) + 1):
+        if (base / Path(*rel.parts[:k])).is_symlink():
+            return "a symbolic link, not a file: submit the file itself"
+    if not source.is_file():
+        return "not a regular file"
     if source.stat().st_size > MAX_FILE_BYTES:
         return f"larger than {MAX_FILE_BYTES:,} bytes"
     try:
@@ -209,43 +186,33 @@ def compile_errors(work: Path, files: list[str]) -> dict[str, str]:
     return errors
 
 
-def import_problem(
-    work: Path, files: list[str], timeout: float, python: str = sys.executable
-) -> tuple[str | None, str] | None:
-    """None when every rtpy module imports in a child process within `timeout`; else
-    (the student's task file to blame, or None when none can be named; the problem)."""
-    env = child_environment(work)
+def import_problem(child, files: list[str], work: Path) -> tuple[str | None, str] | None:
+    """None when the sandboxed child (a new rtpy.grading.sandbox.Child in work) imports
+    every rtpy module and the probes; else (the student's task file to blame, or None
+    when none can be named; the problem). The child is stopped."""
+    from .sandbox import ChildFailure, StudentError
+
     try:
-        proc = subprocess.run(
-            [python, "-c", IMPORT_CHECK, str(timeout)],
-            cwd=work,
-            env=env,
-            capture_output=True,
-            text=True,
-            errors="replace",
-            timeout=timeout + 30.0,
-        )
-    except subprocess.TimeoutExpired:
-        return None, f"importing rtpy did not finish within {timeout:g} s"
-    if proc.returncode == 0:
+        child.call("import_everything", {}, float(child.config.get("import_timeout", 60.0)))
         return None
-    err = proc.stderr
-    hang = "Timeout (" in err and "Traceback" not in err  # faulthandler's dump
-    blamed = None
-    for path, line in FRAME.findall(err):
-        rel = _relative(path, work)
-        if rel in files:
-            blamed = (rel, line)
-    if blamed is None:  # an ImportError names the module file it looked in
-        for rel in files:
-            if str(work / rel) in err:
-                blamed = (rel, "")
-    last = [ln for ln in err.strip().splitlines() if ln.strip()][-1:] or ["no error message"]
-    what = f"importing it did not finish within {timeout:g} s" if hang else last[0].strip()
-    if blamed is None:
-        return None, what
-    rel, line = blamed
-    return rel, f"line {line}: {what}" if line else what
+    except StudentError as err:
+        if err.where is not None and err.where[1] in files:
+            return err.where[1], f"line {err.where[2]}: {err}"
+        return None, str(err)
+    except ChildFailure as err:
+        text = child.output()
+        blamed = None
+        for path, line in FRAME.findall(text):
+            rel = _relative(path, work)
+            if rel in files:
+                blamed = (rel, line)
+        lines = [ln.strip() for ln in text.strip().splitlines() if ln.strip()]
+        what = lines[-1][:300] if lines and "Traceback" in text else str(err)
+        if blamed is None:
+            return None, what
+        return blamed[0], f"line {blamed[1]}: {what}"
+    finally:
+        child.stop()
 
 
 def _relative(path: str, base: Path) -> str | None:
@@ -253,13 +220,6 @@ def _relative(path: str, base: Path) -> str | None:
         return Path(path).resolve().relative_to(base.resolve()).as_posix()
     except (ValueError, OSError):
         return None
-
-
-def child_environment(work: Path) -> dict[str, str]:
-    """The environment of a process that runs the student's code: rtpy from work only."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
-    env.update(PYTHONPATH=str(work), PYTHONDONTWRITEBYTECODE="1", PYTHONIOENCODING="utf-8")
-    return env
 
 
 def ignored_changes(repository: Path | None, pristine: Path, task_files: list[str]) -> list[str]:

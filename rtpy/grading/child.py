@@ -283,4 +283,6 @@ def boot() -> None:
         os._exit(3)
 
 
-BOOT = "import sys; sys.path.insert(0, sys.argv.pop(1)); from rtpy.grading.child import boot; boot()"
+BOOT = (
+    "import sys; sys.path.insert(0, sys.argv.pop(1)); from rtpy.grading.child import boot; boot()"
+)

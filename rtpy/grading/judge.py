@@ -98,6 +98,7 @@ class Judge:
     test_timeout: float = 60.0
     total_timeout: float = 1e9
     collect_only: bool = False
+    progress: object = None  # called after each test's outcome (results saved as they come)
     tests: dict[str, Graded] = field(default_factory=dict)
     errors: list[str] = field(default_factory=list)  # graders that could not be loaded
     log: list[str] = field(default_factory=list)  # for the instructor
@@ -168,6 +169,8 @@ class Judge:
             graded.outcome = Outcome(False, self.message(call, report, item.nodeid), renders)
         elif call.when == "call":
             graded.outcome = Outcome(True, "", renders)
+        if self.progress is not None:
+            self.progress()
 
     def message(self, call, report, nodeid: str) -> str:
         """What the student reads for a test that did not pass."""

@@ -181,6 +181,18 @@ def radiance(scene: str, rays: list, settings: dict, params: dict | None = None,
     built = SCENES[scene](**(params or {}))
     integrator = make_integrator(RenderSettings(**settings))
     with use_generator(make_generator(int(seed))):
-        return [
-            floats(integrator.compute_scattering(Ray(vec(o), vec(d)), built)) for o, d in rays
-        ]
+        return [floats(integrator.compute_scattering(Ray(vec(o), vec(d)), built)) for o, d in rays]
+
+
+@probe(returns=Bool)
+def import_everything():
+    """Import every module of rtpy (a task file that fails to import is found here)."""
+    import importlib
+    import pkgutil
+
+    import rtpy
+
+    for module in pkgutil.walk_packages(rtpy.__path__, "rtpy."):
+        if not module.name.endswith("__main__"):
+            importlib.import_module(module.name)
+    return True

@@ -134,5 +134,6 @@ def score_table(results: dict) -> str:
 def write_results(path: str | Path, results: dict) -> None:
     """Write results as JSON, atomically (a reader sees the old file or the new one)."""
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     text = json.dumps(results, indent=2) + "\n"
     atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))

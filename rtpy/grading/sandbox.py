@@ -382,7 +382,9 @@ class InProcess:
     def call(self, probe: str, inputs: dict, seconds: float):
         if self._probes is None:
             self._probes = load_probes(self.config.get("probe_modules", []))
-        request = decode(encode({"id": 1, "probe": probe, "inputs": inputs, "seconds": seconds})[4:])
+        request = decode(
+            encode({"id": 1, "probe": probe, "inputs": inputs, "seconds": seconds})[4:]
+        )
         task_files = set(self.config.get("task_files", []))
         timed = hasattr(signal, "SIGALRM") and threading.current_thread() is threading.main_thread()
         previous = signal.signal(signal.SIGALRM, _on_alarm) if timed else None
