@@ -109,9 +109,7 @@ def sample_one_light(scene: str, params: dict, cases: list, seed: int):
 
 # --- the scenes the graders render or look into ------------------------------------------
 def big_floor(albedo=(0.5, 0.5, 0.5), height: float = 0.0):
-    return Quad(
-        Vec3(-50, height, -50), Vec3(0, 0, 100), Vec3(100, 0, 0), Lambertian(color(albedo))
-    )
+    return Quad(Vec3(-50, height, -50), Vec3(0, 0, 100), Vec3(100, 0, 0), Lambertian(color(albedo)))
 
 
 @scene_builder
@@ -142,7 +140,9 @@ def area_light():
 @scene_builder
 def glowing_ball(emit: list, background: list):
     """One light sphere at (0, 0, -3), radius 1, before a background."""
-    return Scene([Sphere(Vec3(0, 0, -3), 1.0, DiffuseLight(color(emit)))], background=color(background))
+    return Scene(
+        [Sphere(Vec3(0, 0, -3), 1.0, DiffuseLight(color(emit)))], background=color(background)
+    )
 
 
 @scene_builder
@@ -171,4 +171,3 @@ def lit_sphere(albedo: list, center: list, radius: float, light: list, intensity
 def lit_floor(albedo: list, height: float, corner: list, light: list, intensity: list):
     plane = Quad(vec(corner), Vec3(0, 0, 100), Vec3(100, 0, 0), Lambertian(color(albedo)))
     return Scene([plane], [PointLight(vec(light), color(intensity))])
-

@@ -195,7 +195,8 @@ class Array(Schema):
         if not isinstance(value, np.ndarray):
             raise _fail(where, "an array", value)
         if value.ndim != len(self.shape) or any(
-            want is not None and got != want for got, want in zip(value.shape, self.shape)
+            want is not None and got != want
+            for got, want in zip(value.shape, self.shape, strict=True)
         ):
             raise ProtocolError(f"{where}: expected shape {self.shape}, got {value.shape}")
         if self.dtype == "bool":
