@@ -100,7 +100,7 @@ def test_answers_and_the_students_exceptions(child):
 @pytest.mark.slow
 def test_an_endless_loop_is_stopped_naming_where_it_was(child):
     start = time.monotonic()
-    with pytest.raises(ChildFailure, match=r"it was in spin \(rtpy/loop.py, line 3\)"):
+    with pytest.raises(ChildFailure, match=r"it was in spin \(rtpy/loop.py, line [23]\)"):
         child.call("spin", {}, 1.0)
     assert time.monotonic() - start < 30
     assert child.call("double", {"x": 3}, 30) == 6.0
