@@ -18,21 +18,18 @@ from functools import partial
 import numpy as np
 
 from ..materials.material import Material
-from ..ray import Ray
-from ..vec3 import Vec3
 from .local_setup import (
     ABSORBED,
-    ORIGIN,
     SPECULAR,
     TWO_PI,
     Samples,
     get_samples,
-    incident_ray,
-    local_hit,
+    local_direction,
     vector_text,
 )
-from .quadrature import AdaptiveSimpson2D, sample_spacing, subdivide
+from .quadrature import AdaptiveSimpson2D, CellRequest, integrate_cells, sample_spacing, subdivide
 from .statistics import chi2_sf
+from .subject import MaterialSubject, as_subject
 
 __all__ = ["PDF_INTEGRAL_SLACK", "Chi2Result", "chi2_test"]
 
@@ -145,16 +142,17 @@ class _BinIntegrals:
     spacings wide (5 Simpson nodes each); each hemisphere has its own integrator,
     so no cell straddles the horizon, where pdf() jumps. The tolerance per cell,
     in probability, is 0.01 * sqrt(expected count) / n, at least 0.01 / n: the
-    chi2 statistic moves by < 1e-4 per bin."""
+    chi2 statistic moves by < 1e-4 per bin. All the bins of a pass are integrated
+    together, so the subject is asked for pdf() once per round of refinement."""
 
     def __init__(
-        self, material: Material, samples: Samples, shape: tuple[int, int], spacing: float
+        self, subject: MaterialSubject, samples: Samples, shape: tuple[int, int], spacing: float
     ) -> None:
         theta_bins, phi_bins = shape
         n = samples.n
-        self.material = material
-        self.ray_view = incident_ray(samples.incident_deg, samples.phi_deg)
-        self.hit = local_hit(material, samples.inside)
+        self.subject = subject
+        self.wo = np.array(local_direction(samples.incident_deg, samples.phi_deg).tolist())
+        self.inside = samples.inside
         self.half = half = theta_bins // 2
         self.bad_values: list[str] = []
         self.guides: dict[tuple[int, int], tuple] = {}  # bin -> (samples' theta, phi, spacing)
@@ -169,7 +167,7 @@ class _BinIntegrals:
         self.quads, self.strips = [], []
         for upper, edges in ((True, theta_edges[: half + 1]), (False, theta_edges[half:])):
             x_edges, x_owner = subdivide(edges, cell)
-            f = partial(self.pdf_sin, upper=upper)
+            f = partial(self.pdf_sin_batch, upper=upper)
             self.quads.append(AdaptiveSimpson2D(f, x_edges, self.y_edges, max_evaluations=300_000))
             self.strips.append([[c for c, o in enumerate(x_owner) if o == b] for b in range(half)])
 
@@ -177,55 +175,87 @@ class _BinIntegrals:
     def evaluations(self) -> int:
         return sum(q.evaluations for q in self.quads)
 
-    def pdf_sin(self, theta: float, phi: float, upper: bool) -> tuple[float]:
-        """pdf * sin(theta), the density per dtheta dphi. On the horizon the value is
-        the limit from the hemisphere being integrated: pdf() jumps there."""
-        if theta == 0.5 * math.pi:
-            theta = 0.5 * math.pi - 1e-9 if upper else 0.5 * math.pi + 1e-9
-        s = math.sin(theta)
-        if s <= 0.0 or theta >= math.pi:  # the poles: zero solid angle
-            return (0.0,)
-        wi = Vec3(s * math.cos(phi), s * math.sin(phi), math.cos(theta))
-        p = self.material.pdf(self.ray_view, Ray(ORIGIN, wi), self.hit)
-        if not (p >= 0.0 and math.isfinite(p)):
-            if len(self.bad_values) < 3:
-                self.bad_values.append(f"pdf() = {p!r} at wi = {vector_text(wi.tolist())}")
-            return (0.0,)
-        return (p * s,)
+    @staticmethod
+    def directions(theta: np.ndarray, phi: np.ndarray, upper: bool):
+        """(unit directions toward the light, sin(theta)) at the nodes; sin = 0 at the
+        poles (zero solid angle). On the horizon the direction is the limit from the
+        hemisphere being integrated: pdf() jumps there."""
+        rows, sines = [], []
+        for t, p in zip(theta.tolist(), phi.tolist(), strict=True):
+            if t == 0.5 * math.pi:
+                t = 0.5 * math.pi - 1e-9 if upper else 0.5 * math.pi + 1e-9
+            s = math.sin(t)
+            if s <= 0.0 or t >= math.pi:
+                s = 0.0
+            rows.append((s * math.cos(p), s * math.sin(p), math.cos(t)))
+            sines.append(s)
+        return np.array(rows, dtype=float).reshape(-1, 3), np.array(sines)
 
-    def integrate(self, bi: int, bj: int, tol_scale: float = 1.0) -> tuple[float, float]:
-        """(integral of pdf over bin (bi, bj), its estimated error). A bin with a
-        guide (the samples in it) has nodes at most the guide's spacing apart
-        wherever there are samples."""
-        hemisphere, row = divmod(bi, self.half)
-        quad = self.quads[hemisphere]
-        guide = self.guides.get((bi, bj))
-        total, error = 0.0, 0.0
-        for ci in self.strips[hemisphere][row]:
-            for cj in self.sectors[bj]:
-                points, spacing = None, (0.0, 0.0)
-                if guide is not None:
-                    t, p, spacing = guide
-                    x0, x1 = quad.x_edges[ci], quad.x_edges[ci + 1]
-                    y0, y1 = self.y_edges[cj], self.y_edges[cj + 1]
-                    inside = (t >= x0) & (t <= x1) & (p >= y0) & (p <= y1)
-                    points = (t[inside], p[inside])
-                abs_tol, sqrt_tol = self.abs_tol * tol_scale, self.sqrt_tol * tol_scale
-                value, e = quad.cell(ci, cj, abs_tol, 0.0, sqrt_tol, points, spacing)
-                total += value[0]
-                error += e
-        return total, error
+    def pdf_sin(self, batches) -> list[np.ndarray]:
+        """pdf * sin(theta), the density per dtheta dphi, at the nodes of every
+        (integrator, theta, phi) of a round: one pdf() call for them all."""
+        parts = [self.directions(x, y, quad is self.quads[0]) for quad, x, y in batches]
+        wi = np.concatenate([d for d, _ in parts])
+        sines = np.concatenate([s for _, s in parts])
+        asked = sines > 0.0
+        p = np.zeros(len(wi))
+        if asked.any():
+            wo = np.broadcast_to(self.wo, (int(asked.sum()), 3))
+            p[asked] = np.asarray(self.subject.pdf(wo, wi[asked], inside=self.inside), float)
+        bad = asked & ~(np.isfinite(p) & (p >= 0.0))
+        for k in np.flatnonzero(bad)[: 3 - len(self.bad_values)]:
+            self.bad_values.append(f"pdf() = {float(p[k])!r} at wi = {vector_text(wi[k])}")
+        values = np.where(bad, 0.0, p * sines)[:, None]
+        bounds = np.cumsum([0] + [len(x) for _, x, _ in batches])
+        return [values[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
+    def pdf_sin_batch(self, theta: np.ndarray, phi: np.ndarray, upper: bool) -> np.ndarray:
+        """pdf * sin(theta) at nodes of one hemisphere."""
+        quad = self.quads[0 if upper else 1]
+        return self.pdf_sin([(quad, theta, phi)])[0]
+
+    def integrate(self, bins, tol_scale: float = 1.0) -> list[tuple[float, float]]:
+        """(integral of pdf over bin (bi, bj), its estimated error) for every bin, all
+        integrated together. A bin with a guide (the samples in it) has nodes at most
+        the guide's spacing apart wherever there are samples."""
+        jobs, owners = [], []
+        abs_tol, sqrt_tol = self.abs_tol * tol_scale, self.sqrt_tol * tol_scale
+        for k, (bi, bj) in enumerate(bins):
+            hemisphere, row = divmod(int(bi), self.half)
+            quad = self.quads[hemisphere]
+            guide = self.guides.get((bi, bj))
+            for ci in self.strips[hemisphere][row]:
+                for cj in self.sectors[bj]:
+                    points, spacing = None, (0.0, 0.0)
+                    if guide is not None:
+                        t, p, spacing = guide
+                        x0, x1 = quad.x_edges[ci], quad.x_edges[ci + 1]
+                        y0, y1 = self.y_edges[cj], self.y_edges[cj + 1]
+                        inside = (t >= x0) & (t <= x1) & (p >= y0) & (p <= y1)
+                        points = (t[inside], p[inside])
+                    request = CellRequest(ci, cj, abs_tol, 0.0, sqrt_tol, points, spacing)
+                    jobs.append((quad, request))
+                    owners.append(k)
+        totals = [[0.0, 0.0] for _ in bins]
+        for k, (value, e) in zip(owners, integrate_cells(jobs, self.pdf_sin), strict=True):
+            totals[k][0] += value[0]
+            totals[k][1] += e
+        return [(t, e) for t, e in totals]
 
     def integrate_all(self, hist: _Histogram, n: int) -> tuple[np.ndarray, np.ndarray]:
         """(integral of pdf over every bin, its estimated error), refined where the
         samples or the error estimates ask for it."""
         integral = np.zeros(hist.observed.shape)
         errors = np.zeros(hist.observed.shape)
-        for bi, bj in np.ndindex(*hist.observed.shape):
-            integral[bi, bj], errors[bi, bj] = self.integrate(bi, bj)
+        self.update(list(np.ndindex(*hist.observed.shape)), integral, errors)
         self.refine_where_samples_crowd(hist, integral, errors, n)
         self.refine_largest_errors(integral, errors, n)
         return integral, errors
+
+    def update(self, bins, integral, errors, tol_scale: float = 1.0) -> None:
+        bins = [(int(bi), int(bj)) for bi, bj in bins]
+        for (bi, bj), (value, e) in zip(bins, self.integrate(bins, tol_scale), strict=True):
+            integral[bi, bj], errors[bi, bj] = value, e
 
     def refine_where_samples_crowd(self, hist: _Histogram, integral, errors, n: int) -> None:
         """A lobe narrower than the node spacing can hide between the nodes. Where a
@@ -235,10 +265,12 @@ class _BinIntegrals:
         excess = (hist.observed - n * integral) / np.sqrt(n * integral + 1.0)
         suspects = np.argwhere(excess > 5.0)
         order = np.argsort(-excess[suspects[:, 0], suspects[:, 1]])
-        for bi, bj in suspects[order[:64]]:
+        chosen = [(int(bi), int(bj)) for bi, bj in suspects[order[:64]]]
+        for bi, bj in chosen:
             t, p = hist.samples_in(bi, bj)
             self.guides[bi, bj] = (t, p, sample_spacing(t, p))
-            integral[bi, bj], errors[bi, bj] = self.integrate(bi, bj, 0.01)
+        if chosen:
+            self.update(chosen, integral, errors, 0.01)
 
     def refine_largest_errors(self, integral, errors, n: int) -> None:
         """The absorbed category's expected count n * (1 - sum of integrals) collects
@@ -250,8 +282,7 @@ class _BinIntegrals:
                 break
             scale *= 0.1
             share = errors / errors.sum()
-            for bi, bj in np.argwhere(share > 0.2 / share.size):
-                integral[bi, bj], errors[bi, bj] = self.integrate(bi, bj, scale)
+            self.update(np.argwhere(share > 0.2 / share.size), integral, errors, scale)
 
 
 # --- the statistic ---------------------------------------------------------------------------
@@ -340,7 +371,7 @@ def _worst(observed, expected, min_expected, absorbed: float, expected_absorbed,
 
 
 def chi2_test(
-    material: Material,
+    material: Material | MaterialSubject,
     incident_deg: float,
     n_samples: int = 100_000,
     theta_bins: int = 24,
@@ -364,16 +395,17 @@ def chi2_test(
     outright (p = 0), as does a pdf() value that is negative or not finite, or
     a pdf() whose integral over the sphere exceeds 1 by more than the
     quadrature's uncertainty. inside: the viewer is inside the material (the hit
-    on its back face).
+    on its back face). material: an rtpy Material or a MaterialSubject.
     """
     if theta_bins < 2 or theta_bins % 2 or phi_bins < 1:
         raise ValueError("theta_bins must be even and >= 2, phi_bins >= 1")
-    if material.is_specular:
+    subject = as_subject(material)
+    if subject.is_specular:
         raise ValueError("a specular (delta) material has no density to test")
     start = time.perf_counter()
-    samples = get_samples(material, incident_deg, n_samples, seed, phi_deg, samples, inside)
+    samples = get_samples(subject, incident_deg, n_samples, seed, phi_deg, samples, inside)
     hist = _histogram(samples, theta_bins, phi_bins)
-    bins = _BinIntegrals(material, samples, (theta_bins, phi_bins), node_spacing)
+    bins = _BinIntegrals(subject, samples, (theta_bins, phi_bins), node_spacing)
     integral, errors = bins.integrate_all(hist, samples.n)
     result = _assess(samples, hist, bins, integral, errors, min_expected)
     result.seconds = time.perf_counter() - start

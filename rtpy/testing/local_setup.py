@@ -155,6 +155,19 @@ def draw_samples(
 ) -> Samples:
     """Call material.scattering() n times for the incoming ray of the test setup,
     under a generator fixed by (seed, incident angle, phi, side)."""
+    return scatter_draws(material, incident_deg, n, seed, phi_deg, inside, SAMPLING)
+
+
+def scatter_draws(
+    material: Material,
+    incident_deg: float,
+    n: int,
+    seed: int,
+    phi_deg: float,
+    inside: bool,
+    tag: int,
+) -> Samples:
+    """n draws of material.scattering() under sampling_generator(seed, tag, ...)."""
     ray_in = incident_ray(incident_deg, phi_deg)
     hit = local_hit(material, inside)
     nan = math.nan
@@ -162,7 +175,7 @@ def draw_samples(
     rows, status = [], []
     scatter = material.scattering
     start = time.perf_counter()
-    with use_generator(sampling_generator(seed, SAMPLING, incident_deg, phi_deg, inside)):
+    with use_generator(sampling_generator(seed, tag, incident_deg, phi_deg, inside)):
         for _ in range(n):
             s = scatter(ray_in, hit)
             if s is None:
@@ -189,9 +202,10 @@ def draw_samples(
     )
 
 
-def get_samples(material, incident_deg, n, seed, phi_deg, samples, inside=False) -> Samples:
+def get_samples(subject, incident_deg, n, seed, phi_deg, samples, inside=False) -> Samples:
+    """The given samples (checked to be of this setup), or n draws of the subject's."""
     if samples is None:
-        return draw_samples(material, incident_deg, n, seed=seed, phi_deg=phi_deg, inside=inside)
+        return subject.draw(incident_deg, n, seed=seed, phi_deg=phi_deg, inside=inside)
     if (samples.incident_deg, samples.phi_deg, samples.inside) != (incident_deg, phi_deg, inside):
         raise ValueError("the samples were drawn for another incident direction")
     return samples

@@ -30,27 +30,23 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
 from ..materials.material import Material
-from ..ray import Ray
-from ..vec3 import Vec3
 from .local_setup import (
-    ORIGIN,
     TWO_PI,
     Samples,
-    brdf_between,
     close,
     color_text,
     get_samples,
-    incident_ray,
     local_direction,
-    local_hit,
     vector_text,
 )
-from .quadrature import AdaptiveSimpson2D, sample_spacing, subdivide
+from .quadrature import AdaptiveSimpson2D, CellRequest, integrate_cells, sample_spacing, subdivide
 from .statistics import normal_quantile
+from .subject import MaterialSubject, as_subject
 
 __all__ = [
     "INCONCLUSIVE_QUADRATURE_ERROR",
@@ -97,7 +93,7 @@ class CheckResult:
 
 
 def check_weights(
-    material: Material,
+    material: Material | MaterialSubject,
     incident_deg: float,
     n: int = 2000,
     seed: int = 0,
@@ -109,20 +105,20 @@ def check_weights(
     """For the first n scattered (non-specular) samples: attenuation ==
     BRDF(ray_in, scattered, hit) * |cos| / pdf(ray_in, scattered, hit) per channel,
     ScatterInfo.pdf == pdf(...), and the direction is a unit vector."""
-    samples = get_samples(material, incident_deg, n, seed, phi_deg, samples, inside)
-    ray_view = incident_ray(incident_deg, phi_deg)
-    hit = local_hit(material, inside)
+    subject = as_subject(material)
+    samples = get_samples(subject, incident_deg, n, seed, phi_deg, samples, inside)
     idx = np.flatnonzero(samples.scattered)[:n]
     if len(idx) == 0:
         detail = "no scattered samples"
         return CheckResult("weights", incident_deg, True, detail, skipped=True, inside=inside)
+    wi = samples.directions[idx]
+    wo = np.broadcast_to(local_direction(incident_deg, phi_deg).tolist(), wi.shape)
+    brdfs = np.asarray(subject.brdf(wo, wi, inside=inside), dtype=float).tolist()
+    pdfs = np.asarray(subject.pdf(wo, wi, inside=inside), dtype=float).tolist()
     failures, first = 0, ""
-    for k in idx:
-        x, y, z = (float(c) for c in samples.directions[k])
-        weight = [float(c) for c in samples.weights[k]]
-        wi = Vec3(x, y, z)
-        f = material.BRDF(ray_view, Ray(ORIGIN, wi), hit)
-        pdf = material.pdf(ray_view, Ray(ORIGIN, wi), hit)
+    for k, f, pdf in zip(idx.tolist(), brdfs, pdfs, strict=True):
+        x, y, z = samples.directions[k].tolist()
+        weight = samples.weights[k].tolist()
         length = math.sqrt(x * x + y * y + z * z)
         problem = ""
         if not abs(length - 1.0) <= 1e-9:
@@ -132,7 +128,7 @@ def check_weights(
         elif not pdf > 0.0:
             problem = f"pdf() = {pdf!r} for a direction scattering() returned"
         else:
-            expect = [c * abs(z) / pdf for c in (f.e0, f.e1, f.e2)]
+            expect = [c * abs(z) / pdf for c in f]
             if not all(close(a, b, rel_tol) for a, b in zip(weight, expect, strict=True)):
                 problem = (
                     f"attenuation {color_text(weight)} but BRDF * cos / pdf = {color_text(expect)}"
@@ -202,101 +198,164 @@ def _mean_and_error(w: np.ndarray) -> tuple[RGB, RGB]:
     return tuple(float(x) for x in w.mean(axis=0)), tuple(float(x) for x in se)
 
 
-def _power_weights(material: Material, samples: Samples, weights: np.ndarray) -> np.ndarray:
+def _power_weights(subject: MaterialSubject, samples: Samples, weights: np.ndarray) -> np.ndarray:
     """The weights with each transmitted sample's f(wo, wi) replaced by f(wi, wo): its
     share of the power arriving from wo (weight = f |cos| / pdf)."""
     out = weights.copy()
-    wo = local_direction(samples.incident_deg, samples.phi_deg)
-    for k in np.flatnonzero(samples.transmitted):
-        x, y, z = (float(c) for c in samples.directions[k])
-        f = brdf_between(material, Vec3(x, y, z), wo, samples.inside)
-        scale = abs(z) / float(samples.pdfs[k])
-        out[k] = (f.e0 * scale, f.e1 * scale, f.e2 * scale)
+    below = np.flatnonzero(samples.transmitted)
+    if len(below) == 0:
+        return out
+    wo = local_direction(samples.incident_deg, samples.phi_deg).tolist()
+    d = samples.directions[below]
+    f = np.asarray(subject.brdf(d, np.broadcast_to(wo, d.shape), inside=samples.inside), float)
+    for k, row, z, pdf in zip(
+        below, f.tolist(), d[:, 2].tolist(), samples.pdfs[below].tolist(), strict=True
+    ):
+        scale = abs(z) / pdf
+        out[k] = (row[0] * scale, row[1] * scale, row[2] * scale)
     return out
 
 
 class _HemisphereQuadrature:
-    """Adaptive Simpson quadrature of BRDF * |cos| over one hemisphere of directions
-    toward the light, in strips of theta, refined where the samples that went there
-    disagree with it. Below the surface the integrand has six components: f(wo, wi)
-    |cos| and the swapped f(wi, wo) |cos| (see the module's docstring)."""
+    """Adaptive Simpson quadrature of BRDF * |cos| over the directions toward the
+    light, in strips of theta, refined where the samples that went there disagree
+    with it. Below the surface the integrand has six components: f(wo, wi) |cos|
+    and the swapped f(wi, wo) |cos| (see the module's docstring). Every strip of
+    both hemispheres is integrated together: one brdf() call per round."""
 
-    def __init__(self, material: Material, samples: Samples, node_spacing: float, abs_tol: float):
-        self.material, self.samples = material, samples
+    def __init__(
+        self, subject: MaterialSubject, samples: Samples, node_spacing: float, abs_tol: float
+    ):
+        self.subject, self.samples = subject, samples
         self.node_spacing, self.abs_tol = node_spacing, abs_tol
-        self.ray_view = incident_ray(samples.incident_deg, samples.phi_deg)
-        self.wo = local_direction(samples.incident_deg, samples.phi_deg)
-        self.hit = local_hit(material, samples.inside)
+        self.wo = local_direction(samples.incident_deg, samples.phi_deg).tolist()
         # Where the samples went, as (theta, phi), and their weights' channel mean.
         ok = samples.scattered
         d = samples.directions[ok]
         self.theta_s = np.arccos(np.clip(d[:, 2], -1.0, 1.0))
         self.phi_s = np.mod(np.arctan2(d[:, 1], d[:, 0]), TWO_PI)
         self.w_s = samples.weights[ok].mean(axis=1)
+        self.lower: dict[int, bool] = {}  # id(integrator) -> below the surface
 
-    def f_cos_sin(self, theta: float, ph: float, lower: bool) -> tuple[float, ...]:
-        s, c = math.sin(theta), math.cos(theta)
-        if s <= 0.0 or (c >= 0.0 if lower else c <= 0.0):
-            return (0.0,) * (6 if lower else 3)
-        wi = Vec3(s * math.cos(ph), s * math.sin(ph), c)
-        f = self.material.BRDF(self.ray_view, Ray(ORIGIN, wi), self.hit)
-        k = abs(c) * s
-        if not lower:
-            return (f.e0 * k, f.e1 * k, f.e2 * k)
-        g = brdf_between(self.material, wi, self.wo, self.samples.inside)
-        return (f.e0 * k, f.e1 * k, f.e2 * k, g.e0 * k, g.e1 * k, g.e2 * k)
+    def f_cos_sin(self, batches) -> list[np.ndarray]:
+        """BRDF * |cos| * sin(theta) at the nodes of every (integrator, theta, phi) of
+        a round, three components above the surface, six below: one brdf() call."""
+        wo_rows, wi_rows, plan = [], [], []
+        for quad, theta, phi in batches:
+            lower = self.lower[id(quad)]
+            ks = []
+            for t, ph in zip(theta.tolist(), phi.tolist(), strict=True):
+                s, c = math.sin(t), math.cos(t)
+                if s <= 0.0 or (c >= 0.0 if lower else c <= 0.0):
+                    ks.append(None)
+                    continue
+                wi = (s * math.cos(ph), s * math.sin(ph), c)
+                wo_rows.append(self.wo)
+                wi_rows.append(wi)
+                if lower:  # and the swapped f(wi, wo)
+                    wo_rows.append(wi)
+                    wi_rows.append(self.wo)
+                ks.append(abs(c) * s)
+            plan.append((lower, ks))
+        f = np.zeros((0, 3))
+        if wo_rows:
+            f = self.subject.brdf(np.array(wo_rows), np.array(wi_rows), inside=self.samples.inside)
+            f = np.asarray(f, dtype=float).tolist()
+        out, row = [], 0
+        for lower, ks in plan:
+            width = 6 if lower else 3
+            values = []
+            for k in ks:
+                if k is None:
+                    values.append((0.0,) * width)
+                    continue
+                a = f[row]
+                if lower:
+                    g = f[row + 1]
+                    values.append((a[0] * k, a[1] * k, a[2] * k, g[0] * k, g[1] * k, g[2] * k))
+                    row += 2
+                else:
+                    values.append((a[0] * k, a[1] * k, a[2] * k))
+                    row += 1
+            out.append(np.array(values, dtype=float).reshape(len(ks), width))
+        return out
 
-    def integrate(self, lower: bool) -> tuple[list[float], float, int]:
-        """(integral per component, estimated error, BRDF evaluations) over the
-        upper or the lower hemisphere."""
-        n = self.samples.n
-        # Strips in theta; each strip has its own number of phi cells, fewer near the
-        # poles, so that no cell is much more than 4 node spacings wide on the sphere.
+    def strips(self, lower: bool) -> list[tuple[AdaptiveSimpson2D, list[float]]]:
+        """The integrators of one hemisphere's strips in theta, with their phi edges.
+        Each strip has its own number of phi cells, fewer near the poles, so that no
+        cell is much more than 4 node spacings wide on the sphere."""
         cell = 4.0 * self.node_spacing
         span = [0.5 * math.pi, math.pi] if lower else [0.0, 0.5 * math.pi]
         x_edges, _ = subdivide(span, cell)
-        total, error, evaluations = [0.0] * (6 if lower else 3), 0.0, 0
+        out = []
         for lo, hi in zip(x_edges[:-1], x_edges[1:], strict=True):
             widest = max(math.sin(lo), math.sin(hi))
             y_edges, _ = subdivide([0.0, TWO_PI], min(0.5 * math.pi, cell / widest))
-            quad = AdaptiveSimpson2D(
-                lambda t, p: self.f_cos_sin(t, p, lower), [lo, hi], y_edges, max_evaluations=40_000
-            )
+            quad = AdaptiveSimpson2D(None, [lo, hi], y_edges, max_evaluations=40_000)
+            quad.f = partial(self.f_of, quad)
+            self.lower[id(quad)] = lower
+            out.append((quad, y_edges))
+        return out
+
+    def f_of(self, quad: AdaptiveSimpson2D, theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
+        """The integrand of one strip's integrator alone."""
+        return self.f_cos_sin([(quad, theta, phi)])[0]
+
+    def integrate(self, two_sided: bool) -> list[tuple[list[float], float, int]]:
+        """(integral per component, estimated error, BRDF evaluations) over the upper
+        hemisphere and, when two_sided, the lower one."""
+        n = self.samples.n
+        hemispheres = [self.strips(False)] + ([self.strips(True)] if two_sided else [])
+        cells = [
+            (quad, j) for strips in hemispheres for quad, y in strips for j in range(len(y) - 1)
+        ]
+        first = integrate_cells(
+            [(q, CellRequest(0, j, self.abs_tol, 1e-6)) for q, j in cells], self.f_cos_sin
+        )
+        # The samples in a cell estimate its integral too (sum of weights / n). A lobe
+        # narrower than the nodes hides between them, or a node on its peak inflates
+        # it: where the two disagree by more than 5 standard errors, or the quadrature
+        # is less sure than the samples, integrate again with nodes a third of the
+        # samples' spread apart wherever there are samples, before blaming the
+        # material.
+        again, where = [], []
+        for k, ((quad, j), (value, e)) in enumerate(zip(cells, first, strict=True)):
+            lo, hi = quad.x_edges
+            y_edges = quad.y_edges
             in_strip = (self.theta_s >= lo) & (self.theta_s < hi)
             cell_of = np.searchsorted(y_edges, self.phi_s[in_strip], side="right") - 1
-            for j in range(len(y_edges) - 1):
-                value, e = quad.cell(0, j, self.abs_tol, 1e-6)
-                # The samples in this cell estimate its integral too (sum of weights / n).
-                # A lobe narrower than the nodes hides between them, or a node on its
-                # peak inflates it: where the two disagree by more than 5 standard
-                # errors, or the quadrature is less sure than the samples, integrate
-                # again with nodes a third of the samples' spread apart wherever there
-                # are samples, before blaming the material.
-                mine = cell_of == j
-                if np.count_nonzero(mine) >= 2:
-                    ws = self.w_s[in_strip][mine]
-                    estimate = ws.sum() / n
-                    variance = max(float((ws * ws).sum()) / n - estimate * estimate, 0.0) / n
-                    spread = math.sqrt(variance)
-                    if abs(sum(value[:3]) / 3.0 - estimate) > 5.0 * spread or e > spread:
-                        t_in, p_in = self.theta_s[in_strip][mine], self.phi_s[in_strip][mine]
-                        quad.max_evaluations = quad.evaluations + 1_000_000
-                        value, e = quad.cell(
-                            0,
-                            j,
-                            self.abs_tol,
-                            1e-6,
-                            points=(t_in, p_in),
-                            spacing=sample_spacing(t_in, p_in),
-                        )
-                total = [t + v for t, v in zip(total, value, strict=True)]
-                error += e
-            evaluations += quad.evaluations
-        return total, error, evaluations
+            mine = cell_of == j
+            if np.count_nonzero(mine) < 2:
+                continue
+            ws = self.w_s[in_strip][mine]
+            estimate = ws.sum() / n
+            variance = max(float((ws * ws).sum()) / n - estimate * estimate, 0.0) / n
+            spread = math.sqrt(variance)
+            if abs(sum(value[:3]) / 3.0 - estimate) > 5.0 * spread or e > spread:
+                t_in, p_in = self.theta_s[in_strip][mine], self.phi_s[in_strip][mine]
+                points, spacing = (t_in, p_in), sample_spacing(t_in, p_in)
+                again.append((quad, CellRequest(0, j, self.abs_tol, 1e-6, 0.0, points, spacing)))
+                where.append(k)
+        for quad in {id(q): q for q, _ in again}.values():
+            quad.max_evaluations = quad.evaluations + 1_000_000
+        for k, result in zip(where, integrate_cells(again, self.f_cos_sin), strict=True):
+            first[k] = result
+        out = []
+        for strips in hemispheres:
+            width = 3 if strips is hemispheres[0] else 6
+            total, error, evaluations = [0.0] * width, 0.0, 0
+            for quad, _ in strips:
+                for (q, _), (value, e) in zip(cells, first, strict=True):
+                    if q is quad:
+                        total = [t + v for t, v in zip(total, value, strict=True)]
+                        error += e
+                evaluations += quad.evaluations
+            out.append((total, error, evaluations))
+        return out
 
 
 def directional_albedo(
-    material: Material,
+    material: Material | MaterialSubject,
     incident_deg: float,
     n_samples: int = 100_000,
     seed: int = 0,
@@ -310,20 +369,22 @@ def directional_albedo(
     """The directional albedo by importance sampling and by quadrature, for the viewer
     at incident_deg outside the surface (inside: inside it). two_sided: integrate below
     the surface too (a material that transmits); None: when a sample went there."""
-    samples = get_samples(material, incident_deg, n_samples, seed, phi_deg, samples, inside)
+    subject = as_subject(material)
+    samples = get_samples(subject, incident_deg, n_samples, seed, phi_deg, samples, inside)
     if two_sided is None:
         two_sided = bool(samples.transmitted.any())
     w = np.where(samples.scattered[:, None], samples.weights, 0.0)
     mean, se = _mean_and_error(w)
-    quadrature = _HemisphereQuadrature(material, samples, node_spacing, abs_tol)
-    reflected, error, evaluations = quadrature.integrate(lower=False)
+    quadrature = _HemisphereQuadrature(subject, samples, node_spacing, abs_tol)
+    parts = quadrature.integrate(two_sided)
+    reflected, error, evaluations = parts[0]
     transmitted, power = [0.0] * 3, [0.0] * 3
     sampled_power, power_se = mean, se
     if two_sided:
-        below, e, count = quadrature.integrate(lower=True)
+        below, e, count = parts[1]
         transmitted, power = below[:3], below[3:]
         error, evaluations = error + e, evaluations + count
-        sampled_power, power_se = _mean_and_error(_power_weights(material, samples, w))
+        sampled_power, power_se = _mean_and_error(_power_weights(subject, samples, w))
     return AlbedoEstimate(
         sampled=mean,
         standard_error=se,
@@ -345,7 +406,7 @@ INCONCLUSIVE_QUADRATURE_ERROR = 1e-3
 
 
 def check_energy(
-    material: Material,
+    material: Material | MaterialSubject,
     incident_deg: float,
     n_samples: int = 100_000,
     alpha: float = 0.01,

@@ -30,16 +30,23 @@ from ..materials.material import Material
 from ..texture import Texture
 from ..vec3 import Vec3
 from .chi_square import chi2_test
-from .local_setup import Samples, color_text, draw_samples
+from .local_setup import Samples, color_text
 from .material_checks import CheckResult, check_energy, check_weights
 from .pointwise_checks import check_non_negative_finite, check_reciprocity
 from .statistics import sidak_alpha
+from .subject import MaterialSubject, as_subject, material_of
 
 __all__ = ["MaterialReport", "assert_material", "check_material", "material_name"]
 
 
-def material_name(material: Material) -> str:
-    """ClassName(parameter=value, ...) from the material's simple attributes."""
+def material_name(material: Material | MaterialSubject) -> str:
+    """ClassName(parameter=value, ...) from the material's simple attributes (a
+    subject of another process: its `name`, else its class name)."""
+    if not isinstance(material, Material):
+        inner = material_of(material)
+        if inner is None:
+            return str(getattr(material, "name", type(material).__name__))
+        material = inner
     parts = []
     for key, value in getattr(material, "__dict__", {}).items():
         if key.startswith("_"):
@@ -122,7 +129,7 @@ def _run(
 
 
 def check_material(
-    material: Material,
+    material: Material | MaterialSubject,
     incident_angles: Sequence[float] = (0.0, 30.0, 60.0, 85.0, 89.9),
     n_samples: int = 100_000,
     alpha: float = 0.01,
@@ -150,6 +157,8 @@ def check_material(
     from inside, or not.
     """
     start = time.perf_counter()
+    name = material_name(material)
+    material = as_subject(material)
     angles = [float(t) for t in incident_angles]
     checks: list[CheckResult] = []
     if material.is_specular:
@@ -161,7 +170,7 @@ def check_material(
             _run("finite >= 0", None, lambda: check_non_negative_finite(material, seed=seed))
         )
         a = sidak_alpha(alpha, max(1, len(angles)))
-        return MaterialReport(material_name(material), checks, a, time.perf_counter() - start)
+        return MaterialReport(name, checks, a, time.perf_counter() - start)
     outside = {theta: _draw(material, theta, n_samples, seed, False) for theta in angles}
     transmits = any(
         not isinstance(s, CheckResult) and bool(s.transmitted.any()) for s in outside.values()
@@ -179,7 +188,7 @@ def check_material(
             checks += _checks_at(material, samples, a, options)
     if reciprocal:
         if ior is None and transmits:
-            ior = getattr(material, "ior", None)
+            ior = getattr(material_of(material) or material, "ior", None)
         checks.append(
             _run("reciprocity", None, lambda: check_reciprocity(material, seed=seed, ior=ior))
         )
@@ -191,19 +200,21 @@ def check_material(
                 lambda side=side: check_non_negative_finite(material, seed=seed, inside=side),
             )
         )
-    return MaterialReport(material_name(material), checks, a, time.perf_counter() - start)
+    return MaterialReport(name, checks, a, time.perf_counter() - start)
 
 
-def _draw(material: Material, theta: float, n: int, seed: int, inside: bool):
-    """draw_samples, or a failed CheckResult when scattering() raised."""
+def _draw(subject: MaterialSubject, theta: float, n: int, seed: int, inside: bool):
+    """The subject's draws, or a failed CheckResult when scattering() raised."""
     try:
-        return draw_samples(material, theta, n, seed=seed, inside=inside)
+        return subject.draw(theta, n, seed=seed, inside=inside)
     except Exception as error:
         detail = f"raised {type(error).__name__}: {error}"
         return CheckResult("scattering", theta, False, detail, inside=inside)
 
 
-def _checks_at(material: Material, samples: Samples, a: float, options: dict) -> list[CheckResult]:
+def _checks_at(
+    material: MaterialSubject, samples: Samples, a: float, options: dict
+) -> list[CheckResult]:
     """The chi2, weights and energy checks of one set of samples."""
     theta, inside = samples.incident_deg, samples.inside
 
@@ -235,7 +246,7 @@ def _checks_at(material: Material, samples: Samples, a: float, options: dict) ->
     ]
 
 
-def assert_material(material: Material, **options) -> MaterialReport:
+def assert_material(material: Material | MaterialSubject, **options) -> MaterialReport:
     """check_material, raising AssertionError with the report's table when a check fails."""
     report = check_material(material, **options)
     if not report.passed:
