@@ -227,8 +227,9 @@ def grade_submission(root: Path, config: dict, results_path: Path) -> dict:
 def new_child(run: Run) -> Child:
     folder = run.work / "assignments" / f"week{run.week}"
     config = child_config(folder, run.work, run.config.get("task_functions", []))
-    config["import_timeout"] = float(run.config.get("import_timeout", 60.0))
-    return Child(run.work, config, run.isolation, log=run.log)
+    timeout = float(run.config.get("import_timeout", 60.0))
+    config["import_timeout"] = timeout
+    return Child(run.work, config, run.isolation, log=run.log, start_timeout=timeout)
 
 
 def prepare(run: Run, submission: Path, scratch: Path) -> None:

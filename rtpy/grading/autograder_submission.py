@@ -207,7 +207,10 @@ def import_problem(child, files: list[str], work: Path) -> tuple[str | None, str
             if rel in files:
                 blamed = (rel, line)
         lines = [ln.strip() for ln in text.strip().splitlines() if ln.strip()]
-        what = lines[-1][:300] if lines and "Traceback" in text else str(err)
+        if "Timeout (" in text and "Traceback" not in text:  # faulthandler's dump
+            what = f"importing it did not finish within {child.start_timeout:g} s"
+        else:
+            what = lines[-1][:300] if lines and "Traceback" in text else str(err)
         if blamed is None:
             return None, what
         return blamed[0], f"line {blamed[1]}: {what}"

@@ -2,7 +2,7 @@
 
 The judge (rtpy.grading.sandbox) starts
 
-    python -I -c "<BOOT>" WORK CONFIG
+    python -I -c "<BOOT>" WORK CONFIG START_TIMEOUT
 
 in a copy of the assignment where only the task files are the student's (on
 Gradescope as an unprivileged user who cannot read the graders, the hidden checks or
@@ -29,9 +29,9 @@ there.
 
 from __future__ import annotations
 
+import faulthandler
 import functools
 import importlib
-import importlib.util
 import json
 import os
 import signal
@@ -232,20 +232,14 @@ def serve(request: dict, probes: dict, base: Path, task_files: set[str]) -> dict
 
 def load_probes(paths: list[str]) -> dict:
     """rtpy.grading.probes and the probe modules at `paths` (files of the work copy)."""
-    from . import probes
+    from .probes import load_probes as load
 
-    for k, path in enumerate(paths):
-        spec = importlib.util.spec_from_file_location(f"rtpy_week_probes_{k}", path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[spec.name] = module
-        spec.loader.exec_module(module)
-    return probes.PROBES
+    return load(paths)
 
 
-def main(argv: list[str]) -> None:
-    replies = os.fdopen(os.dup(1), "wb")  # the channel of the replies, before any print
-    os.dup2(2, 1)
-    config = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
+def main(config_path: str, replies_fd: int) -> None:
+    replies = os.fdopen(replies_fd, "wb")
+    config = json.loads(Path(config_path).read_text(encoding="utf-8"))
     base = Path.cwd().resolve()
     import rtpy
 
@@ -254,6 +248,7 @@ def main(argv: list[str]) -> None:
     task_files = set(config.get("task_files", []))
     install_return_checks(config.get("task_functions", []))
     probes = load_probes(config.get("probe_modules", []))
+    faulthandler.cancel_dump_traceback_later()
     if hasattr(signal, "SIGALRM"):
         signal.signal(signal.SIGALRM, _on_alarm)
     requests = sys.stdin.buffer
@@ -272,17 +267,25 @@ def main(argv: list[str]) -> None:
     os._exit(0)  # a thread the student's code left running cannot keep the process alive
 
 
-def boot() -> None:
-    """The child's entry point (BOOT): main() with the command line's arguments, and
-    the traceback of a failure to start on standard error."""
+def boot(config_path: str, replies_fd: int) -> None:
+    """main(), and the traceback of a failure to start on standard error."""
     try:
-        main(sys.argv[1:])
+        main(config_path, replies_fd)
     except BaseException:
         traceback.print_exc()
         sys.stderr.flush()
         os._exit(3)
 
 
-BOOT = (
-    "import sys; sys.path.insert(0, sys.argv.pop(1)); from rtpy.grading.child import boot; boot()"
-)
+# The child's first lines, before anything of rtpy (and so of the student's) is
+# imported: the replies' channel moves off standard output, and an import that hangs
+# (a loop at a task file's top level) is ended with its stack on standard error.
+# Arguments: WORK CONFIG START_TIMEOUT.
+BOOT = """import faulthandler, os, sys
+replies = os.dup(1)
+os.dup2(2, 1)
+faulthandler.dump_traceback_later(float(sys.argv[3]), exit=True)
+sys.path.insert(0, sys.argv[1])
+from rtpy.grading.child import boot
+boot(sys.argv[2], replies)
+"""

@@ -175,9 +175,10 @@ def run_graders(folder: Path, paths: list[str], runner=None, collect_only: bool 
 
 def collect_graders(week: str, root: Path | None = None) -> list:
     """The week's graders (rtpy.grading.judge.Graded) with their points and tasks,
-    collected without running them (the hidden checks too, where they are)."""
+    collected without running them (not the hidden checks)."""
     folder = grader_dir(week, root)
-    return list(run_graders(folder, [str(folder)], collect_only=True).tests.values())
+    paths = [str(p) for p in sorted(folder.glob("test_*.py"))]
+    return list(run_graders(folder, paths, collect_only=True).tests.values())
 
 
 def grade(
@@ -206,3 +207,14 @@ def grade(
             "\n".join(plugin.errors) or f"no tests found in {folder}"
         )
     return results
+
+
+def local_probe(week: str, root: Path | None = None, in_process: bool = True):
+    """The `probe` of week's graders outside pytest, answered in this process (or a
+    child): for making references and for rtpy's own tests of the graders."""
+    from .judge import probe_registry, probes_outside_pytest
+
+    folder = grader_dir(week, root)
+    probes = folder / PROBES_FILE
+    registry = probe_registry([probes] if probes.is_file() else [])
+    return probes_outside_pytest(local_runner(folder, in_process), registry)

@@ -16,7 +16,6 @@ per test with the message the student reads. `judge()` runs it.
 
 from __future__ import annotations
 
-import importlib.util
 import sys
 import time
 import traceback
@@ -50,21 +49,17 @@ class Graded:
     hidden: bool
     outcome: Outcome | None = None
 
+    @property
+    def max_score(self) -> float:
+        return self.points
+
 
 def probe_registry(probe_modules: list[Path]) -> dict:
     """The probes (with their forms) of rtpy.grading.probes and the given modules,
     imported from the instructor's copy."""
-    from . import probes
+    from .probes import load_probes
 
-    for path in probe_modules:
-        name = f"rtpy_judge_probes_{path.parent.name}"
-        if name in sys.modules:
-            continue
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-    return probes.PROBES
+    return load_probes(probe_modules)
 
 
 class Probes:
@@ -109,10 +104,6 @@ class Judge:
     def pytest_configure(self, config) -> None:
         config.addinivalue_line("markers", "points(n, task): points a grader test is worth")
         self._total_deadline = time.monotonic() + self.total_timeout
-
-    @pytest.fixture
-    def probe(self, request) -> Probes:
-        return Probes(self, request.node.nodeid)
 
     def ask(self, nodeid: str, found, inputs: dict):
         seconds = self._deadline - time.monotonic()
@@ -217,3 +208,36 @@ def judge(plugin: Judge, paths: list[str]) -> Judge:
     with contextlib.redirect_stdout(io.StringIO()):
         pytest.main(pytest_args(paths, plugin.collect_only), plugins=[plugin])
     return plugin
+
+
+def probes_outside_pytest(runner, registry: dict, seconds: float = 1e5) -> Probes:
+    """A `probe` fixture for use outside pytest (making references, rtpy's own tests):
+    each call may take up to `seconds`."""
+    plugin = Judge(runner, registry, test_timeout=seconds)
+    plugin._deadline = time.monotonic() + seconds
+    return Probes(plugin, "")
+
+
+@pytest.fixture
+def probe(request) -> Probes:
+    """The graders' fixture (each week's conftest.py imports it): the judge's probes
+    when the judge runs the tests; under plain `python -m pytest assignments/weekNN`,
+    probes answered by a child process in this repository, for the whole session."""
+    config = request.config
+    for plugin in config.pluginmanager.get_plugins():
+        if isinstance(plugin, Judge):
+            return Probes(plugin, request.node.nodeid)
+    standalone = getattr(config, "_rtpy_probe_judge", None)
+    if standalone is None:
+        from .graders import local_runner
+
+        folder = Path(request.node.path).parent
+        if folder.name == "hidden":
+            folder = folder.parent
+        probes_file = folder / "probes.py"
+        registry = probe_registry([probes_file] if probes_file.is_file() else [])
+        standalone = Judge(local_runner(folder), registry, test_timeout=1e5)
+        config._rtpy_probe_judge = standalone
+        config.add_cleanup(standalone.runner.stop)
+    standalone._deadline = time.monotonic() + standalone.test_timeout
+    return Probes(standalone, request.node.nodeid)

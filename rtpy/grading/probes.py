@@ -62,18 +62,46 @@ def probe(returns: Schema, renders: bool = False):
 
     def register(function: Callable) -> Callable:
         name = function.__name__
-        if name in PROBES and PROBES[name].function is not function:
-            raise ValueError(f"two probes are called {name!r}")
+        known = PROBES.get(name)
+        if known is not None and _folder(known.function) != _folder(function):
+            raise ValueError(f"two probes are called {name!r}")  # in two weeks' probes
         PROBES[name] = Probe(name, function, returns, renders)
         return function
 
     return register
 
 
+def _folder(function: Callable) -> str:
+    """The name of the folder of a function's file (a week's folder, or grading): a
+    copy of the same week loaded again replaces its probes."""
+    from pathlib import Path
+
+    return Path(function.__code__.co_filename).parent.name
+
+
 def scene_builder(function: Callable) -> Callable:
     """Register a function that builds a scene (from plain parameters) by its name."""
     SCENES[function.__name__] = function
     return function
+
+
+def load_probes(paths) -> dict[str, Probe]:
+    """PROBES, after importing the probe modules at `paths` (once each)."""
+    import hashlib
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    for path in paths:
+        path = Path(path).resolve()
+        name = "rtpy_probes_" + hashlib.sha1(str(path).encode()).hexdigest()[:12]
+        if name in sys.modules:
+            continue
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return PROBES
 
 
 # --- between plain data and rtpy objects ---------------------------------------------

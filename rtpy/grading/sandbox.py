@@ -163,6 +163,7 @@ class Child:
     isolation: Isolation = field(default_factory=Isolation)
     python: str = sys.executable
     log: list[str] = field(default_factory=list)  # for the instructor
+    start_timeout: float = START_TIMEOUT  # seconds to import rtpy and the probes
     _proc: subprocess.Popen | None = None
     _replies: Replies | None = None
     _output: list[bytes] = field(default_factory=list)
@@ -174,6 +175,7 @@ class Child:
         config_path = (home or self.work) / "child-config.json"
         config_path.write_text(json.dumps(self.config), encoding="utf-8")
         command = [self.python, "-I", "-c", BOOT, str(self.work), str(config_path)]
+        command.append(str(self.start_timeout))
         options: dict = {}
         ids = sandbox_ids(self.isolation.user)
         if ids is not None:
@@ -229,7 +231,7 @@ class Child:
         deadline = time.monotonic() + seconds + GRACE
         if self._proc is None:
             self.start()
-            deadline += START_TIMEOUT
+            deadline += self.start_timeout
         self._next_id += 1
         request = {"id": self._next_id, "probe": probe, "inputs": inputs, "seconds": seconds}
         try:

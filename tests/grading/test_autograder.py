@@ -108,23 +108,19 @@ def tamper(repo: Path, week: str) -> list[str]:
         path.write_text(text.replace(old, new))
         changed.append(rel)
 
-    graders_py = "rtpy/grading/graders.py"
     edit(
-        graders_py,
-        "result.score, result.passed = 0.0, False",
-        "result.score, result.passed = result.max_score, True",
+        "rtpy/grading/judge.py",
+        "graded.outcome = Outcome(False, self.message(call, report, item.nodeid), renders)",
+        "graded.outcome = Outcome(True, '', renders)",
     )
-    edit(
-        graders_py, "if report.failed:\n            result.score", "if 0:\n            result.score"
-    )
-    edit("rtpy/grading/autograder_child.py", "passed=item.nodeid not in", "passed=True or 1 in")
+    edit("rtpy/grading/protocol.py", "    return schema.check(value, where)", "    return value")
     checks = repo / "rtpy" / "testing" / "material_checks.py"
     checks.write_text(checks.read_text() + PASSING_CHECKS)
     changed.append("rtpy/testing/material_checks.py")
     graders = repo / "assignments" / f"week{week}" / f"test_week{week}.py"
     tree = ast.parse(graders.read_text())
     names = [n.name for n in tree.body if isinstance(n, ast.FunctionDef) and n.name[:5] == "test_"]
-    graders.write_text("".join(f"def {name}():\n    pass\n\n\n" for name in names))
+    graders.write_text("".join(f"def {name}(probe):\n    pass\n\n\n" for name in names))
     changed.append(graders.relative_to(repo).as_posix())
     for reference in (repo / "assignments" / f"week{week}" / "reference").iterdir():
         reference.write_bytes(b"tampered")
@@ -212,7 +208,7 @@ def check_week(built, tmp_path: Path, week: str) -> None:
     tampered, _ = run_autograder(zip_path, tampered_repo, tmp_path)
     assert summary(tampered) == summary(untouched)
     assert "Changes outside the task files are not graded" in tampered["output"]
-    assert "rtpy/grading/graders.py" in tampered["output"]
+    assert "rtpy/grading/judge.py" in tampered["output"]
     assert changed
 
     reference = with_reference(student, tmp_path / "reference", week)
@@ -263,9 +259,9 @@ def test_week_05_end_to_end(built, tmp_path):
     results, _ = run_autograder(zip_path, submission, tmp_path)
     tests = {t["name"].split(":")[0]: t for t in results["tests"]}
     assert "rtpy/light.py: line" in results["output"] and "SyntaxError" in results["output"]
-    assert tests["PointLight.sample"]["score"] == 0
-    assert tests["PointLight.sample"]["output"].startswith("rtpy/light.py was not used (line")
-    assert tests["Scene.find_occlusion"]["score"] == tests["Scene.find_occlusion"]["max_score"]
+    assert tests["Point light"]["score"] == 0
+    assert tests["Point light"]["output"].startswith("rtpy/light.py was not used (line")
+    assert tests["Shadow rays"]["score"] == tests["Shadow rays"]["max_score"] > 0
     hidden = [t for t in results["tests"] if t["visibility"] == "after_due_date"]
     assert len(hidden) == 2 and all(t["max_score"] > 0 for t in hidden)
 
@@ -281,8 +277,7 @@ def test_the_zip_holds_what_gradescope_needs(built, tmp_path):
     assert {r.split(">")[0] for r in requirements} == {"numpy", "pillow", "tqdm", "pytest"}
     config = json.loads((source / "autograder.json").read_text())
     assert config["task_files"] == task_files("05", ROOT)
-    hidden = [t["hidden"] for t in config["tests"]]
-    assert hidden == sorted(hidden) and any(hidden)  # the graders first, then hidden checks
+    assert "useradd" in (source / "setup.sh").read_text()  # the sandbox's user
     repo = source / "repo"
     assert (repo / "assignments" / "week05" / "hidden" / "test_week05_hidden.py").exists()
     assert not (repo / "tests").exists() and not (repo / "docs").exists()

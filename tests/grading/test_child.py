@@ -4,11 +4,8 @@ in the task files (the judge's side of the process is tests/grading/test_sandbox
 
 from __future__ import annotations
 
-import json
-import shutil
 import subprocess
 import sys
-import textwrap
 from pathlib import Path
 
 import pytest

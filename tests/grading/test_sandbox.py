@@ -15,7 +15,7 @@ from rtpy.grading.sandbox import Child, ChildFailure, Isolation, StudentError
 
 ROOT = Path(__file__).resolve().parents[2]
 
-PROBES = '''
+PROBES = """
 import os, sys
 from rtpy.grading.probes import probe
 from rtpy.grading.protocol import Float, Plain, encode
@@ -65,7 +65,7 @@ def lie():
 def hog():
     block = bytearray(8 * 2**30)
     return float(len(block))
-'''
+"""
 
 LOOP = "def spin():\n    while True:\n        pass\n\n\ndef divide(x):\n    return 1 / x\n"
 
