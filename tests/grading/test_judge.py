@@ -70,7 +70,7 @@ def run(tmp_path, **limits) -> Judge:
 
 
 def test_outcomes_are_worded_by_the_judge(tmp_path):
-    plugin = run(tmp_path, test_timeout=1.0, total_timeout=1.5)
+    plugin = run(tmp_path, test_timeout=1.0, total_timeout=0.5)
     out = {g.nodeid.split("::")[-1]: g for g in plugin.tests.values()}
     assert out["test_square"].outcome.passed and out["test_square"].points == 2.0
     assert out["test_square"].task == "05.1" and out["test_square"].name == "squares"
@@ -80,5 +80,5 @@ def test_outcomes_are_worded_by_the_judge(tmp_path):
     assert any("KeyError" in line for line in plugin.log)  # the traceback, for the instructor
     slow = out["test_slow[1]"].outcome.output
     assert "did not finish within its time limit" in slow  # the probe's own timer, 1 s
-    assert out["test_slow[2]"].outcome.output.startswith("not run: the time limit of 1.5 s")
+    assert out["test_slow[2]"].outcome.output.startswith("not run: the time limit of 0.5 s")
     assert out["test_slow[1]"].name == "slow[1]"
