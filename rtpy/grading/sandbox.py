@@ -29,6 +29,7 @@ import re
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from dataclasses import dataclass, field
@@ -168,11 +169,17 @@ class Child:
     _replies: Replies | None = None
     _output: list[bytes] = field(default_factory=list)
     _next_id: int = 0
+    _config_file: Path | None = None
 
     # --- the process -------------------------------------------------------------
     def start(self) -> None:
         home = self.isolation.home
-        config_path = (home or self.work) / "child-config.json"
+        if home is not None:
+            config_path = home / "child-config.json"
+        else:  # not in the student's repository
+            fd, name = tempfile.mkstemp(prefix="rtpy-child-", suffix=".json")
+            os.close(fd)
+            config_path = self._config_file = Path(name)
         config_path.write_text(json.dumps(self.config), encoding="utf-8")
         command = [self.python, "-I", "-c", BOOT, str(self.work), str(config_path)]
         command.append(str(self.start_timeout))
@@ -220,6 +227,9 @@ class Child:
         except OSError:
             pass
         kill_tree(proc, self.isolation.user)
+        if self._config_file is not None:
+            self._config_file.unlink(missing_ok=True)
+            self._config_file = None
         output = self.output().strip()
         if output:
             self.log.append(f"the student's process printed:\n{output[-4000:]}")
