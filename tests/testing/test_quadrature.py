@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from rtpy.testing import AdaptiveSimpson2D
-from rtpy.testing.quadrature import per_point
+from rtpy.testing.quadrature import CellRequest, integrate_cells, per_point
 
 
 def test_adaptive_simpson_is_accurate_for_smooth_and_peaked_integrands():
@@ -54,3 +54,40 @@ def test_adaptive_simpson_is_accurate_for_smooth_and_peaked_integrands():
     # It promises no accuracy then, only a value the integrand allows and an error
     # estimate that says the tolerance was not met.
     assert 0.0 <= value[0] <= 1.0 and error > 1e-15
+
+
+def test_many_cells_at_once_give_each_cell_its_own_result_in_few_calls():
+    def lobe(x, y):
+        return (math.exp(-((x - 0.41) ** 2 + (y - 0.57) ** 2) / (2 * 0.03**2)), x * y)
+
+    calls = []
+
+    def counted(xs, ys):
+        calls.append(len(xs))
+        return per_point(lobe)(xs, ys)
+
+    edges = [0.0, 0.25, 0.5, 0.75, 1.0]
+    one_by_one = []
+    for i in range(4):
+        for j in range(4):
+            quad = AdaptiveSimpson2D(per_point(lobe), edges, edges)
+            one_by_one.append(quad.cell(i, j, 1e-9))
+    together = AdaptiveSimpson2D(counted, edges, edges)
+    requests = [CellRequest(i, j, 1e-9) for i in range(4) for j in range(4)]
+    # The same local rule, the sums in the same order: the same numbers.
+    assert together.cells(requests) == one_by_one
+    # One call per round, a round per level of refinement (at most 2 * max_depth + 1).
+    assert len(calls) <= 2 * together.max_depth + 1
+    assert sum(calls) == together.evaluations  # no node asked twice
+    # Two integrators in one run share one evaluate per round.
+    other = AdaptiveSimpson2D(per_point(lobe), edges, edges)
+    rounds = []
+
+    def evaluate(batches):
+        rounds.append(len(batches))
+        return [quad.f(xs, ys) for quad, xs, ys in batches]
+
+    mine = AdaptiveSimpson2D(counted, edges, edges)
+    jobs = [(quad, r) for r in requests for quad in (mine, other)]
+    results = integrate_cells(jobs, evaluate)
+    assert results[1::2] == one_by_one and max(rounds) == 2
