@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-from .protocol import ProtocolError, check
+from .protocol import List, ProtocolError, check
 from .sandbox import ChildFailure, StudentError
 
 HIDDEN_PART = "/hidden/"
@@ -112,7 +112,12 @@ class Judge:
         if found.renders:
             self.renders.add(nodeid)
         value = self.runner.call(found.name, inputs, seconds)
-        return check(found.returns, value, f"the answer of the probe {found.name}")
+        where = f"the answer of the probe {found.name}"
+        cases = inputs.get("cases")
+        if isinstance(found.returns, List) and isinstance(cases, list | tuple):
+            if not isinstance(value, list) or len(value) != len(cases):
+                raise ProtocolError(f"{where}: expected one answer for each of {len(cases)} cases")
+        return check(found.returns, value, where)
 
     # --- collection ---------------------------------------------------------------
     def pytest_collectreport(self, report) -> None:

@@ -16,7 +16,8 @@ run by the judge, which calls the probe by name and decides from what comes back
 
 Probes are public (they ship to students): they say what is called, never with which
 inputs nor what is expected. `returns` is the answer's form (rtpy.grading.protocol):
-the judge checks every answer against it before a verdict sees it. A probe that
+the judge checks every answer against it before a verdict sees it (and, for a List
+form and an input called `cases`, that there is one answer per case). A probe that
 renders is registered with renders=True, so that a failed render can point to the
 component graders that failed.
 """

@@ -2,10 +2,10 @@
 of BRDF * cos over the sphere, for the chi-square and energy checks.
 
 The integrand is batched, f(xs, ys) -> (m, k) values, and many cells are
-integrated at once, breadth first: each round evaluates, in one call, every node
-the pending cells need that no earlier round evaluated, then accepts or halves
-each cell. A material in another process is then asked once per round, not once
-per node.
+integrated at once, breadth first: each level of refinement evaluates, in one
+call, every node the pending cells need that is not cached yet, then accepts or
+halves each cell. A material in another process is then asked once per level, not
+once per node.
 """
 
 from __future__ import annotations

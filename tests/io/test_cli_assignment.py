@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 import rtpy.grading.assignment as assignment
 import rtpy.grading.autograder as autograder
 import rtpy.grading.graders as graders
+import rtpy.grading.results as results_module
 from rtpy.grading.assignment import WEEKS, AssignmentError, check_week
 from rtpy.io.cli import main
 
@@ -60,7 +61,7 @@ def no_grading(monkeypatch):
         return {"score": 1.0, "max_score": 1.0, "tests": []}
 
     monkeypatch.setattr(graders, "grade", grade)
-    monkeypatch.setattr(graders, "score_table", lambda results: "table")
+    monkeypatch.setattr(results_module, "score_table", lambda results: "table")
     return asked
 
 
@@ -86,8 +87,8 @@ def test_grade_json_on_a_full_disk_is_one_line_and_keeps_the_old_file(
 ):
     out = tmp_path / "results.json"
     out.write_text("old")
-    real = graders.atomic_write
-    monkeypatch.setattr(graders, "atomic_write", lambda path, write: real(path, full_disk))
+    real = results_module.atomic_write
+    monkeypatch.setattr(results_module, "atomic_write", lambda path, write: real(path, full_disk))
     assert main(["grade", "05", "--json", str(out)]) == 1
     err = capsys.readouterr().err
     assert err == f"rtpy: error: cannot write '{out}': {os.strerror(errno.ENOSPC)}\n"
