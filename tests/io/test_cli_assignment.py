@@ -58,7 +58,7 @@ def no_grading(monkeypatch):
 
     def grade(week, *args, **kwargs):
         asked.append(week)
-        return {"score": 1.0, "max_score": 1.0, "tests": []}
+        return {"score": 1.0, "max_score": 1.0, "tests": [{"name": "t", "status": "passed"}]}
 
     monkeypatch.setattr(graders, "grade", grade)
     monkeypatch.setattr(results_module, "score_table", lambda results: "table")
