@@ -1,28 +1,20 @@
 # ruff: noqa: E501  (the assertion messages are prose for students)
 """Week 06 graders: reflect, refract (Snell), Schlick, total internal reflection, the
-mirror and the dielectric. Run them with `python -m rtpy grade 06`."""
+mirror and the dielectric. Run them with `python -m rtpy grade 06`.
+
+Each test is a verdict: it asks the student's code for numbers through `probe`
+(the probes are in probes.py beside this file) and decides here, in the judge. Each
+names the method it checks and says what is wrong when it fails.
+"""
 
 import math
 from pathlib import Path
 
 import numpy as np
 
-import rtpy.materials.dielectric as dielectric
-import rtpy.vec3 as vec3
-from rtpy import Camera, Color, HitInfo, Lambertian, PointLight, Quad, Ray, Scene, Sphere, Vec3
-from rtpy.grading import assert_image_matches, deterministic_image, points
-from rtpy.materials import Dielectric, Mirror
-from rtpy.sampling import make_generator, use_generator
+from rtpy.grading import assert_image_matches, points
 
 HERE = Path(__file__).parent
-
-
-def v(a):
-    return Vec3(*map(float, a))
-
-
-def arr(x):
-    return np.array(list(x))
 
 
 def random_incidence(rng):
@@ -36,31 +28,40 @@ def random_incidence(rng):
     return n, d
 
 
+def schlick(cosine, ratio):
+    """Schlick's reflectance, computed here: r0 + (1 - r0)(1 - cos)^5."""
+    r0 = ((1 - ratio) / (1 + ratio)) ** 2
+    return r0 + (1 - r0) * (1 - cosine) ** 5
+
+
 @points(2, task="06.1")
-def test_reflect():
+def test_reflect(probe):
     """vec3.reflect: v - 2 (v . n) n"""
     rng = np.random.default_rng(6)
-    for _ in range(50):
-        n, d = random_incidence(rng)
-        got = arr(vec3.reflect(v(d), v(n)))
+    cases = [random_incidence(rng) for _ in range(50)]
+    got = probe.week06_reflect(cases=[[d, n] for n, d in cases])
+    for (n, d), value in zip(cases, got, strict=True):
         expected = d - 2 * (d @ n) * n
-        assert np.allclose(got, expected, atol=1e-12), (
-            f"reflect (rtpy/vec3.py): reflect({d.round(3)}, n={n.round(3)}) = {got.round(4)}, "
+        assert np.allclose(value, expected, atol=1e-12), (
+            f"reflect (rtpy/vec3.py): reflect({d.round(3)}, n={n.round(3)}) = {value.round(4)}, "
             f"expected {expected.round(4)} (v - 2 (v . n) n: same angle on the other side of n)"
         )
 
 
 @points(3, task="06.2")
-def test_refract_obeys_snell():
+def test_refract_obeys_snell(probe):
     """vec3.refract: Snell's law, in the plane of incidence, unit length"""
     rng = np.random.default_rng(66)
+    cases = []
     for _ in range(100):
         n, d = random_incidence(rng)
         eta = rng.uniform(0.4, 1.6)
         sin_i = np.linalg.norm(np.cross(d, n))
         if eta * sin_i >= 1:
             continue  # total internal reflection: refract is not called
-        t = arr(vec3.refract(v(d), v(n), eta))
+        cases.append((n, d, eta, sin_i))
+    got = probe.week06_refract(cases=[[d, n, eta] for n, d, eta, _ in cases])
+    for (n, d, eta, sin_i), t in zip(cases, got, strict=True):
         where = f"refract (rtpy/vec3.py) with eta = {eta:.3f} at incidence {math.degrees(math.asin(sin_i)):.1f} degrees"
         assert abs(np.linalg.norm(t) - 1) < 1e-9, (
             f"{where}: the refracted direction must be a unit vector"
@@ -76,122 +77,134 @@ def test_refract_obeys_snell():
 
 
 @points(2, task="06.3")
-def test_schlick():
+def test_schlick(probe):
     """dielectric.schlick: r0 + (1 - r0)(1 - cos)^5"""
     rng = np.random.default_rng(7)
-    for _ in range(50):
-        c, ratio = rng.uniform(0, 1), rng.uniform(0.3, 3)
-        r0 = ((1 - ratio) / (1 + ratio)) ** 2
-        expected = r0 + (1 - r0) * (1 - c) ** 5
-        got = dielectric.schlick(c, ratio)
-        assert abs(got - expected) < 1e-12, (
-            f"schlick (rtpy/materials/dielectric.py): schlick({c:.3f}, {ratio:.3f}) = {got:.6f}, "
+    cases = [(rng.uniform(0, 1), rng.uniform(0.3, 3)) for _ in range(50)]
+    got = probe.week06_schlick(cases=cases)
+    for (c, ratio), value in zip(cases, got, strict=True):
+        expected = schlick(c, ratio)
+        assert abs(value - expected) < 1e-12, (
+            f"schlick (rtpy/materials/dielectric.py): schlick({c:.3f}, {ratio:.3f}) = {value:.6f}, "
             f"expected r0 + (1 - r0)(1 - cos)^5 = {expected:.6f} with r0 = ((1 - eta)/(1 + eta))^2"
         )
 
 
-def glass_hit(front_face, material):
-    return HitInfo(Vec3(0, 0, 0), Vec3(0, 0, 1), 1.0, front_face, material)
-
-
 def incoming(theta_deg):
+    """The ray [origin, direction] arriving at the origin at theta_deg from the normal
+    (0, 0, 1), in the x-z plane."""
     t = math.radians(theta_deg)
-    return Ray(Vec3(math.sin(t), 0, math.cos(t)), Vec3(-math.sin(t), 0, -math.cos(t)))
+    return [math.sin(t), 0.0, math.cos(t)], [-math.sin(t), 0.0, -math.cos(t)]
+
+
+def scatter_case(material, theta_deg, front_face, count):
+    """A case of the probe week06_scatter: count scatterings of the ray arriving at
+    theta_deg at a hit at the origin with normal (0, 0, 1)."""
+    origin, direction = incoming(theta_deg)
+    return {"material": material, "origin": origin, "direction": direction,
+            "normal": [0.0, 0.0, 1.0], "front_face": front_face, "count": count}  # fmt: skip
+
+
+def none_message(rows, method):
+    """The message for scatterings that returned None (a dielectric or a mirror always
+    scatters), or None when every one returned a sample."""
+    if (rows[:, 0] == 1.0).all():
+        return None
+    return (
+        f"{method}: returned None; a {method.split('.')[0].lower()} never absorbs, it returns "
+        "a ScatterInfo for every ray"
+    )
 
 
 @points(2, task="06.3")
-def test_total_internal_reflection():
+def test_total_internal_reflection(probe):
     """Dielectric: from inside beyond the critical angle every ray reflects"""
-    glass = Dielectric(1.5)
+    glass = {"type": "Dielectric", "ior": 1.5}
     critical = math.degrees(math.asin(1 / 1.5))
-    with use_generator(make_generator(6, 1)):
-        for theta in (critical + 1, 60.0, 85.0):
-            for _ in range(50):
-                s = glass.scattering(incoming(theta), glass_hit(False, glass))
-                d = arr(s.scattered_ray.direction)
-                assert d[2] > 0, (
-                    f"Dielectric.scattering (rtpy/materials/dielectric.py): inside glass at {theta:.1f} "
-                    f"degrees (critical angle {critical:.1f}) a ray refracted out: beyond the critical "
-                    "angle eta sin(theta) > 1 and the ray must reflect (total internal reflection)"
-                )
-        refracted = 0
-        for _ in range(50):
-            s = glass.scattering(incoming(critical - 5), glass_hit(False, glass))
-            refracted += arr(s.scattered_ray.direction)[2] < 0
-        assert refracted > 0, (
-            "Dielectric.scattering: below the critical angle light must also leave the glass"
+    thetas = (critical + 1, 60.0, 85.0)
+    cases = [scatter_case(glass, theta, False, 50) for theta in thetas]
+    cases.append(scatter_case(glass, critical - 5, False, 50))
+    *beyond, below = probe.week06_scatter(cases=cases, generator=[6, 1])
+    for theta, rows in zip(thetas, beyond, strict=True):
+        message = none_message(rows, "Dielectric.scattering (rtpy/materials/dielectric.py)")
+        assert message is None, message
+        assert (rows[:, 3] > 0).all(), (
+            f"Dielectric.scattering (rtpy/materials/dielectric.py): inside glass at {theta:.1f} "
+            f"degrees (critical angle {critical:.1f}) a ray refracted out: beyond the critical "
+            "angle eta sin(theta) > 1 and the ray must reflect (total internal reflection)"
         )
+    message = none_message(below, "Dielectric.scattering (rtpy/materials/dielectric.py)")
+    assert message is None, message
+    assert (below[:, 3] < 0).sum() > 0, (
+        "Dielectric.scattering: below the critical angle light must also leave the glass"
+    )
 
 
 @points(2, task="06.3")
-def test_dielectric_reflects_with_probability_schlick():
+def test_dielectric_reflects_with_probability_schlick(probe):
     """Dielectric.scattering: reflect with probability R, refract otherwise, weight albedo"""
-    glass = Dielectric(1.5, Color(0.9, 0.95, 1.0))
-    n = 4000
-    with use_generator(make_generator(6, 2)):
-        for theta in (10.0, 75.0):
-            ray = incoming(theta)
-            reflected = 0
-            for _ in range(n):
-                s = glass.scattering(ray, glass_hit(True, glass))
-                assert np.allclose(arr(s.attenuation), [0.9, 0.95, 1.0]), (
-                    "Dielectric.scattering: the weight is the albedo, with no cosine and no R factor "
-                    f"(R is the probability of reflecting); got {s.attenuation}"
-                )
-                reflected += arr(s.scattered_ray.direction)[2] > 0
-            cos = math.cos(math.radians(theta))
-            r = dielectric.schlick(cos, 1 / 1.5)
-            z = (reflected / n - r) / math.sqrt(r * (1 - r) / n)
-            assert abs(z) < 4.0, (
-                f"Dielectric.scattering at {theta} degrees reflects {reflected / n:.3f} of rays, "
-                f"Schlick's R is {r:.3f} (z = {z:.1f}); refracted rays must not be absorbed or clamped"
-            )
+    albedo = [0.9, 0.95, 1.0]
+    glass = {"type": "Dielectric", "ior": 1.5, "albedo": albedo}
+    n, thetas = 4000, (10.0, 75.0)
+    cases = [scatter_case(glass, theta, True, n) for theta in thetas]
+    got = probe.week06_scatter(cases=cases, generator=[6, 2])
+    for theta, rows in zip(thetas, got, strict=True):
+        message = none_message(rows, "Dielectric.scattering (rtpy/materials/dielectric.py)")
+        assert message is None, message
+        wrong = ~np.isclose(rows[:, 4:7], albedo).all(axis=1)
+        assert not wrong.any(), (
+            "Dielectric.scattering: the weight is the albedo, with no cosine and no R factor "
+            f"(R is the probability of reflecting); got {rows[np.argmax(wrong), 4:7].round(6)}"
+        )
+        reflected = int((rows[:, 3] > 0).sum())
+        r = schlick(math.cos(math.radians(theta)), 1 / 1.5)
+        z = (reflected / n - r) / math.sqrt(r * (1 - r) / n)
+        assert abs(z) < 4.0, (
+            f"Dielectric.scattering at {theta} degrees reflects {reflected / n:.3f} of rays, "
+            f"Schlick's R is {r:.3f} (z = {z:.1f}); refracted rays must not be absorbed or clamped"
+        )
 
 
 @points(2, task="06.1")
-def test_mirror():
+def test_mirror(probe):
     """Mirror.scattering: the reflected ray, weight albedo (no cosine)"""
-    m = Mirror(Color(0.9, 0.8, 0.7))
-    for theta in (0.0, 45.0, 80.0):
-        s = m.scattering(incoming(theta), glass_hit(True, m))
+    mirror = {"type": "Mirror", "albedo": [0.9, 0.8, 0.7]}
+    thetas = (0.0, 45.0, 80.0)
+    got = probe.week06_scatter(cases=[scatter_case(mirror, theta, True, 1) for theta in thetas])
+    for theta, rows in zip(thetas, got, strict=True):
+        message = none_message(rows, "Mirror.scattering (rtpy/materials/mirror.py)")
+        assert message is None, message
+        (_, *direction, r, g, b, specular) = rows[0]
         t = math.radians(theta)
-        assert np.allclose(
-            arr(s.scattered_ray.direction), [-math.sin(t), 0, math.cos(t)], atol=1e-12
-        ), (
+        assert np.allclose(direction, [-math.sin(t), 0, math.cos(t)], atol=1e-12), (
             f"Mirror.scattering (rtpy/materials/mirror.py) at {theta} degrees: not the mirror direction"
         )
-        assert np.allclose(arr(s.attenuation), [0.9, 0.8, 0.7]), (
-            f"Mirror.scattering at {theta} degrees: weight {s.attenuation}; a mirror reflects "
+        assert np.allclose([r, g, b], [0.9, 0.8, 0.7]), (
+            f"Mirror.scattering at {theta} degrees: weight {np.round([r, g, b], 6)}; a mirror reflects "
             "albedo of the light, with no cosine factor"
         )
-        assert s.is_specular, "Mirror.scattering: the sample is specular (is_specular=True)"
+        assert specular == 1.0, "Mirror.scattering: the sample is specular (is_specular=True)"
 
 
-def optics_scene():
-    objects = [
-        Quad(Vec3(-4, -0.5, -6), Vec3(8, 0, 0), Vec3(0, 0, 6), Lambertian(Color(0.6, 0.6, 0.6))),
-        Quad(Vec3(-4, -0.5, -5), Vec3(8, 0, 0), Vec3(0, 4, 0), Lambertian(Color(0.3, 0.5, 0.7))),
-        Sphere(Vec3(-0.7, 0.0, -2.2), 0.5, Dielectric(1.5)),
-        Sphere(Vec3(0.7, 0.0, -2.6), 0.5, Mirror(Color(0.9, 0.9, 0.9))),
-    ]
-    camera = Camera(Vec3(0, 0.4, 0.5), Vec3(0, 0, -2.4), vfov=55, aspect_ratio="16:9", width=48)
-    return Scene(objects, [PointLight(Vec3(0.5, 2.5, -1.0), Color(8, 8, 8))], camera=camera)
-
-
+# Whitted with a point light and a pinhole is deterministic; spp 1 shows each pixel's
+# jittered sample, so the seed fixes the image.
 REFERENCE = {"name": "whitted_optics"}
+RENDER = {"integrator": "whitted", "max_depth": 8, "spp": 1}
 
 
-def make_reference_image():
-    return deterministic_image(optics_scene(), integrator="whitted", max_depth=8)
+def render_optics(probe):
+    return probe.render(scene="week06_optics", seeds=[0], settings=RENDER)[0]
+
+
+def make_reference_image(probe):
+    return render_optics(probe)
 
 
 @points(3, task="06.3")
-def test_whitted_render_matches_reference():
+def test_whitted_render_matches_reference(probe):
     """whitted render of a glass and a mirror ball matches the reference"""
-    # Whitted with a point light and a pinhole is deterministic; spp 1 shows
-    # each pixel's jittered sample, so the seed fixes the image.
-    image = deterministic_image(optics_scene(), integrator="whitted", max_depth=8)
-    reference = np.load(HERE / "reference" / f"{REFERENCE['name']}.npy")
+    image = render_optics(probe)
+    reference = np.load(HERE / "reference" / f"{REFERENCE['name']}.npy", allow_pickle=False)
     assert_image_matches(
         image, reference, "whitted render", "glass that renders dark or opaque means "
         "refracted rays are lost; check reflect, refract, schlick and Dielectric._split",

@@ -15,12 +15,8 @@ import math
 
 import numpy as np
 
-from rtpy import Color, HitInfo, Ray, Vec3
 from rtpy.grading import points
 from rtpy.grading.autograder_seed import grading_rng, grading_seed
-from rtpy.materials import Dielectric
-from rtpy.sampling import make_generator, use_generator
-from rtpy.vec3 import reflect, refract
 
 ALPHA = 1e-4
 CASES = 3
@@ -39,22 +35,27 @@ def incidence(rng, cos_range=(0.05, 1.0)):
 
 
 @points(2)
-def test_reflect_and_refract_at_new_directions():
+def test_reflect_and_refract_at_new_directions(probe):
     """reflect and refract: the laws of reflection and Snell's law at new directions"""
     rng = grading_rng(601)
+    reflections, refractions = [], []
     for _ in range(200):
         n, d, cos = incidence(rng)
-        got = as_array(reflect(Vec3(*d), Vec3(*n)))
+        reflections.append((n, d))
+        eta = float(rng.uniform(0.4, 2.5))
+        sin_t = eta * math.sqrt(1 - cos * cos)
+        if sin_t > math.sin(math.radians(88)):
+            continue  # total internal reflection, or within 2 degrees of it
+        refractions.append((n, d, eta, sin_t))
+    reflected = probe.week06_reflect(cases=[[d, n] for n, d in reflections])
+    refracted = probe.week06_refract(cases=[[d, n, eta] for n, d, eta, _ in refractions])
+    for (n, d), got in zip(reflections, reflected, strict=True):
         want = d - 2 * (d @ n) * n
         assert np.allclose(got, want, atol=1e-12), (
             f"reflect (rtpy/vec3.py)(v={d.round(4)}, n={n.round(4)}) = {got.round(6)}, expected "
             f"v - 2 (v . n) n = {want.round(6)}"
         )
-        eta = float(rng.uniform(0.4, 2.5))
-        sin_t = eta * math.sqrt(1 - cos * cos)
-        if sin_t > math.sin(math.radians(88)):
-            continue  # total internal reflection, or within 2 degrees of it
-        got = as_array(refract(Vec3(*d), Vec3(*n), eta))
+    for (n, d, eta, sin_t), got in zip(refractions, refracted, strict=True):
         where = f"refract (rtpy/vec3.py)(uv={d.round(4)}, n={n.round(4)}, etai_over_etat={eta:.4f})"
         assert abs(np.linalg.norm(got) - 1) < 1e-9, f"{where} = {got.round(6)}: not a unit vector"
         assert got @ n < 0, (
@@ -69,10 +70,6 @@ def test_reflect_and_refract_at_new_directions():
         )
 
 
-def as_array(v: Vec3) -> np.ndarray:
-    return np.array([v.x(), v.y(), v.z()])
-
-
 def binomial_p_value(k: int, n: int, p: float) -> float:
     """Two-sided p-value of k successes in n trials of probability p: twice the
     smaller tail, at most 1."""
@@ -85,26 +82,31 @@ def binomial_p_value(k: int, n: int, p: float) -> float:
 
 
 @points(2)
-def test_dielectric_reflects_with_the_schlick_probability_at_new_angles():
+def test_dielectric_reflects_with_the_schlick_probability_at_new_angles(probe):
     """Dielectric.scattering: reflects with probability R at new angles and indices"""
     rng = grading_rng(602)
-    with use_generator(make_generator(grading_seed(603), 6)):
-        for _ in range(CASES):
-            ior = float(rng.uniform(1.2, 2.4))
-            n, d, cos = incidence(rng, (0.1, 1.0))
-            glass = Dielectric(ior, Color(0.9, 0.95, 1.0))
-            hit = HitInfo(Vec3(0, 0, 0), Vec3(*n), 1.0, True, glass)
-            ray = Ray(Vec3(*-d), Vec3(*d))
-            reflected = 0
-            for _ in range(N):
-                s = glass.scattering(ray, hit)
-                reflected += as_array(s.scattered_ray.direction) @ n > 0
-            r0 = ((1 - ior) / (1 + ior)) ** 2
-            r = r0 + (1 - r0) * (1 - cos) ** 5  # entering the glass: no total reflection
-            p = binomial_p_value(int(reflected), N, r)
-            assert p > ALPHA / CASES, (
-                f"Dielectric.scattering (rtpy/materials/dielectric.py), ior {ior:.3f}, entering at "
-                f"{math.degrees(math.acos(cos)):.1f} degrees: reflects {reflected / N:.4f} of the rays, "
-                f"Schlick's R is {r:.4f} (binomial p = {p:.2g}). Reflect with probability R "
-                "(schlick(cos, 1 / ior) on the way in), refract otherwise"
-            )
+    cases, asked = [], []
+    for _ in range(CASES):
+        ior = float(rng.uniform(1.2, 2.4))
+        n, d, cos = incidence(rng, (0.1, 1.0))
+        cases.append((ior, n, cos))
+        asked.append(
+            {"material": {"type": "Dielectric", "ior": ior, "albedo": [0.9, 0.95, 1.0]},
+             "origin": -d, "direction": d, "normal": n, "front_face": True, "count": N}
+        )  # fmt: skip
+    got = probe.week06_scatter(cases=asked, generator=[grading_seed(603), 6])
+    for (ior, n, cos), rows in zip(cases, got, strict=True):
+        assert (rows[:, 0] == 1.0).all(), (
+            f"Dielectric.scattering (rtpy/materials/dielectric.py), ior {ior:.3f}: returned None; "
+            "a dielectric never absorbs, it returns a ScatterInfo for every ray"
+        )
+        reflected = int((rows[:, 1:4] @ n > 0).sum())
+        r0 = ((1 - ior) / (1 + ior)) ** 2
+        r = r0 + (1 - r0) * (1 - cos) ** 5  # entering the glass: no total reflection
+        p = binomial_p_value(reflected, N, r)
+        assert p > ALPHA / CASES, (
+            f"Dielectric.scattering (rtpy/materials/dielectric.py), ior {ior:.3f}, entering at "
+            f"{math.degrees(math.acos(cos)):.1f} degrees: reflects {reflected / N:.4f} of the rays, "
+            f"Schlick's R is {r:.4f} (binomial p = {p:.2g}). Reflect with probability R "
+            "(schlick(cos, 1 / ior) on the way in), refract otherwise"
+        )

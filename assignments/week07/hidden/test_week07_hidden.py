@@ -12,17 +12,10 @@ import math
 
 import numpy as np
 
-from rtpy import Color, HitInfo, Lambertian, Quad, Ray, Sphere, Vec3
 from rtpy.grading import points
 from rtpy.grading.autograder_seed import grading_rng
-from rtpy.texture import CheckerTexture
 
-M = Lambertian()
 MARGIN = 1e-6
-
-
-def vec(a) -> Vec3:
-    return Vec3(*(float(x) for x in a))
 
 
 def unit(v: np.ndarray) -> np.ndarray:
@@ -30,9 +23,10 @@ def unit(v: np.ndarray) -> np.ndarray:
 
 
 @points(2)
-def test_sphere_and_quad_uv_at_new_points():
+def test_sphere_and_quad_uv_at_new_points(probe):
     """Sphere.surface_uv and Quad.surface_uv at new points"""
     rng = grading_rng(701)
+    spheres, asked = [], []
     for _ in range(100):
         u, v = rng.uniform(MARGIN, 1 - MARGIN, 2)
         phi, theta = 2 * math.pi * u, math.pi * v
@@ -41,25 +35,30 @@ def test_sphere_and_quad_uv_at_new_points():
             [-math.cos(phi) * math.sin(theta), -math.cos(theta), math.sin(phi) * math.sin(theta)]
         )
         center, radius = rng.uniform(-5, 5, 3), float(rng.uniform(0.2, 3))
-        sphere = Sphere(vec(center), radius, M)
-        hit = HitInfo(vec(center + radius * n), vec(n), 1.0, True, M, sphere)
-        got = sphere.surface_uv(hit)
+        spheres.append((u, v, center, radius, n))
+        asked.append(
+            {"center": center, "radius": radius, "point": center + radius * n, "normal": n}
+        )
+    for (u, v, center, radius, n), got in zip(
+        spheres, probe.week07_sphere_surface_uv(cases=asked), strict=True
+    ):
         assert np.allclose(got, (u, v), atol=1e-9), (
             f"Sphere.surface_uv (rtpy/sphere.py) at the point {(center + radius * n).round(4)} of "
             f"the sphere at {center.round(3)}, radius {radius:.3f}: {np.round(got, 6)}, expected "
             f"({u:.6f}, {v:.6f}): u = phi / (2 pi) with phi = atan2(-z, x) + pi, v = theta / pi "
             "with theta = acos(-y), from the unit outward normal"
         )
+    quads, asked = [], []
     for _ in range(50):
         q, a, b = rng.uniform(-3, 3, 3), rng.uniform(-2, 2, 3), rng.uniform(-2, 2, 3)
         if np.linalg.norm(np.cross(a, b)) < 0.3 * np.linalg.norm(a) * np.linalg.norm(b):
             continue
         alpha, beta = rng.uniform(0, 1, 2)
-        quad = Quad(vec(q), vec(a), vec(b), M)
         point = q + alpha * a + beta * b
         normal = unit(np.cross(a, b))
-        hit = quad.hit_info(Ray(vec(point + normal), vec(-normal)), 1.0)
-        got = quad.surface_uv(hit)
+        quads.append((alpha, beta))
+        asked.append({"q": q, "u": a, "v": b, "ray": [point + normal, -normal], "t": 1.0})
+    for (alpha, beta), got in zip(quads, probe.week07_quad_surface_uv(cases=asked), strict=True):
         assert np.allclose(got, (alpha, beta), atol=1e-9), (
             f"Quad.surface_uv (rtpy/quad.py) at q + {alpha:.4f} u + {beta:.4f} v: {np.round(got, 6)}, "
             "expected (alpha, beta), the point's coordinates along u and v"
@@ -67,20 +66,23 @@ def test_sphere_and_quad_uv_at_new_points():
 
 
 @points(2)
-def test_checker_at_new_points():
+def test_checker_at_new_points(probe):
     """CheckerTexture.value: 3-D cells at new points and scales"""
     rng = grading_rng(702)
-    even, odd = Color(0.9, 0.8, 0.7), Color(0.1, 0.2, 0.3)
+    even, odd = [0.9, 0.8, 0.7], [0.1, 0.2, 0.3]
+    cases, asked = [], []
     for _ in range(200):
         scale = float(rng.uniform(0.2, 3))
         cells = rng.integers(-20, 20, 3) + rng.uniform(MARGIN, 1 - MARGIN, 3)
         point = cells * scale
-        texture = CheckerTexture(scale, even, odd)
-        hit = HitInfo(vec(point), Vec3(0, 1, 0), 1.0, True, M)
-        got = texture.value(hit)
+        cases.append((scale, cells, point))
+        asked.append({"scale": scale, "even": even, "odd": odd, "point": point})
+    for (scale, cells, point), got in zip(
+        cases, probe.week07_checker_value(cases=asked), strict=True
+    ):
         want = even if int(np.floor(cells).sum()) % 2 == 0 else odd
-        assert np.allclose(list(got), list(want)), (
+        assert np.allclose(got, want), (
             f"CheckerTexture.value (rtpy/texture.py), scale {scale:.4f}, at {point.round(4)}: "
-            f"{got}, expected {want}: the cell is floor(x / scale) + floor(y / scale) + "
+            f"{got.round(4)}, expected {want}: the cell is floor(x / scale) + floor(y / scale) + "
             "floor(z / scale), even cells get `even`"
         )
