@@ -22,9 +22,10 @@ import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from .protocol import List, ProtocolError, check
+from .protocol import ProtocolError, check
 from .sandbox import ChildFailure, StudentError
 
 HIDDEN_PART = "/hidden/"
@@ -113,10 +114,13 @@ class Judge:
             self.renders.add(nodeid)
         value = self.runner.call(found.name, inputs, seconds)
         where = f"the answer of the probe {found.name}"
-        cases = inputs.get("cases")
-        if isinstance(found.returns, List) and isinstance(cases, list | tuple):
-            if not isinstance(value, list) or len(value) != len(cases):
-                raise ProtocolError(f"{where}: expected one answer for each of {len(cases)} cases")
+        for many in ("cases", "seeds"):  # one answer per case, one render per seed
+            asked = inputs.get(many)
+            if isinstance(asked, list | tuple) and not (
+                isinstance(value, list | np.ndarray) and len(value) == len(asked)
+            ):
+                wanted = f"one answer for each of {len(asked)} {many}"
+                raise ProtocolError(f"{where}: expected {wanted}")
         return check(found.returns, value, where)
 
     # --- collection ---------------------------------------------------------------
@@ -232,17 +236,17 @@ def probe(request) -> Probes:
     for plugin in config.pluginmanager.get_plugins():
         if isinstance(plugin, Judge):
             return Probes(plugin, request.node.nodeid)
-    standalone = getattr(config, "_rtpy_probe_judge", None)
+    folder = Path(request.node.path).parent
+    if folder.name == "hidden":
+        folder = folder.parent
+    judges = config.__dict__.setdefault("_rtpy_probe_judges", {})  # one per week's folder
+    standalone = judges.get(folder)
     if standalone is None:
         from .graders import local_runner
 
-        folder = Path(request.node.path).parent
-        if folder.name == "hidden":
-            folder = folder.parent
         probes_file = folder / "probes.py"
         registry = probe_registry([probes_file] if probes_file.is_file() else [])
-        standalone = Judge(local_runner(folder), registry, test_timeout=1e5)
-        config._rtpy_probe_judge = standalone
+        standalone = judges[folder] = Judge(local_runner(folder), registry, test_timeout=1e5)
         config.add_cleanup(standalone.runner.stop)
     standalone._deadline = time.monotonic() + standalone.test_timeout
     return Probes(standalone, request.node.nodeid)

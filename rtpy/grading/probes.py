@@ -82,6 +82,9 @@ def _folder(function: Callable) -> str:
 
 def scene_builder(function: Callable) -> Callable:
     """Register a function that builds a scene (from plain parameters) by its name."""
+    known = SCENES.get(function.__name__)
+    if known is not None and _folder(known) != _folder(function):
+        raise ValueError(f"two scene builders are called {function.__name__!r}")
     SCENES[function.__name__] = function
     return function
 

@@ -13,16 +13,10 @@ import math
 
 import numpy as np
 
-from rtpy import Interval, Lambertian, Quad, Ray, Scene, Sphere, Triangle, Vec3
 from rtpy.grading import points
 from rtpy.grading.autograder_seed import grading_rng
 
-M = Lambertian()
 REL = 1e-7  # relative tolerance on t; rounding is about 1e-15
-
-
-def vec(a) -> Vec3:
-    return Vec3(*(float(x) for x in a))
 
 
 def unit(v: np.ndarray) -> np.ndarray:
@@ -44,39 +38,55 @@ def check(got, want, where: str) -> None:
         )
 
 
+def checked_hits(probe, asked: list) -> None:
+    """Ask shape_hit_t (assignments/week04/probes.py) for the cases of `asked`, a list of
+    (case, expected t or None, where), in one call, and check them in order."""
+    got = probe.shape_hit_t(cases=[case for case, _, _ in asked])
+    for t, (_, want, where) in zip(got, asked, strict=True):
+        check(t, want, where)
+
+
+def ray_case(shape: dict, o, d, t_min: float, t_max: float = math.inf) -> dict:
+    return {"shape": shape, "origin": o, "direction": d, "t_min": t_min, "t_max": t_max}
+
+
 @points(3)
-def test_sphere_hits_at_new_rays():
+def test_sphere_hits_at_new_rays(probe):
     """Sphere.hit_t: new rays from outside and inside, hits, misses, the interval"""
     rng = grading_rng(401)
+    asked = []
     for _ in range(150):
         c, r = rng.uniform(-3, 3, 3), float(rng.uniform(0.3, 2.0))
         d = unit(rng.normal(size=3))
         s = float(rng.choice([rng.uniform(0.0, 0.9), rng.uniform(1.1, 2.0)]))
         b, far = r * s, float(rng.uniform(r + 0.5, r + 6))  # miss distance, along the ray
         o = c + b * perpendicular(rng, d) - far * d
-        sphere, ray = Sphere(vec(c), r, M), Ray(vec(o), vec(d))
+        sphere = {"type": "Sphere", "center": c, "radius": r}
         where = f"Sphere.hit_t (rtpy/sphere.py), center {c.round(3)}, radius {r:.3f}, ray from {o.round(3)} along {d.round(3)}"
         if s > 1:
-            check(sphere.hit_t(ray, 1e-9, math.inf), None, where)
+            asked.append((ray_case(sphere, o, d, 1e-9), None, where))
             continue
         half = math.sqrt(r * r - b * b)
         near, exit_ = far - half, far + half
-        check(sphere.hit_t(ray, 1e-9, math.inf), near, where)
-        check(sphere.hit_t(ray, 1e-9, near * 0.99), None, f"{where}, t_max below the hit")
-        check(
-            sphere.hit_t(ray, near * 1.01 + 1e-3, math.inf),
-            exit_,
-            f"{where}, t_min past the first root (the far root)",
+        asked.append((ray_case(sphere, o, d, 1e-9), near, where))
+        asked.append(
+            (ray_case(sphere, o, d, 1e-9, near * 0.99), None, f"{where}, t_max below the hit")
+        )
+        asked.append(
+            (
+                ray_case(sphere, o, d, near * 1.01 + 1e-3),
+                exit_,
+                f"{where}, t_min past the first root (the far root)",
+            )
         )
         start = c + float(rng.uniform(0, 0.8)) * r * unit(rng.normal(size=3))
         oc = c - start
         h = oc @ d
         want = h + math.sqrt(h * h - (oc @ oc - r * r))  # the root ahead, from inside
-        check(
-            sphere.hit_t(Ray(vec(start), vec(d)), 1e-9, math.inf),
-            want,
-            f"{where}, from inside at {start.round(3)}",
+        asked.append(
+            (ray_case(sphere, start, d, 1e-9), want, f"{where}, from inside at {start.round(3)}")
         )
+    checked_hits(probe, asked)
 
 
 def planar_case(rng, inside: bool, triangle: bool) -> tuple[float, float]:
@@ -102,9 +112,10 @@ def approach(rng, p: np.ndarray, normal: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 @points(3)
-def test_quad_and_triangle_hits_at_new_rays():
+def test_quad_and_triangle_hits_at_new_rays(probe):
     """Quad.hit_t and Triangle.hit_t: new shapes and rays, inside, outside, the interval"""
     rng = grading_rng(402)
+    asked = []
     for _ in range(100):
         q = rng.uniform(-3, 3, 3)
         u = rng.uniform(-2, 2, 3)
@@ -112,23 +123,31 @@ def test_quad_and_triangle_hits_at_new_rays():
         n = np.cross(u, v)
         if np.linalg.norm(n) < 0.3 * np.linalg.norm(u) * np.linalg.norm(v):
             continue  # nearly parallel edges
-        for shape in (Quad(vec(q), vec(u), vec(v), M), Triangle(vec(q), vec(q + u), vec(q + v), M)):
-            triangle = isinstance(shape, Triangle)
+        quad = {"type": "Quad", "corner": q, "u": u, "v": v}
+        for shape in (quad, {"type": "Triangle", "a": q, "b": q + u, "c": q + v}):
+            triangle = shape["type"] == "Triangle"
             inside = bool(rng.integers(2))
             a, b = planar_case(rng, inside, triangle)
             o, d, dist = approach(rng, q + a * u + b * v, unit(n))
-            ray = Ray(vec(o), vec(d))
             name = "Triangle.hit_t (rtpy/triangle.py)" if triangle else "Quad.hit_t (rtpy/quad.py)"
             where = f"{name}, q {q.round(3)}, u {u.round(3)}, v {v.round(3)}, ray through alpha {a:.3f}, beta {b:.3f}"
-            check(shape.hit_t(ray, 1e-9, math.inf), dist if inside else None, where)
+            asked.append((ray_case(shape, o, d, 1e-9), dist if inside else None, where))
             if inside:
-                check(shape.hit_t(ray, 1e-9, dist * 0.99), None, f"{where}, t_max below the hit")
+                asked.append(
+                    (
+                        ray_case(shape, o, d, 1e-9, dist * 0.99),
+                        None,
+                        f"{where}, t_max below the hit",
+                    )
+                )
+    checked_hits(probe, asked)
 
 
 @points(2)
-def test_closest_hit_among_new_spheres():
+def test_closest_hit_among_new_spheres(probe):
     """Scene.find_intersection: the nearest of new spheres along a ray, in any order"""
     rng = grading_rng(403)
+    cases, expected = [], []
     for _ in range(30):
         o, d = rng.uniform(-2, 2, 3), unit(rng.normal(size=3))
         k = int(rng.integers(3, 9))  # below the BVH's threshold: the loop is tested
@@ -137,20 +156,27 @@ def test_closest_hit_among_new_spheres():
         if gaps.min() < 0.5:
             continue
         radii = 0.2 * gaps
-        spheres = [
-            Sphere(vec(o + t * d), float(r), M) for t, r in zip(distances, radii, strict=True)
-        ]
+        spheres = [[o + t * d, float(r)] for t, r in zip(distances, radii, strict=True)]
         order = rng.permutation(k)
-        scene = Scene([spheres[i] for i in order])
-        hit = scene.find_intersection(Ray(vec(o), vec(d)), Interval(1e-9, math.inf))
-        where = f"Scene.find_intersection (rtpy/scene.py) with {k} spheres on a ray, the nearest listed at position {int(np.argmin(order)) + 1}"
+        listed = [spheres[i] for i in order]
+        nearest = int(np.argmin(order))  # where the nearest sphere is listed
+        t_hit = float(distances[0] - radii[0])
+        cases.append({"spheres": listed, "origin": o, "direction": d, "interval": [1e-9, math.inf]})
+        cases.append(
+            {"spheres": listed, "origin": o, "direction": d, "interval": [1e-9, t_hit * 0.99]}
+        )
+        expected.append((k, nearest, t_hit, distances[0]))
+    got = probe.scene_closest_hit(cases=cases)
+    for (k, nearest, t_hit, distance), hit, limited in zip(
+        expected, got[::2], got[1::2], strict=True
+    ):
+        where = f"Scene.find_intersection (rtpy/scene.py) with {k} spheres on a ray, the nearest listed at position {nearest + 1}"
         assert hit is not None, f"{where}: returned None"
-        assert (
-            hit.obj is spheres[0] and abs(hit.t - (distances[0] - radii[0])) <= REL * distances[0]
-        ), (
-            f"{where}: hit t = {hit.t:.6g}, expected the nearest sphere at t = {distances[0] - radii[0]:.6g}"
+        assert abs(hit.t - t_hit) <= REL * distance, (
+            f"{where}: hit t = {hit.t:.6g}, expected the nearest sphere at t = {t_hit:.6g}"
         )
-        limit = Interval(1e-9, float(distances[0] - radii[0]) * 0.99)
-        assert scene.find_intersection(Ray(vec(o), vec(d)), limit) is None, (
-            f"{where}: a hit beyond interval.max must not count"
+        assert hit.index == nearest, (
+            f"{where}: the hit at the right t names another object (hit.obj must be the "
+            "nearest sphere)"
         )
+        assert limited is None, f"{where}: a hit beyond interval.max must not count"
