@@ -91,19 +91,25 @@ def light_sample_estimate(cases: list, f: list):
     return out
 
 
-@probe(returns=List(Vec))
-def sample_one_light(scene: str, params: dict, cases: list, seed: int):
-    """sample_one_light(scene, incoming, hit, scene.lights) at floor points: a hit on the
-    scene's first object (a floor facing +y) at `point`, the incoming ray from above."""
-    built = SCENES[scene](**params)
-    floor = built.objects[0]
+@probe(returns=List(List(Vec)))
+def sample_one_light(scene: str, cases: list, seed: int):
+    """sample_one_light(built, incoming, hit, built.lights) at floor points, for each case
+    {"params": the scene's parameters, "points": [...]}: built = SCENES[scene](**params),
+    a hit on its first object (a floor facing +y) at each point, the incoming ray from
+    above; one generator, seeded with seed, for all of them, in order."""
     out = []
     with use_generator(make_generator(int(seed), 5)):
-        for point in cases:
-            p = vec(point)
-            hit = floor.hit_info(Ray(p + Vec3(0, 1e-3, 0), Vec3(0, -1, 0)), 1e-3)
-            incoming = Ray(p + Vec3(0, 1, 0), Vec3(0, -1, 0))
-            out.append(floats(direct_lighting.sample_one_light(built, incoming, hit, built.lights)))
+        for case in cases:
+            built = SCENES[scene](**case["params"])
+            floor = built.objects[0]
+            values = []
+            for point in case["points"]:
+                p = vec(point)
+                hit = floor.hit_info(Ray(p + Vec3(0, 1e-3, 0), Vec3(0, -1, 0)), 1e-3)
+                incoming = Ray(p + Vec3(0, 1, 0), Vec3(0, -1, 0))
+                lit = direct_lighting.sample_one_light(built, incoming, hit, built.lights)
+                values.append(floats(lit))
+            out.append(values)
     return out
 
 
@@ -163,11 +169,13 @@ def lamp_under_wall(albedo: list, center: list, radius: float):
 
 @scene_builder
 def lit_sphere(albedo: list, center: list, radius: float, light: list, intensity: list):
+    """A sphere under a point light."""
     sphere = Sphere(vec(center), float(radius), Lambertian(color(albedo)))
     return Scene([sphere], [PointLight(vec(light), color(intensity))])
 
 
 @scene_builder
-def lit_floor(albedo: list, height: float, corner: list, light: list, intensity: list):
+def lit_floor(albedo: list, corner: list, light: list, intensity: list):
+    """A large horizontal floor from corner under a point light."""
     plane = Quad(vec(corner), Vec3(0, 0, 100), Vec3(100, 0, 0), Lambertian(color(albedo)))
     return Scene([plane], [PointLight(vec(light), color(intensity))])

@@ -8,6 +8,10 @@ submission, so code that is right only for the graders' fixed inputs fails them.
 - No shadow acne: a point on a lit surface, with nothing in the way, is lit (the
   shadow ray must start off the surface it leaves).
 
+The student's direct integrator and sample_one_light run in the student's process
+(the probes radiance and sample_one_light, of the scenes built by ../probes.py); the
+expected values are computed here.
+
 False failures: both compare with values computed here for scenes built so that
 nothing lies between the points and the light, with tolerances far above rounding;
 spawn_ray's offset (rtpy/ray.py) exceeds the rounding of the hit points by design.
@@ -18,29 +22,17 @@ import math
 
 import numpy as np
 
-from rtpy import Color, Lambertian, PointLight, Quad, Ray, Scene, Sphere, Vec3
 from rtpy.grading import points
 from rtpy.grading.autograder_seed import grading_rng, grading_seed
-from rtpy.integrators import DirectIntegrator
-from rtpy.integrators.direct_lighting import sample_one_light
-from rtpy.materials import DiffuseLight
-from rtpy.render_settings import RenderSettings
-from rtpy.sampling import make_generator, use_generator
 
-ALBEDO = Color(0.7, 0.5, 0.3)
+ALBEDO = np.array([0.7, 0.5, 0.3])
+DIRECT = {"integrator": "direct"}
+UP = np.array([0.0, 1.0, 0.0])
 SPAWN_HINT = (
     "The shadow ray must start just off the surface: spawn_ray(hit.point, hit.normal, "
     "direction) (rtpy/ray.py) moves its origin by a small offset along the normal, so it "
     "cannot hit the surface it leaves (shadow acne)."
 )
-
-
-def vec(a) -> Vec3:
-    return Vec3(*(float(x) for x in a))
-
-
-def arr(v) -> np.ndarray:
-    return np.array(list(v), dtype=float)
 
 
 def unit(v: np.ndarray) -> np.ndarray:
@@ -52,58 +44,74 @@ def lambert_point_light(point, normal, light, intensity) -> np.ndarray:
     to_light = light - point
     d2 = to_light @ to_light
     cos = normal @ to_light / math.sqrt(d2)
-    return arr(ALBEDO) / math.pi * intensity * cos / d2
+    return ALBEDO / math.pi * intensity * cos / d2
 
 
-def seen_from_above(integrator, scene, point, normal, rng) -> np.ndarray:
-    """The direct integrator's radiance at `point`, looked at from just in front of it."""
+def answered(got: list, asked: list, what: str) -> list:
+    """got, after checking that it has an answer for each of `asked`."""
+    assert len(got) == len(asked), f"{what}: {len(got)} answers for {len(asked)} questions"
+    return got
+
+
+def ray_from_above(point, normal, rng) -> list:
+    """A camera ray [origin, direction] looking at `point` from just in front of it."""
     tilt = unit(normal + 0.5 * np.cross(normal, unit(rng.normal(size=3))))
     eye = point + 0.05 * tilt
-    return arr(integrator.compute_scattering(Ray(vec(eye), vec(unit(point - eye))), scene))
+    return [eye, unit(point - eye)]
 
 
 @points(3)
-def test_objects_beyond_the_light_cast_no_shadow():
+def test_objects_beyond_the_light_cast_no_shadow(probe):
     """shadow rays stop at the light: a ceiling above the light casts no shadow"""
     rng = grading_rng(501)
-    integrator = DirectIntegrator(RenderSettings(integrator="direct"))
-    floor = Quad(Vec3(-50, 0, -50), Vec3(0, 0, 100), Vec3(100, 0, 0), Lambertian(ALBEDO))
     for _ in range(4):
         light = np.array([rng.uniform(-2, 2), rng.uniform(1, 3), rng.uniform(-2, 2)])
         top = light[1] + rng.uniform(0.2, 2.0)
-        ceiling = Quad(Vec3(-50, top, -50), Vec3(100, 0, 0), Vec3(0, 0, 100), Lambertian())
         intensity = rng.uniform(1, 5, 3)
-        scene = Scene([floor, ceiling], [PointLight(vec(light), vec(intensity))])
+        points_, rays = [], []
         for _ in range(8):
             point = np.array([light[0] + rng.uniform(-2, 2), 0.0, light[2] + rng.uniform(-2, 2)])
-            got = seen_from_above(integrator, scene, point, np.array([0.0, 1.0, 0.0]), rng)
-            want = lambert_point_light(point, np.array([0.0, 1.0, 0.0]), light, intensity)
-            assert np.allclose(got, want, rtol=1e-6, atol=1e-12), (
+            points_.append(point)
+            rays.append(ray_from_above(point, UP, rng))
+        params = {"albedo": ALBEDO, "light": light, "intensity": intensity, "top": top}
+        got = probe.radiance(scene="floor_and_ceiling", params=params, rays=rays, settings=DIRECT)
+        answered(got, rays, "DirectIntegrator.compute_scattering")
+        for point, value in zip(points_, got, strict=True):
+            want = lambert_point_light(point, UP, light, intensity)
+            assert np.allclose(value, want, rtol=1e-6, atol=1e-12), (
                 f"direct integrator at floor point {point.round(3)} under a point light at "
-                f"{light.round(3)} and a ceiling at height {top:.3f} above it: radiance {got.round(6)}, "
+                f"{light.round(3)} and a ceiling at height {top:.3f} above it: radiance {value.round(6)}, "
                 f"expected albedo / pi * I cos / d^2 = {want.round(6)}. Nothing lies between the point "
                 "and the light: the shadow ray must stop at the light (sample_one_light in "
                 "rtpy/integrators/direct_lighting.py: Interval(0, distance to the light), not to "
                 "infinity), so the ceiling beyond it casts no shadow"
             )
-    with use_generator(make_generator(grading_seed(502), 5)):
-        for _ in range(4):
-            center = np.array([rng.uniform(-2, 2), rng.uniform(1.5, 3), rng.uniform(-2, 2)])
-            lamp = Sphere(vec(center), float(rng.uniform(0.1, 0.4)), DiffuseLight(Color(4, 4, 4)))
-            wall = Sphere(vec(center + [0, 3.0, 0]), 2.0, Lambertian())  # above and beyond
-            scene = Scene([floor, lamp, wall])
-            for _ in range(8):
-                point = center * [1, 0, 1] + [rng.uniform(-1.5, 1.5), 0.0, rng.uniform(-1.5, 1.5)]
-                hit = floor.hit_info(Ray(vec(point + [0, 1e-3, 0]), Vec3(0, -1, 0)), 1e-3)
-                incoming = Ray(vec(point + [0, 1, 0]), Vec3(0, -1, 0))
-                got = arr(sample_one_light(scene, incoming, hit, scene.lights))
-                assert got.min() > 0.0, (
-                    f"sample_one_light (rtpy/integrators/direct_lighting.py) at floor point "
-                    f"{point.round(3)} under a sphere light at {center.round(3)}, with a sphere "
-                    f"above the light: {got.round(6)}, but nothing lies between the point and the "
-                    "light. The shadow ray must stop at the light (Interval(0, a little less than "
-                    "the distance to the sampled point), not search to infinity"
-                )
+    cases, lamps = [], []
+    for _ in range(4):
+        center = np.array([rng.uniform(-2, 2), rng.uniform(1.5, 3), rng.uniform(-2, 2)])
+        radius = float(rng.uniform(0.1, 0.4))
+        floor_points = [
+            center * [1, 0, 1] + [rng.uniform(-1.5, 1.5), 0.0, rng.uniform(-1.5, 1.5)]
+            for _ in range(8)
+        ]
+        cases.append(
+            {"params": {"albedo": ALBEDO, "center": center, "radius": radius},
+             "points": floor_points}
+        )  # fmt: skip
+        lamps.append(center)
+    got = probe.sample_one_light(scene="lamp_under_wall", cases=cases, seed=grading_seed(502))
+    for case, center, values in zip(
+        cases, lamps, answered(got, cases, "sample_one_light"), strict=True
+    ):
+        answered(values, case["points"], "sample_one_light")
+        for point, value in zip(case["points"], values, strict=True):
+            assert value.min() > 0.0, (
+                f"sample_one_light (rtpy/integrators/direct_lighting.py) at floor point "
+                f"{point.round(3)} under a sphere light at {center.round(3)}, with a sphere "
+                f"above the light: {value.round(6)}, but nothing lies between the point and the "
+                "light. The shadow ray must stop at the light (Interval(0, a little less than "
+                "the distance to the sampled point), not search to infinity"
+            )
 
 
 def sphere_points(rng, n):
@@ -121,36 +129,37 @@ def sphere_points(rng, n):
 
 
 @points(2)
-def test_lit_points_have_no_shadow_acne():
+def test_lit_points_have_no_shadow_acne(probe):
     """no shadow acne: points on a lit sphere and plane are not shadowed by themselves"""
     rng = grading_rng(503)
-    integrator = DirectIntegrator(RenderSettings(integrator="direct"))
-    dark = []
+    asked = []  # (scene, params, [(point, normal)], light, intensity, rays)
     for _ in range(5):
         center, radius, light, cases = sphere_points(rng, 20)
         intensity = rng.uniform(1, 5, 3) * radius**2
-        scene = Scene(
-            [Sphere(vec(center), radius, Lambertian(ALBEDO))],
-            [PointLight(vec(light), vec(intensity))],
-        )
-        for point, normal in cases:
-            got = seen_from_above(integrator, scene, point, normal, rng)
-            want = lambert_point_light(point, normal, light, intensity)
-            if not np.allclose(got, want, rtol=1e-4, atol=0):
-                dark.append((point, got, want))
+        rays = [ray_from_above(point, normal, rng) for point, normal in cases]
+        params = {"albedo": ALBEDO, "center": center, "radius": radius, "light": light,
+                  "intensity": intensity}  # fmt: skip
+        asked.append(("lit_sphere", params, cases, light, intensity, rays))
     for _ in range(3):
         height = float(rng.uniform(-30, 30))
         q = np.array([rng.uniform(-60, -40), height, rng.uniform(-60, -40)])
-        plane = Quad(vec(q), Vec3(0, 0, 100), Vec3(100, 0, 0), Lambertian(ALBEDO))
         light = np.array([rng.uniform(-5, 5), height + rng.uniform(0.5, 4), rng.uniform(-5, 5)])
         intensity = rng.uniform(1, 5, 3)
-        scene = Scene([plane], [PointLight(vec(light), vec(intensity))])
+        cases, rays = [], []
         for _ in range(20):
             point = np.array([rng.uniform(-8, 8), height, rng.uniform(-8, 8)])
-            got = seen_from_above(integrator, scene, point, np.array([0.0, 1.0, 0.0]), rng)
-            want = lambert_point_light(point, np.array([0.0, 1.0, 0.0]), light, intensity)
-            if not np.allclose(got, want, rtol=1e-4, atol=0):
-                dark.append((point, got, want))
+            cases.append((point, UP))
+            rays.append(ray_from_above(point, UP, rng))
+        params = {"albedo": ALBEDO, "corner": q, "light": light, "intensity": intensity}
+        asked.append(("lit_floor", params, cases, light, intensity, rays))
+    dark = []
+    for scene, params, cases, light, intensity, rays in asked:
+        got = probe.radiance(scene=scene, params=params, rays=rays, settings=DIRECT)
+        answered(got, rays, "DirectIntegrator.compute_scattering")
+        for (point, normal), value in zip(cases, got, strict=True):
+            want = lambert_point_light(point, normal, light, intensity)
+            if not np.allclose(value, want, rtol=1e-4, atol=0):
+                dark.append((point, value, want))
     if dark:
         point, got, want = dark[0]
         raise AssertionError(

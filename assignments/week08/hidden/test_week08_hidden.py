@@ -4,7 +4,9 @@ never ships to students). Their inputs come from grading_seed, new for every
 submission, so code that is right only for the graders' fixed inputs fails them.
 
 Each reflection model gets new parameters (exponent, roughness, distribution, kd, ks,
-albedo) and a new angle of incidence.
+albedo) and a new angle of incidence. The models are asked through RemoteMaterial
+(the student's process draws and evaluates, the checks run here); the furnace renders
+the scene week08_glowing_furnace of probes.py.
 
 False failures: the weight check (BRDF * cos / pdf, rtpy.testing.check_weights) is
 exact up to rounding and never fails a correct model. The sampling check is a
@@ -18,12 +20,12 @@ Together: below 2e-4 per submission.
 
 import math
 
+import numpy as np
+
 import rtpy.testing as rt
-from rtpy import Camera, Color, Scene, Sphere, Vec3
-from rtpy.grading import points, render_stack
+from rtpy.grading import points
 from rtpy.grading.autograder_seed import grading_rng, grading_seed
-from rtpy.materials import BlinnPhong, CookTorrance, Phong
-from rtpy.testing.analytic_scenes import GlowingLambertian
+from rtpy.grading.remote_material import RemoteMaterial
 
 ALPHA = 1e-4
 Z = 4.5
@@ -34,89 +36,97 @@ FILES = {
 }
 
 
-def new_models(rng) -> list:
-    """One Phong, Blinn-Phong and Cook-Torrance material with new parameters."""
-    albedo = Color(*(float(x) for x in rng.uniform(0.2, 0.9, 3)))
+def new_models(rng) -> list[dict]:
+    """The specs of one Phong, Blinn-Phong and Cook-Torrance material with new
+    parameters (rtpy.grading.probes.make_material)."""
+    albedo = [float(x) for x in rng.uniform(0.2, 0.9, 3)]
     kd = float(rng.uniform(0.2, 0.6))
     ks = float(rng.uniform(0.2, 0.9 - kd * max(albedo)))
+    common = {"albedo": albedo, "kd": kd, "ks": ks}
     return [
-        Phong(albedo, kd=kd, ks=ks, exponent=float(rng.uniform(5, 60))),
-        BlinnPhong(albedo, kd=kd, ks=ks, exponent=float(rng.uniform(20, 200))),
-        CookTorrance(
-            albedo,
-            kd=kd,
-            ks=ks,
-            roughness=float(rng.uniform(0.15, 0.6)),
-            distribution=str(rng.choice(["ggx", "beckmann"])),
-        ),
+        {"type": "Phong", **common, "exponent": float(rng.uniform(5, 60))},
+        {"type": "BlinnPhong", **common, "exponent": float(rng.uniform(20, 200))},
+        {
+            "type": "CookTorrance",
+            **common,
+            "roughness": float(rng.uniform(0.15, 0.6)),
+            "distribution": str(rng.choice(["ggx", "beckmann"])),
+        },
     ]
 
 
-def described(material) -> str:
-    name = type(material).__name__
+def described(spec: dict) -> str:
+    name = spec["type"]
     params = ", ".join(
-        f"{k}={getattr(material, k):.3g}"
-        if isinstance(getattr(material, k), float)
-        else f"{k}={getattr(material, k)}"
+        f"{k}={spec[k]:.3g}" if isinstance(spec[k], float) else f"{k}={spec[k]}"
         for k in ("kd", "ks", "exponent", "roughness", "distribution")
-        if hasattr(material, k)
+        if k in spec
     )
     return f"{name}({params}) ({FILES[name]})"
 
 
 @points(3)
-def test_sampling_follows_pdf_at_new_parameters():
+def test_sampling_follows_pdf_at_new_parameters(probe):
     """scattering() draws directions with density pdf(), new parameters (chi-square)"""
     rng = grading_rng(801)
     models = new_models(rng)
     alpha = rt.sidak_alpha(ALPHA, len(models))
-    for k, material in enumerate(models):
+    for k, spec in enumerate(models):
         theta = float(rng.uniform(10, 70))
         result = rt.chi2_test(
-            material, theta, n_samples=10_000, theta_bins=8, phi_bins=16, seed=grading_seed(810 + k)
+            RemoteMaterial(probe, spec),
+            theta,
+            n_samples=10_000,
+            theta_bins=8,
+            phi_bins=16,
+            seed=grading_seed(810 + k),
         )
         assert result.passed(alpha), (
-            f"{described(material)}.scattering at {theta:.1f} degrees draws directions that do not "
+            f"{described(spec)}.scattering at {theta:.1f} degrees draws directions that do not "
             f"follow pdf() (p = {result.p_value:.2g}): {result.summary()}"
         )
 
 
 @points(3)
-def test_weight_is_brdf_cos_over_pdf_at_new_parameters():
+def test_weight_is_brdf_cos_over_pdf_at_new_parameters(probe):
     """scattering() weight = BRDF * cos / pdf, new parameters"""
     rng = grading_rng(802)
-    for k, material in enumerate(new_models(rng)):
+    for k, spec in enumerate(new_models(rng)):
+        subject = RemoteMaterial(probe, spec)
         theta = float(rng.uniform(5, 80))
-        result = rt.check_weights(material, theta, n=300, seed=grading_seed(820 + k))
+        result = rt.check_weights(subject, theta, n=300, seed=grading_seed(820 + k))
         assert result.passed, (
-            f"{described(material)}.scattering at {theta:.1f} degrees: the attenuation must be "
+            f"{described(spec)}.scattering at {theta:.1f} degrees: the attenuation must be "
             f"BRDF * cos / pdf of the lobe mixture: {result.detail}"
         )
-        result = rt.check_reciprocity(material, n_pairs=300, seed=grading_seed(830 + k))
-        assert result.passed, f"{described(material)}.BRDF is not reciprocal: {result.detail}"
+        result = rt.check_reciprocity(subject, n_pairs=300, seed=grading_seed(830 + k))
+        assert result.passed, f"{described(spec)}.BRDF is not reciprocal: {result.detail}"
 
 
 PIXELS = 2 * 8 * 8
+FURNACE = {"integrator": "path", "spp": 8, "max_depth": 100, "russian_roulette": 3}
 
 
 @points(2)
-def test_path_furnace_at_new_seeds():
+def test_path_furnace_at_new_seeds(probe):
     """path integrator: inside a glowing sphere L = Le / (1 - albedo), new seeds"""
     rng = grading_rng(803)
     rho, le = float(rng.uniform(0.3, 0.6)), float(rng.uniform(0.2, 1.0))
     eye = rng.uniform(-0.5, 0.5, 3)
-    scene = Scene(
-        [Sphere(Vec3(0, 0, 0), 2.0, GlowingLambertian(Color(rho, rho, rho), Color(le, le, le)))],
-        camera=Camera(
-            Vec3(*eye), Vec3(*(eye + rng.normal(size=3))), vfov=90, aspect_ratio=1.0, width=8
-        ),
+    params = {
+        "albedo": [rho] * 3,
+        "emit": [le] * 3,
+        "eye": eye,
+        "look_at": eye + rng.normal(size=3),
+    }
+    seeds = [grading_seed(840), grading_seed(841)]
+    stack = probe.render(
+        scene="week08_glowing_furnace", params=params, seeds=seeds, settings=FURNACE
     )
-    seeds = (grading_seed(840), grading_seed(841))
-    stack = render_stack(scene, seeds, integrator="path", spp=8, max_depth=100, russian_roulette=3)
     values = stack[..., 0].ravel()
     mean, se = values.mean(), values.std(ddof=1) / math.sqrt(values.size)
     z = (mean - le / (1 - rho)) / se
-    assert values.size == PIXELS and abs(z) < Z, (
+    assert values.size == PIXELS and np.isfinite(values).all() and abs(z) < Z, (
         f"PathIntegrator.compute_scattering (rtpy/integrators/path.py): inside a closed sphere of "
         f"albedo {rho:.3f} emitting {le:.3f}, every pixel must converge to Le / (1 - albedo) = "
         f"{le / (1 - rho):.4f}; got {mean:.4f} +- {se:.4f} (z = {z:.1f})"
