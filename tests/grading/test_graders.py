@@ -610,7 +610,7 @@ def test_graders_pass_on_the_reference(tmp_path, capsys):
             == sum(t["max_score"] for t in results["tests"])
             == sum(t.points for t in week_map.graded)
         )
-        keys = {"name", "number", "score", "max_score", "status", "output"}
+        keys = {"name", "number", "score", "max_score", "status", "output", "visibility"}
         numbers = [t["number"] for t in results["tests"]]
         for task in week_map.tasks:
             tests = [t for t in results["tests"] if t["number"].startswith(f"{task.number}.")]
