@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rtpy.grading import assert_render_matches, load_reference, points, summarize
+from rtpy.grading import assert_render_matches, load_reference, points, reference_summary
 from rtpy.testing import chi2_sf
 
 HERE = Path(__file__).parent
@@ -177,9 +177,7 @@ REFERENCE = {"name": "jittered_sky", "seeds": tuple(range(100, 108)), "spp": 32}
 
 
 def make_reference_summary(probe):
-    settings = dict(RENDER, spp=REFERENCE["spp"])
-    stack = probe.render(scene="week03_sky", seeds=list(REFERENCE["seeds"]), settings=settings)
-    return summarize(stack, REFERENCE["spp"])
+    return reference_summary(probe, "week03_sky", RENDER, REFERENCE)
 
 
 @points(2, task="03.5")

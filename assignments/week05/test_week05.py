@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 import rtpy.testing as rt
-from rtpy.grading import assert_render_matches, load_reference, points, summarize
+from rtpy.grading import assert_render_matches, load_reference, points, reference_summary
 from rtpy.grading.remote_material import RemoteMaterial
 
 HERE = Path(__file__).parent
@@ -229,9 +229,7 @@ REFERENCE = {"name": "direct_area_light", "seeds": tuple(range(100, 108)), "spp"
 
 
 def make_reference_summary(probe):
-    settings = dict(RENDER, spp=REFERENCE["spp"])
-    stack = probe.render(scene="area_light", seeds=list(REFERENCE["seeds"]), settings=settings)
-    return summarize(stack, REFERENCE["spp"])
+    return reference_summary(probe, "area_light", RENDER, REFERENCE)
 
 
 @points(4, task="05.4")

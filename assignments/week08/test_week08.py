@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import rtpy.testing as rt
-from rtpy.grading import assert_render_matches, load_reference, points, summarize
+from rtpy.grading import assert_render_matches, load_reference, points, reference_summary
 from rtpy.grading.remote_material import RemoteMaterial
 
 HERE = Path(__file__).parent
@@ -346,9 +346,7 @@ SCENE = "week08_glossy_balls"
 
 
 def make_reference_summary(probe):
-    settings = dict(RENDER, spp=REFERENCE["spp"])
-    stack = probe.render(scene=SCENE, seeds=list(REFERENCE["seeds"]), settings=settings)
-    return summarize(stack, REFERENCE["spp"])
+    return reference_summary(probe, SCENE, RENDER, REFERENCE)
 
 
 @points(4, task="08.4")

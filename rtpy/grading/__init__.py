@@ -10,6 +10,7 @@ from .graders import (
     grade,
     load_reference,
     points,
+    reference_summary,
     save_reference,
     summarize,
 )
@@ -21,6 +22,7 @@ __all__ = [
     "grade",
     "load_reference",
     "points",
+    "reference_summary",
     "save_reference",
     "summarize",
 ]

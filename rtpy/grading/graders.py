@@ -86,6 +86,17 @@ def save_reference(path: str | Path, summary: dict[str, np.ndarray]) -> None:
     np.savez_compressed(path, **summary)
 
 
+def reference_summary(probe, scene: str, render: dict, reference: dict) -> dict:
+    """What a render grader stores as its reference: the summary of renders of the
+    probes' scene `scene` with the grader's `render` settings, at reference["spp"]
+    with the seeds reference["seeds"] (made with rtpy's solution behind `probe`)."""
+    spp = reference["spp"]
+    settings = dict(render, spp=spp)
+    return summarize(
+        probe.render(scene=scene, seeds=list(reference["seeds"]), settings=settings), spp
+    )
+
+
 def assert_render_matches(stack: np.ndarray, spp: int, reference: dict, what: str) -> None:
     """AssertionError naming the worst block unless the renders agree with the reference
     (and have its shape, and only finite, non-negative pixels)."""
