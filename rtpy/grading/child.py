@@ -206,6 +206,7 @@ def error_reply(exc: BaseException, kind: str, base: Path, task_files: set[str])
         "type": type(exc).__name__,
         "message": str(exc)[:2000],
         "where": list(where) if where else None,
+        "traceback": "".join(traceback.format_exception(exc, limit=-12))[-6000:],
     }
 
 

@@ -332,7 +332,11 @@ def student_error(error, task_files) -> Exception:
         text = f"{name}: {message}" if message else name
         if place:
             text += f" (raised in {place})"
-    return StudentError(text, frame)
+    error_ = StudentError(text, frame)
+    trace = error.get("traceback")
+    if isinstance(trace, str) and trace:  # shown by plain pytest, never in results
+        error_.add_note("The student's process said:\n" + printable(trace, 6000))
+    return error_
 
 
 def kill_tree(proc: subprocess.Popen, user: str | None) -> None:
