@@ -45,14 +45,10 @@ class Graded:
 
     nodeid: str
     name: str  # the first line of its docstring, with a parametrized case's id
-    points: float
+    max_score: float  # its points
     task: str | None  # the id of the task of the week's map it grades ("05.1")
     hidden: bool
     outcome: Outcome | None = None
-
-    @property
-    def max_score(self) -> float:
-        return self.points
 
 
 def probe_registry(probe_modules: list[Path]) -> dict:

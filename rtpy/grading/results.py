@@ -59,8 +59,8 @@ def gradescope_results(
             {
                 "name": f"{group[1]}: {g.name}",
                 "number": f"{group[0]}.{counts[group]}",
-                "score": g.points if outcome.passed else 0.0,
-                "max_score": g.points,
+                "score": g.max_score if outcome.passed else 0.0,
+                "max_score": g.max_score,
                 "status": "passed" if outcome.passed else "failed",
                 "output": explain(outcome, problems or {}, task_functions or [], failed_components),
                 "visibility": "after_due_date" if g.hidden else "visible",

@@ -62,7 +62,7 @@ def run(tmp_path, **limits) -> Judge:
     folder = tmp_path / "assignments" / "week05"
     folder.mkdir(parents=True)
     (folder / "probes.py").write_text(PROBES)
-    (folder / "test_week05.py").write_text(textwrap.dedent(GRADERS))
+    (folder / "test_judged.py").write_text(textwrap.dedent(GRADERS))
     (folder / "conftest.py").write_text("from rtpy.grading.judge import probe  # noqa: F401\n")
     registry = probe_registry([folder / "probes.py"])
     runner = InProcess({"probe_modules": [str(folder / "probes.py")]}, tmp_path)
@@ -72,7 +72,7 @@ def run(tmp_path, **limits) -> Judge:
 def test_outcomes_are_worded_by_the_judge(tmp_path):
     plugin = run(tmp_path, test_timeout=1.0, total_timeout=0.5)
     out = {g.nodeid.split("::")[-1]: g for g in plugin.tests.values()}
-    assert out["test_square"].outcome.passed and out["test_square"].points == 2.0
+    assert out["test_square"].outcome.passed and out["test_square"].max_score == 2.0
     assert out["test_square"].task == "05.1" and out["test_square"].name == "squares"
     assert out["test_wrong"].outcome.output == "square(2) = 4.0, expected 5"
     assert out["test_form"].outcome.output.startswith("the student's code answered in the wrong")
