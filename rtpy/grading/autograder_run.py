@@ -134,41 +134,64 @@ def _stop(signum, frame) -> None:
     raise SystemExit(128 + signum)
 
 
+class Unconfined(Exception):
+    """As root, the student's code cannot be run as an unprivileged user."""
+
+
+def make_user(name: str) -> bool:
+    """Make the system user `name` (no home, no shell); whether it exists now."""
+    if sandbox_ids(name) is None:
+        subprocess.run(
+            ["useradd", "--system", "--no-create-home", "--shell", "/usr/sbin/nologin", name],
+            capture_output=True,
+        )
+    return sandbox_ids(name) is not None
+
+
 def isolation(root: Path, log: list[str]) -> Isolation:
-    """How the child is confined here: as root, by the sandbox user (made when missing,
-    and only when it can run this Python), with the autograder's folders closed."""
+    """How the child is confined here: as root, by a user of this run's own (so that
+    ending every process of the user ends this run's alone, even beside other runs
+    on the machine), else by SANDBOX_USER (made by setup.sh), with the autograder's
+    folders closed to both; without root, not by a user."""
     if not hasattr(os, "geteuid") or os.geteuid() != 0:
         log.append("not root: the student's code runs as this user (no user isolation)")
         return Isolation()
-    if sandbox_ids(SANDBOX_USER) is None:
-        subprocess.run(
-            ["useradd", "--system", "--no-create-home", "--shell", "/usr/sbin/nologin",
-             SANDBOX_USER],
-            capture_output=True,
-        )  # fmt: skip
-    if sandbox_ids(SANDBOX_USER) is None:
-        log.append(f"could not make the user {SANDBOX_USER}: no user isolation")
-        return Isolation()
+    user = f"{SANDBOX_USER}-{secrets.token_hex(4)}"
+    if not make_user(user):
+        user = SANDBOX_USER
+        if not make_user(user):
+            raise Unconfined(f"could not make the user {SANDBOX_USER} (useradd failed)")
     for name in ("source", "submission", "results"):
         folder = root / name
         if folder.exists():
             os.chmod(folder, 0o700)
-    return Isolation(user=SANDBOX_USER)
+    return Isolation(user=user)
 
 
-def can_run_python(isolation_: Isolation, python: str) -> bool:
-    """Can the sandbox user start this Python (its folders may be closed to others)?"""
+def remove_user(user: str | None) -> None:
+    """End every process of this run's user, and remove the user (not SANDBOX_USER)."""
+    ids = sandbox_ids(user)
+    if ids is None:
+        return
+    kill_user(ids[0])
+    if user != SANDBOX_USER:
+        subprocess.run(["userdel", user], capture_output=True)
+
+
+def python_problem(isolation_: Isolation, python: str) -> str:
+    """Why the sandbox user cannot start this Python with numpy (its folders may be
+    closed to others), or ""."""
     ids = sandbox_ids(isolation_.user)
     if ids is None:
-        return True
+        return ""
     try:
         proc = subprocess.run(
             [python, "-I", "-c", "import numpy"], user=ids[0], group=ids[1], extra_groups=[],
-            cwd="/", capture_output=True, env={"PATH": "/usr/bin:/bin"}, timeout=60,
+            cwd="/", capture_output=True, text=True, env={"PATH": "/usr/bin:/bin"}, timeout=60,
         )  # fmt: skip
-    except (OSError, subprocess.TimeoutExpired):
-        return False
-    return proc.returncode == 0
+    except (OSError, subprocess.TimeoutExpired) as err:
+        return repr(err)
+    return "" if proc.returncode == 0 else proc.stderr.strip()[-300:]
 
 
 def make_work_copy(source: Path, dest: Path, week: str) -> Path:
@@ -202,6 +225,7 @@ def seal(work: Path, home: Path, isolation_: Isolation) -> None:
 def grade_submission(root: Path, config: dict, results_path: Path) -> dict:
     log: list[str] = []
     confined = isolation(root, log)
+    user = confined.user
     with tempfile.TemporaryDirectory(prefix="rtpy-judge-") as tmp:
         scratch = Path(tmp)
         source = root / "source" / "repo"
@@ -217,9 +241,7 @@ def grade_submission(root: Path, config: dict, results_path: Path) -> dict:
             run_tests(run)
             return run.results(partial=False)
         finally:
-            ids = sandbox_ids(confined.user)
-            if ids is not None:
-                kill_user(ids[0])
+            remove_user(user)
             for line in run.log:
                 print(line)
 
@@ -237,12 +259,13 @@ def prepare(run: Run, submission: Path, scratch: Path) -> None:
     what was taken and what could not be used."""
     import sys
 
-    if run.isolation.user is not None and not can_run_python(run.isolation, sys.executable):
-        run.log.append(
-            f"the user {run.isolation.user} cannot run {sys.executable}: no user isolation "
-            "(install Python where every user can run it, as setup.sh does)"
+    problem = python_problem(run.isolation, sys.executable)
+    if problem:  # the student's code never runs as root
+        raise Unconfined(
+            f"the user {run.isolation.user} cannot run {sys.executable} ({problem}); as root "
+            "the autograder runs a student's code only as an unprivileged user: install "
+            "Python where every user can run it, as setup.sh does"
         )
-        run.isolation.user = None
     task_files = run.config["task_files"]
     pristine = run.source
     try:

@@ -38,6 +38,14 @@ from rtpy.io.cli import main
 from .test_assignment import MAKING, side_by_side
 
 ROOT = Path(__file__).resolve().parents[2]
+# As root the autograder runs the student's code only as an unprivileged user, who must
+# be able to run the judge's Python (.ci/run makes one: RTPY_SANDBOX_PYTHON); this
+# machine's default Python may live where other users cannot reach it.
+ROOT_USER = hasattr(os, "geteuid") and os.geteuid() == 0
+JUDGE_PYTHON = os.environ.get("RTPY_SANDBOX_PYTHON", "") if ROOT_USER else sys.executable
+needs_judge_python = pytest.mark.skipif(
+    not JUDGE_PYTHON, reason="as root, set RTPY_SANDBOX_PYTHON to a Python every user can run"
+)
 TEST_TIMEOUT = 2  # seconds per test in the broken runs (an endless loop costs this much)
 TOTAL_TIMEOUT = 240
 
@@ -66,7 +74,7 @@ def run_autograder(zip_path: Path, submission: Path, tmp: Path, **env) -> tuple[
         shutil.rmtree(root)
     extract(zip_path, root / "source")
     shutil.copytree(submission, root / "submission")
-    variables = dict(os.environ, AUTOGRADER_ROOT=str(root), PYTHON=sys.executable)
+    variables = dict(os.environ, AUTOGRADER_ROOT=str(root), PYTHON=JUDGE_PYTHON or sys.executable)
     variables.update({k: str(v) for k, v in env.items()})
     start = time.monotonic()
     proc = subprocess.run(
@@ -242,12 +250,14 @@ def checked_weeks(request, built, tmp_path_factory):
     yield from side_by_side(request, "test_the_autograder_of_every_week", check, tmp_path_factory)
 
 
+@needs_judge_python
 @pytest.mark.slow
 @pytest.mark.parametrize("week", WEEKS)
 def test_the_autograder_of_every_week(checked_weeks: dict[str, Future], week):
     checked_weeks[week].result()
 
 
+@needs_judge_python
 @pytest.mark.slow
 def test_week_05_end_to_end(built, tmp_path):
     """A syntax error in light.py: its tests score 0 and say why, the other tests are
@@ -338,3 +348,20 @@ def test_assignments_need_a_source_checkout(tmp_path, capsys, monkeypatch):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and all("needs rtpy's source checkout" in line for line in err)
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not ROOT_USER, reason="the autograder as root")
+def test_as_root_a_students_code_never_runs_as_root(built, tmp_path):
+    """A judge's Python that no unprivileged user can run (this machine's default lives
+    under /root, closed to others): the autograder refuses to grade, score 0, rather
+    than run the student's code as root."""
+    zip_path, student = built("05")
+    root = tmp_path / "closed"
+    (root / "bin").mkdir(parents=True)
+    os.chmod(root, 0o700)
+    python = root / "bin" / "python"
+    python.write_text(f'#!/bin/sh\nexec "{sys.executable}" "$@"\n')
+    python.chmod(0o755)
+    results = run_autograder(zip_path, student, tmp_path, PYTHON=str(python))[0]
+    assert results["score"] == 0 and results["tests"] == []
+    assert "only as an unprivileged user" in results["output"]
