@@ -161,11 +161,18 @@ def isolation(root: Path, log: list[str]) -> Isolation:
         user = SANDBOX_USER
         if not make_user(user):
             raise Unconfined(f"could not make the user {SANDBOX_USER} (useradd failed)")
-    for name in ("source", "submission", "results"):
-        folder = root / name
-        if folder.exists():
-            os.chmod(folder, 0o700)
+    close(root)
     return Isolation(user=user)
+
+
+def close(root: Path) -> None:
+    """Everything of AUTOGRADER_ROOT to root alone (source/, submission/, results/,
+    Gradescope's submission_metadata.json), but the Python environment, venv/, which
+    the sandbox user runs."""
+    os.chmod(root, 0o711)
+    for entry in root.iterdir():
+        if entry.name != "venv" and not entry.is_symlink():
+            os.chmod(entry, 0o700 if entry.is_dir() else 0o600)
 
 
 def remove_user(user: str | None) -> None:

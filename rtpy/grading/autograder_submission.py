@@ -26,6 +26,8 @@ import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .protocol import printable
+
 MAX_FILE_BYTES = 1_000_000  # a task file larger than this is not a student's source
 MAX_UNZIPPED_BYTES = 500_000_000
 MAX_DEPTH = 3  # how far below the submission folder the repository may be
@@ -210,7 +212,7 @@ def import_problem(child, files: list[str], work: Path) -> tuple[str | None, str
         if "Timeout (" in text and "Traceback" not in text:  # faulthandler's dump
             what = f"importing it did not finish within {child.start_timeout:g} s"
         else:
-            what = lines[-1][:300] if lines and "Traceback" in text else str(err)
+            what = printable(lines[-1], 300) if lines and "Traceback" in text else str(err)
         if blamed is None:
             return None, what
         return blamed[0], f"line {blamed[1]}: {what}"

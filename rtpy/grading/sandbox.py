@@ -68,7 +68,7 @@ class Isolation:
     memory_mb: int | None = 4096
     cpu_seconds: int | None = None
     file_mb: int | None = 64
-    processes: int | None = 64
+    processes: int | None = 16
     home: Path | None = None  # the child's HOME and TMPDIR (its user's, when it has one)
 
     def preexec(self):
@@ -174,12 +174,12 @@ class Child:
     # --- the process -------------------------------------------------------------
     def start(self) -> None:
         home = self.isolation.home
-        if home is not None:
-            config_path = home / "child-config.json"
-        else:  # not in the student's repository
-            fd, name = tempfile.mkstemp(prefix="rtpy-child-", suffix=".json")
-            os.close(fd)
-            config_path = self._config_file = Path(name)
+        # A file of the judge's own, never in the child's folders: as root the judge
+        # would follow a link the student's code left there.
+        fd, name = tempfile.mkstemp(prefix="rtpy-child-", suffix=".json")
+        os.close(fd)
+        config_path = self._config_file = Path(name)
+        os.chmod(config_path, 0o644)
         config_path.write_text(json.dumps(self.config), encoding="utf-8")
         command = [self.python, "-I", "-c", BOOT, str(self.work), str(config_path)]
         command.append(str(self.start_timeout))
