@@ -466,10 +466,11 @@ _attack_on_probe(_outlive)
 
 HOME_LINK = """
 import os
-# the judge (root) writes each new child's configuration into this user's HOME: a link
-# left there makes it write through it, wherever it points
+# a judge (root) that wrote each new child's configuration into this user's HOME would
+# write through a link left there, wherever it points
 config = os.path.join(os.environ["HOME"], "child-config.json")
-os.unlink(config)
+if os.path.lexists(config):
+    os.unlink(config)
 os.symlink(@WITNESS@, config)
 _attack_mark("@NAME@-linked")
 """
