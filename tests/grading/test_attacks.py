@@ -30,7 +30,7 @@ in pytest's tmp folder (0700, which alone would stop the sandbox user from reach
 anything). Runs go two at a time: as root the judge makes a user for each run, so
 ending every process of that user ends that run's alone.
 
-Week 05 gets every attack; the other weeks the patching, forging, killing and leaking
+Week 05 gets every attack; the other weeks the patching (all at once), forging and leaking
 ones. All are slow but week 05's pytest patch. Known holes are xfail(strict) with the
 hole as the reason, so that closing one turns its test into a failure to remove the
 mark. test_inflated_noise_cannot_pass_a_wrong_render attacks the render verdict itself.
@@ -862,7 +862,7 @@ def tree_memory_bounded(outcome: Outcome, ctx: Context) -> None:
 
 
 ATTACKS = [
-    Attack("patch_pytest", append_code(PATCH_PYTEST), every_week=True, fast=True),
+    Attack("patch_pytest", append_code(PATCH_PYTEST), fast=True),
     Attack("patch_graders", append_code(PATCH_GRADERS)),
     Attack("patch_rtpy_grading", append_code(PATCH_RTPY_GRADING)),
     Attack("patch_rtpy_testing", append_code(PATCH_RTPY_TESTING)),
@@ -877,7 +877,7 @@ ATTACKS = [
         needs_user=True,
         check=source_unchanged,
     ),
-    Attack("signal_the_judge", append_code(SIGNAL_JUDGE), needs_user=True, every_week=True),
+    Attack("signal_the_judge", append_code(SIGNAL_JUDGE), needs_user=True),
     Attack(
         "link_in_home",
         home_link,
