@@ -11,7 +11,11 @@ from pathlib import Path
 
 import numpy as np
 
-from rtpy.grading import assert_render_matches, load_reference, points, reference_summary
+from rtpy.grading import (
+    assert_renders_match,
+    points,
+    reference_summary,
+)
 from rtpy.testing import chi2_sf
 
 HERE = Path(__file__).parent
@@ -183,11 +187,12 @@ def make_reference_summary(probe):
 @points(2, task="03.5")
 def test_sky_render_matches_reference(probe):
     """jittered render of the sky matches the reference (camera rays and pixel jitter)"""
-    stack = probe.render(scene="week03_sky", seeds=list(SEEDS), settings=RENDER)
-    assert_render_matches(
-        stack,
-        RENDER["spp"],
-        load_reference(HERE / "reference" / f"{REFERENCE['name']}.npz"),
+    assert_renders_match(
+        probe,
+        "week03_sky",
+        SEEDS,
+        RENDER,
+        HERE / "reference" / f"{REFERENCE['name']}.npz",
         "jittered render of the sky (rtpy/camera.py: _ray_through, get_ray) differs from the "
         "reference beyond its noise: rays through the wrong points of the pixels (pixel "
         "(0, 0) is the top-left one; a jittered sample is uniform over -0.5..0.5 around the "

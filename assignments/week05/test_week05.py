@@ -14,7 +14,11 @@ from pathlib import Path
 import numpy as np
 
 import rtpy.testing as rt
-from rtpy.grading import assert_render_matches, load_reference, points, reference_summary
+from rtpy.grading import (
+    assert_renders_match,
+    points,
+    reference_summary,
+)
 from rtpy.grading.remote_material import RemoteMaterial
 
 HERE = Path(__file__).parent
@@ -235,11 +239,12 @@ def make_reference_summary(probe):
 @points(4, task="05.4")
 def test_direct_render_matches_reference(probe):
     """render with an area and a point light matches the reference (light counted once)"""
-    stack = probe.render(scene="area_light", seeds=list(SEEDS), settings=RENDER)
-    assert_render_matches(
-        stack,
-        RENDER["spp"],
-        load_reference(HERE / "reference" / f"{REFERENCE['name']}.npz"),
+    assert_renders_match(
+        probe,
+        "area_light",
+        SEEDS,
+        RENDER,
+        HERE / "reference" / f"{REFERENCE['name']}.npz",
         "direct integrator (rtpy/integrators/direct.py, direct_lighting.py) differs from the "
         "reference beyond its noise. Too bright: emission added twice in "
         "DirectIntegrator.compute_scattering (direct_lighting already weighs the light a "

@@ -22,7 +22,11 @@ import numpy as np
 import pytest
 
 import rtpy.testing as rt
-from rtpy.grading import assert_render_matches, load_reference, points, reference_summary
+from rtpy.grading import (
+    assert_renders_match,
+    points,
+    reference_summary,
+)
 from rtpy.grading.remote_material import RemoteMaterial
 
 HERE = Path(__file__).parent
@@ -352,11 +356,12 @@ def make_reference_summary(probe):
 @points(4, task="08.4")
 def test_path_render_matches_reference(probe):
     """path integrator: three glossy balls under a quad light match the reference"""
-    stack = probe.render(scene=SCENE, seeds=list(SEEDS), settings=RENDER)
-    assert_render_matches(
-        stack,
-        RENDER["spp"],
-        load_reference(HERE / "reference" / f"{REFERENCE['name']}.npz"),
+    assert_renders_match(
+        probe,
+        SCENE,
+        SEEDS,
+        RENDER,
+        HERE / "reference" / f"{REFERENCE['name']}.npz",
         "path integrator (rtpy/integrators/path.py) with the week's materials differs from "
         "the reference beyond its noise. Too bright: light counted twice (MIS weight of "
         "emission found by a bounce) or a weight without 1/pdf; too dark: Russian roulette "

@@ -6,6 +6,7 @@ its own (rtpy.grading.probes, rtpy.grading.child) and verdicts made by the judge
 from .graders import (
     assert_image_matches,
     assert_render_matches,
+    assert_renders_match,
     compare,
     grade,
     load_reference,
@@ -18,6 +19,7 @@ from .graders import (
 __all__ = [
     "assert_image_matches",
     "assert_render_matches",
+    "assert_renders_match",
     "compare",
     "grade",
     "load_reference",

@@ -121,6 +121,14 @@ def assert_render_matches(stack: np.ndarray, spp: int, reference: dict, what: st
     assert result.passed, f"{what}: {result.worst()}"
 
 
+def assert_renders_match(probe, scene: str, seeds, render: dict, reference, what: str) -> None:
+    """Renders of the probes' scene `scene`, one per seed with the `render` settings,
+    agree with the reference summary stored at the path `reference`
+    (assert_render_matches)."""
+    stack = probe.render(scene=scene, seeds=list(seeds), settings=render)
+    assert_render_matches(stack, render["spp"], load_reference(reference), what)
+
+
 def assert_image_matches(
     image: np.ndarray, reference: np.ndarray, what: str, hint: str, rtol: float, atol: float
 ) -> None:
