@@ -232,6 +232,7 @@ def seal(work: Path, home: Path, isolation_: Isolation) -> None:
 def grade_submission(root: Path, config: dict, results_path: Path) -> dict:
     log: list[str] = []
     confined = isolation(root, log)
+    confined.cpu_seconds = int(float(config["total_timeout"])) + 60  # each child's CPU time
     user = confined.user
     with tempfile.TemporaryDirectory(prefix="rtpy-judge-") as tmp:
         scratch = Path(tmp)
