@@ -140,7 +140,10 @@ def cameras(draw) -> dict:
         distance *= 1.5 if distance < 1.0 else 1.0 - 1e-9
         look_at = offset(look_from, scaled(view, distance))
     view = add(look_at, look_from, -1.0)
-    vup = scaled(draw(directions()), draw(LENGTH))
+    vup, up_length = draw(directions()), draw(LENGTH)
+    while not 1e-6 <= norm(scaled(vup, up_length)) <= 1e6:  # rounded out of range
+        up_length *= 1.5 if up_length < 1.0 else 1.0 - 1e-9
+    vup = scaled(vup, up_length)
     if not norm(cross(vup, view)) >= 2e-6 * norm(vup) * norm(view):
         vup = across(view)
     camera = {"look_from": look_from, "look_at": look_at, "vup": vup, "vfov": draw(VFOV)}
