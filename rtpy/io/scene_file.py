@@ -376,7 +376,7 @@ class _Loader(TableReader):
             ),
             material,
         )
-        if not mesh.triangles:
+        if not len(mesh):
             faces = len(obj.triangles)
             detail = f"all {faces} faces are degenerate" if faces else "it has no faces"
             raise self.fail(w, "path", f"empty mesh {resolved}: {detail}")
@@ -388,7 +388,8 @@ class _Loader(TableReader):
                 ).as_warning(),
                 stacklevel=2,
             )
-        return mesh.triangles
+        # A light is one shape: an emitting mesh is its triangles, each an area light.
+        return mesh.triangles if getattr(material, "is_emitter", False) else [mesh]
 
     def build(
         self, w: Where, key: str, make: Callable[[Any], Any], material: Any, found: str = ""
