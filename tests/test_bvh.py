@@ -374,6 +374,17 @@ def test_bvh_hits_equal_brute_force_hits_in_tiny_scenes(example):
     assert first_mismatch(example) is None
 
 
+@settings(max_examples=80, suppress_health_check=[HealthCheck.too_slow])
+@given(scenes_with_queries(rays=8))
+def test_the_readable_builders_tree_finds_the_same_closest_hits(example):
+    scene, rays = example
+    fast, readable = BVH(scene.objects), BVH(scene.objects, readable=True)
+    for ray, interval in rays:
+        lo, hi = interval.min, interval.max
+        assert fast.closest_hit(ray, lo, hi) == readable.closest_hit(ray, lo, hi)
+        assert fast.any_hit(ray, lo, hi) == readable.any_hit(ray, lo, hi)
+
+
 @given(shapes, st.lists(st.tuples(unit_floats, unit_floats), max_size=20))
 def test_bounding_box_contains_the_shape(shape, samples):
     box = shape.bounding_box()

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..bvh_build import build_tree
+from .. import bvh_build
 from .arrays import max3
 from .ray import ray_columns
 
@@ -42,7 +42,7 @@ class BVH:
 
     def __init__(self, lo: np.ndarray | None = None, hi: np.ndarray | None = None, tree=None):
         if tree is None:
-            tree = build_tree(lo, hi)
+            tree = bvh_build.build_tree(lo, hi)
         self.tree = tree
         self.lo, self.hi, self.child, self.count = tree.lo, tree.hi, tree.child, tree.count
         self.order = tree.order
