@@ -196,12 +196,23 @@ class Mesh(Hittable):
         self.normals = shading
         self.face_normals = np.where(smooth[:, None], corner_normals, -1).astype(np.int32)
         self.tree: Tree | None = None
-        self._triangles: list[Triangle | None] = [None] * len(self.faces)
         if len(self.faces):
             from .bvh_build import build_tree
 
             self.tree = build_tree(*self.triangle_boxes())
-        self._bvh = None if self.tree is None else BVH.over_tree(self, self.tree)
+        self.__setstate__({})
+
+    @classmethod
+    def from_arrays(
+        cls, material, vertices, normals, faces, face_normals, tree: Tree, skipped: int = 0
+    ) -> Mesh:
+        """The mesh of arrays a Mesh was built with (its attributes of those names),
+        with its tree, as rtpy.io.mesh_cache reads them back: nothing is computed."""
+        mesh = cls.__new__(cls)
+        mesh.material, mesh.vertices, mesh.normals = material, vertices, normals
+        mesh.faces, mesh.face_normals, mesh.tree, mesh.skipped = faces, face_normals, tree, skipped
+        mesh.__setstate__(mesh.__dict__)
+        return mesh
 
     @classmethod
     def from_obj(cls, path, material, transform: Transform | None = None) -> Mesh:
@@ -236,12 +247,14 @@ class Mesh(Hittable):
         return [self[k] for k in range(len(self))]
 
     def __getstate__(self) -> dict:
-        # The triangles made as objects are made again where they are needed.
-        return {**self.__dict__, "_triangles": None}
+        # The triangles made as objects, and the search over them, are made again
+        # where they are needed.
+        return {k: v for k, v in self.__dict__.items() if k not in ("_triangles", "_bvh")}
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
         self._triangles = [None] * len(self.faces)
+        self._bvh = None if self.tree is None else BVH.over_tree(self, self.tree)
 
     def triangle_boxes(self):
         """(lo, hi), (T, 3) each: every triangle's box as Triangle.bounding_box makes
