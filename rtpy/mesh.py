@@ -47,6 +47,9 @@ class SmoothTriangle(Triangle):
 
     def __init__(self, a: Vec3, b: Vec3, c: Vec3, normals: Sequence[Vec3], material) -> None:
         super().__init__(a, b, c, material)
+        self._shade(normals)
+
+    def _shade(self, normals: Sequence[Vec3]) -> None:
         na, nb, nc = normals
         for name, n in zip(("na", "nb", "nc"), normals, strict=True):
             if not _usable(n):
@@ -230,14 +233,16 @@ class Mesh(Hittable):
         """Triangle k (made on first use, then kept)."""
         tri = self._triangles[k]
         if tri is None:
-            a, b, c = (Vec3(*p) for p in self.vertices.take(self.faces[k], axis=0).tolist())
-            material = self.material
+            # As Triangle(a, b, c, material) or SmoothTriangle(...) make it, but
+            # without checking each point again: the constructor checked them all.
+            a, b, c = (Vec3(*p) for p in self.vertices[self.faces[k]].tolist())
             ns = self.face_normals[k]
-            if ns[0] >= 0:
-                normals = [Vec3(*n) for n in self.normals.take(ns, axis=0).tolist()]
-                tri = SmoothTriangle(a, b, c, normals, material)
-            else:
-                tri = Triangle(a, b, c, material)
+            smooth = ns[0] >= 0
+            kind = SmoothTriangle if smooth else Triangle
+            tri = kind.__new__(kind)
+            tri._place(a, b, c, self.material)
+            if smooth:
+                tri._shade([Vec3(*n) for n in self.normals[ns].tolist()])
             self._triangles[k] = tri
         return tri
 
@@ -249,12 +254,14 @@ class Mesh(Hittable):
     def __getstate__(self) -> dict:
         # The triangles made as objects, and the search over them, are made again
         # where they are needed.
-        return {k: v for k, v in self.__dict__.items() if k not in ("_triangles", "_bvh")}
+        made = ("_triangles", "_bvh", "_last")
+        return {k: v for k, v in self.__dict__.items() if k not in made}
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
         self._triangles = [None] * len(self.faces)
         self._bvh = None if self.tree is None else BVH.over_tree(self, self.tree)
+        self._last: tuple = (None, 0.0, 0)  # hit_t's last hit: (ray, t, triangle)
 
     def triangle_boxes(self):
         """(lo, hi), (T, 3) each: every triangle's box as Triangle.bounding_box makes
@@ -275,12 +282,21 @@ class Mesh(Hittable):
         if self._bvh is None:
             return None
         found = self._bvh.closest_hit(ray, t_min, t_max)
-        return None if found is None else found[1]
+        if found is None:
+            return None
+        self._last = (ray, found[1], found[0])
+        return found[1]
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
-        """The HitInfo of the triangle hit at t: found again by a search of the
-        interval around t alone, which enters only the boxes around that point."""
-        k, _ = self._bvh.closest_hit(ray, math.nextafter(t, -math.inf), math.nextafter(t, math.inf))
+        """The HitInfo of the triangle hit at t: the one hit_t found last when it was
+        this ray and this t (the scene asks right after), else found again by a
+        search of the interval around t alone, which enters only the boxes around
+        that point. Either way the triangle a search of the whole ray finds."""
+        last_ray, last_t, k = self._last
+        if last_ray is not ray or last_t != t:
+            k, _ = self._bvh.closest_hit(
+                ray, math.nextafter(t, -math.inf), math.nextafter(t, math.inf)
+            )
         return self[k].hit_info(ray, t)
 
     def bounding_box(self) -> AABB | None:
