@@ -210,23 +210,28 @@ class BVH:
 
     def lists(self) -> tuple:
         """The tree as Python lists, which the search reads much faster than numpy
-        arrays: (bounds, child, count, axis, order), bounds[i] the tuple
-        (x0, y0, z0, x1, y1, z1) of node i's box. Made on the first search."""
+        arrays: (start, bounds, child, count, axis, order), bounds[i] the tuple
+        (x0, y0, z0, x1, y1, z1) of node i's box, start the nodes a search starts
+        from, the last first. The unbounded objects are one more leaf, last, with an
+        infinite box. Made on the first search."""
         if self._lists is None:
+            bounds, child, count, axis, order, start = [], [], [], [], [], []
             t = self.tree
-            if t is None:
-                self._lists = ([], [], [], [], [])
-            else:
+            if t is not None:
                 import numpy as np
 
                 bounds = list(map(tuple, np.concatenate([t.lo, t.hi], axis=1).tolist()))
-                self._lists = (
-                    bounds,
-                    t.child.tolist(),
-                    t.count.tolist(),
-                    t.axis.tolist(),
-                    t.order.tolist(),
-                )
+                child, count = t.child.tolist(), t.count.tolist()
+                axis, order, start = t.axis.tolist(), t.order.tolist(), [0]
+            if self.unbounded:
+                inf = math.inf
+                start.append(len(bounds))
+                bounds.append((-inf, -inf, -inf, inf, inf, inf))
+                child.append(len(order))
+                count.append(len(self.unbounded))
+                axis.append(0)
+                order = order + self.unbounded
+            self._lists = (start, bounds, child, count, axis, order)
         return self._lists
 
     def closest_hit(self, ray: Ray, t_min: float, t_max: float) -> tuple[int, float] | None:
@@ -244,31 +249,19 @@ class BVH:
         """(index, t) of the closest hit with t_min < t < t_max, or with first=True
         of the first hit found; objects other than `ignore` only.
 
-        The unbounded objects first, then the tree depth first with a stack of
-        nodes; of two children the one on the side the ray comes from along their
+        Depth first with a stack of nodes (the unbounded objects' leaf first); of
+        two children the one on the side the ray comes from along their
         split axis is visited first, and a box is tested against [t_min, best_t]
         when its node comes off the stack, so every hit found shrinks the part of
         the ray still to be searched.
         """
         objects = self.objects
+        start, bounds, child, count, axis, order = self.lists()
         best_t, best_index = t_max, -1
         # The bound passed to hit_t. Once something is hit it is the next float
         # above best_t, so that a hit at the same t still comes back and the list
         # index can decide. (hit_t with a smaller t_max returns the same t or None.)
         limit = t_max
-        for index in self.unbounded:
-            obj = objects[index]
-            if obj is ignore:
-                continue
-            t = obj.hit_t(ray, t_min, limit)
-            if t is not None and (t, index) < (best_t, best_index):
-                if first:
-                    return index, t
-                best_t, best_index = t, index
-                limit = math.nextafter(t, math.inf)
-        bounds, child, count, axis, order = self.lists()
-        if not bounds:
-            return None if best_index < 0 else (best_index, best_t)
         o, d = ray.origin, ray.direction
         ox, oy, oz, dx, dy, dz = o.e0, o.e1, o.e2, d.e0, d.e1, d.e2
         # Per axis: 1 / d (inf where d = 0, see the slab test) and the positions in
@@ -280,7 +273,7 @@ class BVH:
         nx, ny, nz = (0 if ix > 0.0 else 3), (1 if iy > 0.0 else 4), (2 if iz > 0.0 else 5)
         fx, fy, fz = 3 - nx, 5 - ny, 7 - nz
         backward = (nx == 3, ny == 4, nz == 5)  # the ray runs toward -x, -y, -z
-        stack = [0]
+        stack = start[:]
         while stack:
             node = stack.pop()
             # The slab test. The ray is inside the box's x slab for t between

@@ -26,6 +26,7 @@ from rtpy.sphere import Sphere
 from rtpy.triangle import Triangle
 from rtpy.vec3 import Vec3, cross
 
+from .tiers import slow_except
 from .vectors import V
 
 MAT = Lambertian()
@@ -374,8 +375,8 @@ def test_bvh_hits_equal_brute_force_hits_in_tiny_scenes(example):
     assert first_mismatch(example) is None
 
 
-@settings(max_examples=80, suppress_health_check=[HealthCheck.too_slow])
-@given(scenes_with_queries(rays=8))
+@settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow])
+@given(scenes_with_queries(max_objects=16, rays=6))
 def test_the_readable_builders_tree_finds_the_same_closest_hits(example):
     scene, rays = example
     fast, readable = BVH(scene.objects), BVH(scene.objects, readable=True)
@@ -555,7 +556,7 @@ def contains_box(outer: AABB, inner: AABB) -> bool:
     return outer.contains(inner.lo) and outer.contains(inner.hi)
 
 
-@pytest.mark.parametrize("readable", [False, True])
+@pytest.mark.parametrize("readable", slow_except([False, True], False))
 @given(objects=object_lists(max_size=40))
 def test_tree_holds_every_object_once_inside_nested_boxes(readable, objects):
     bvh = BVH(objects, readable=readable)

@@ -18,6 +18,8 @@ from rtpy.bvh import AABB, Tree, build_readable
 from rtpy.bvh_build import build_tree, morton_codes
 from rtpy.vec3 import Vec3
 
+from .tiers import slow_except
+
 
 def check_tree(tree: Tree, lo: np.ndarray, hi: np.ndarray, leaf_size: int) -> None:
     """Every box in exactly one leaf of 1 .. leaf_size boxes, the node boxes exactly
@@ -43,13 +45,24 @@ def check_tree(tree: Tree, lo: np.ndarray, hi: np.ndarray, leaf_size: int) -> No
 coords = st.one_of(st.integers(-4, 4).map(float), st.floats(-1e3, 1e3))
 
 
-@settings(max_examples=50, deadline=None)
-@given(
-    centers=hnp.arrays(np.float64, st.tuples(st.integers(1, 300), st.just(3)), elements=coords),
-    size=st.floats(0.0, 10.0),
-    leaf_size=st.integers(1, 8),
-)
+boxes = {
+    "centers": hnp.arrays(np.float64, st.tuples(st.integers(1, 300), st.just(3)), elements=coords),
+    "size": st.floats(0.0, 10.0),
+    "leaf_size": st.integers(1, 8),
+}
+
+
+@pytest.mark.slow
+@settings(max_examples=100, deadline=None)
+@given(**boxes)
 def test_any_boxes_make_a_tree_holding_each_once_in_nested_boxes(centers, size, leaf_size):
+    lo, hi = centers - size, centers + size
+    check_tree(build_tree(lo, hi, leaf_size), lo, hi, leaf_size)
+
+
+@settings(max_examples=10, deadline=None)
+@given(**boxes)
+def test_any_boxes_make_a_tree_holding_each_once_in_nested_boxes_quick(centers, size, leaf_size):
     lo, hi = centers - size, centers + size
     check_tree(build_tree(lo, hi, leaf_size), lo, hi, leaf_size)
 
@@ -96,7 +109,7 @@ def random_boxes(rng, kind: str, k: int):
     return c - r, c + r
 
 
-@pytest.mark.parametrize("kind", ["sphere", "clumps", "sizes"])
+@pytest.mark.parametrize("kind", slow_except(["sphere", "clumps", "sizes"], "sizes"))
 def test_its_trees_cost_little_more_than_the_readable_builders(kind):
     """The readable builder tries every split of every node; HLBVH's clusters and
     Morton splits cost 5-12 % more here. 1.25 leaves room, and catches a tree split by

@@ -139,13 +139,13 @@ def test_any_text_gets_parse_objs_answer_or_is_left_to_it(text):
     assert disagreement(text) is None
 
 
-@settings(max_examples=40, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow])
 @given(obj_texts())
 def test_any_text_gets_parse_objs_answer_or_is_left_to_it_quick(text):
     assert disagreement(text) is None
 
 
-@settings(max_examples=40, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow])
 @given(obj_texts(clean=True))
 def test_the_usual_shapes_are_read_here(text):
     fast = parse_obj_bytes(text.encode("utf-8"))

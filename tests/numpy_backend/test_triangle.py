@@ -181,3 +181,15 @@ def test_coincident_triangles_give_the_earliest_through_the_bvh():
     d /= np.linalg.norm(d, axis=1)[:, None]
     obj, t = geo.find_intersection(np.zeros((500, 3)), d)
     assert (obj[t < np.inf] == 40).all() and (t < np.inf).sum() > 100
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["spawn", "forkserver"])
+def test_numpy_workers_receive_the_mesh_and_its_tree_and_never_build_one(tmp_path, method):
+    """tests/test_mesh.py's check (a plugin makes a tree built outside the parent an
+    error) on the numpy backend, whose workers make a BatchScene of the mesh."""
+    from ..test_mesh import run_no_rebuild
+
+    done = run_no_rebuild(tmp_path, method, "numpy")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[0] == "numpy same image"
