@@ -186,9 +186,9 @@ def test_coincident_triangles_give_the_earliest_through_the_bvh():
 @pytest.mark.slow
 @pytest.mark.parametrize("method", ["spawn", "forkserver"])
 def test_numpy_workers_receive_the_mesh_and_its_tree_and_never_build_one(tmp_path, method):
-    """tests/test_mesh.py's check (a plugin makes a tree built outside the parent an
+    """tests/test_mesh_workers.py's check (a plugin makes a tree built outside the parent an
     error) on the numpy backend, whose workers make a BatchScene of the mesh."""
-    from ..test_mesh import run_no_rebuild
+    from ..test_mesh_workers import run_no_rebuild
 
     done = run_no_rebuild(tmp_path, method, "numpy")
     assert done.returncode == 0, done.stderr
