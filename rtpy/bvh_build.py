@@ -51,7 +51,6 @@ def build_tree(lo: np.ndarray, hi: np.ndarray, leaf_size: int | None = None) -> 
     order = np.argsort(codes, kind="stable")
     codes = codes[order]
     sorted_lo, sorted_hi = lo.take(order, axis=0), hi.take(order, axis=0)
-    nodes = _Nodes()
     # Clusters: runs of equal top bits.
     cell = codes >> (30 - CLUSTER_BITS)
     first = np.flatnonzero(np.diff(cell)) + 1
@@ -59,6 +58,7 @@ def build_tree(lo: np.ndarray, hi: np.ndarray, leaf_size: int | None = None) -> 
     c_end = np.concatenate([first, [k]]).astype(np.int64)
     c_lo = np.minimum.reduceat(sorted_lo, c_start, axis=0)
     c_hi = np.maximum.reduceat(sorted_hi, c_start, axis=0)
+    nodes = _Nodes(k, len(c_start))
     c_perm = _top_levels(nodes, c_lo, c_hi, c_end - c_start, leaf_size)
     # The primitives in the clusters' final order; node ranges over clusters become
     # ranges over primitives.
@@ -117,63 +117,44 @@ def _area(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 
 
 class _Nodes:
-    """The nodes made so far, in growing lists of arrays, one entry per batch of
-    nodes made together (the children of one level's splits, which are adjacent
-    pairs). `start`, `end` are ranges over clusters during the top levels and over
-    primitives after to_primitives."""
+    """The nodes made so far: node i covers start[i] .. end[i] (clusters during the
+    top levels, primitives after to_primitives); an inner node's children are
+    child[i] and child[i] + 1 (-1: a leaf), split along axis[i]. A tree over K
+    primitives has at most 2 K - 1 nodes."""
 
-    def __init__(self) -> None:
-        self.start = [np.zeros(1, dtype=np.int64)]
-        self.end: list[np.ndarray] = [np.zeros(1, dtype=np.int64)]  # set by the caller
-        self.child: list[np.ndarray] = [np.full(1, -1, dtype=np.int64)]
-        self.axis: list[np.ndarray] = [np.zeros(1, dtype=np.int8)]
-        self.n = 1
-        self.splits: list[np.ndarray] = []  # per level: the nodes split (their ids)
-        self._pending: list[tuple[np.ndarray, np.ndarray]] = []  # (ids, child ids) to write
+    def __init__(self, k: int, root_end: int) -> None:
+        self.start = np.zeros(2 * k, dtype=np.int64)
+        self.end = np.zeros(2 * k, dtype=np.int64)
+        self.child = np.full(2 * k, -1, dtype=np.int64)
+        self.axis = np.zeros(2 * k, dtype=np.int8)
+        self.end[0], self.n = root_end, 1
+        self.splits: list[np.ndarray] = []  # per level: the nodes split then
 
-    def split(self, ids: np.ndarray, middle: np.ndarray, start, end, axis) -> np.ndarray:
-        """Give nodes `ids` (ranges start..end) the children start..middle and
-        middle..end; returns the children's ids, (2 S,) as left, right pairs."""
-        s = len(ids)
-        first = self.n + 2 * np.arange(s, dtype=np.int64)
-        self._pending.append((ids, first, axis))
-        cs = np.empty(2 * s, dtype=np.int64)
-        ce = np.empty(2 * s, dtype=np.int64)
-        cs[0::2], ce[0::2], cs[1::2], ce[1::2] = start, middle, middle, end
-        self.start.append(cs)
-        self.end.append(ce)
-        self.child.append(np.full(2 * s, -1, dtype=np.int64))
-        self.axis.append(np.zeros(2 * s, dtype=np.int8))
-        self.n += 2 * s
+    def split(self, ids: np.ndarray, middle: np.ndarray, axis: np.ndarray) -> np.ndarray:
+        """Give nodes `ids` the children start..middle and middle..end; returns the
+        children's ids, as (left, right) pairs in one (2 S,) array."""
+        first = self.n + 2 * np.arange(len(ids), dtype=np.int64)
+        self.child[ids], self.axis[ids] = first, axis
+        self.start[first], self.end[first] = self.start[ids], middle
+        self.start[first + 1], self.end[first + 1] = middle, self.end[ids]
+        self.n += 2 * len(ids)
         self.splits.append(ids)
         return np.stack([first, first + 1], axis=1).ravel()
 
-    def _flat(self):
-        child = np.concatenate(self.child)
-        axis = np.concatenate(self.axis)
-        for ids, first, ax in self._pending:
-            child[ids] = first
-            axis[ids] = ax
-        self.child, self.axis, self._pending = [child], [axis], []
-        return child, axis
-
     def to_primitives(self, offset: np.ndarray) -> None:
-        start, end = np.concatenate(self.start), np.concatenate(self.end)
-        self.start, self.end = [offset.take(start)], [offset.take(end)]
-
-    def ranges(self, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        start, end = np.concatenate(self.start), np.concatenate(self.end)
-        self.start, self.end = [start], [end]
-        return start.take(ids), end.take(ids)
+        """Ranges over clusters made ranges over primitives (offset: the first
+        primitive of each position of the clusters' order)."""
+        n = self.n
+        self.start[:n], self.end[:n] = offset[self.start[:n]], offset[self.end[:n]]
 
     def tree(self, sorted_lo, sorted_hi, order) -> Tree:
-        child, axis = self._flat()
-        start, end = np.concatenate(self.start), np.concatenate(self.end)
+        n = self.n
+        start, end, child = self.start[:n], self.end[:n], self.child[:n]
         leaf = child < 0
         count = np.where(leaf, end - start, 0)
         child = np.where(leaf, start, child)
-        lo = np.empty((self.n, 3))
-        hi = np.empty((self.n, 3))
+        lo = np.empty((n, 3))
+        hi = np.empty((n, 3))
         # The leaves' ranges partition the primitives: in the order of their starts,
         # reduceat over those starts gives their boxes.
         leaves = np.flatnonzero(leaf)
@@ -187,6 +168,7 @@ class _Nodes:
             c = child[ids]
             lo[ids] = np.minimum(lo[c], lo[c + 1])
             hi[ids] = np.maximum(hi[c], hi[c + 1])
+        axis = self.axis[:n].copy()
         return Tree(lo, hi, child.astype(np.int32), count.astype(np.int32), axis, order)
 
 
@@ -197,8 +179,6 @@ def _top_levels(nodes: _Nodes, c_lo, c_hi, c_count, leaf_size: int) -> np.ndarra
     m = len(c_lo)
     perm = np.arange(m, dtype=np.int64)
     centroid = 0.5 * (c_lo + c_hi)
-    prims = np.concatenate([[0], np.cumsum(c_count)])  # primitives before each position
-    nodes.end = [np.full(1, m, dtype=np.int64)]
     ids = np.zeros(1, dtype=np.int64)
     start, end = np.zeros(1, dtype=np.int64), np.full(1, m, dtype=np.int64)
     while ids.size:
@@ -258,21 +238,17 @@ def _top_levels(nodes: _Nodes, c_lo, c_hi, c_count, leaf_size: int) -> np.ndarra
         middle = start + (length - np.bincount(node, weights=right_side, minlength=s)).astype(
             np.int64
         )
-        children = nodes.split(ids, middle, start, end, axis_of.astype(np.int8))
-        ids = children
-        start = np.stack([start, middle], axis=1).ravel()
-        end = np.stack([middle, end], axis=1).ravel()
-    del prims
+        ids = nodes.split(ids, middle, axis_of.astype(np.int8))
+        start, end = nodes.start[ids], nodes.end[ids]
     return perm
 
 
 def _bottom_levels(nodes: _Nodes, keys: np.ndarray, leaf_size: int) -> None:
     """Split every leaf of more than leaf_size primitives where the highest bit of
     its keys changes (or in the middle where all keys are equal), level by level."""
-    child, _ = nodes._flat()
-    ids = np.flatnonzero(child < 0)
+    ids = np.flatnonzero(nodes.child[: nodes.n] < 0)
     while ids.size:
-        start, end = nodes.ranges(ids)
+        start, end = nodes.start[ids], nodes.end[ids]
         go = end - start > leaf_size
         ids, start, end = ids[go], start[go], end[go]
         if ids.size == 0:
@@ -287,4 +263,4 @@ def _bottom_levels(nodes: _Nodes, keys: np.ndarray, leaf_size: int) -> None:
         middle = np.searchsorted(keys, target, side="left")
         middle = np.where(same, (start + end) // 2, middle)
         axis = np.where(same | (bit >= 30), 0, 2 - bit % 3).astype(np.int8)
-        ids = nodes.split(ids, middle, start, end, axis)
+        ids = nodes.split(ids, middle, axis)
