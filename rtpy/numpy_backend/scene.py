@@ -86,7 +86,8 @@ class BatchScene:
         self.sets: list[PrimitiveSet | None] = [
             SETS[kd]([self.objects[i] for i in g]) if g else None for kd, g in enumerate(groups)
         ]
-        self.sets.extend(MeshSet(self.objects[i]) for i in meshes)
+        # a mesh with no triangles (all degenerate) is a set of none: no set
+        self.sets.extend(MeshSet(self.objects[i]) if size[i] else None for i in meshes)
         distinct: list = []
         ids: dict[int, int] = {}
         obj_material = np.empty(n, dtype=np.int32)

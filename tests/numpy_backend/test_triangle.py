@@ -193,3 +193,17 @@ def test_numpy_workers_receive_the_mesh_and_its_tree_and_never_build_one(tmp_pat
     done = run_no_rebuild(tmp_path, method, "numpy")
     assert done.returncode == 0, done.stderr
     assert done.stdout.split("\n")[0] == "numpy same image"
+
+
+@pytest.mark.parametrize("backend", ["numpy", "scalar"])
+def test_a_mesh_of_degenerate_faces_only_renders_as_nothing(backend):
+    import rtpy
+
+    line = Mesh([(0, 0, -2), (1, 0, -2), (2, 0, -2)], [], [[(0, -1), (1, -1), (2, -1)]], MAT)
+    assert len(line) == 0 and line.skipped == 1
+    scene = Scene([line, Sphere(V((0, 0, -3)), 0.5, MAT)], sky=True)
+    camera = rtpy.Camera(V((0, 0, 0)), V((0, 0, -1)), width=8)
+    image = rtpy.render(scene, camera=camera, spp=1, backend=backend)
+    alone = rtpy.render(Scene([Sphere(V((0, 0, -3)), 0.5, MAT)], sky=True), camera=camera, spp=1,
+                        backend=backend)  # fmt: skip
+    assert np.array_equal(image.linear, alone.linear)
