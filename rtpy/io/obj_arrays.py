@@ -63,8 +63,10 @@ def parse_obj_bytes(raw: bytes) -> ObjMesh | None:
         return None
     if not raw.isascii() and any(c in raw.decode("utf-8") for c in WIDE_SPLITTERS):
         return None
-    buf = np.frombuffer(raw + b"\n\n\n", dtype=np.uint8)
-    newline = np.flatnonzero(buf[: len(raw)] == 10)
+    if not raw:
+        return ObjMesh(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3, 2), dtype=np.int64))
+    buf = np.frombuffer(raw, dtype=np.uint8)
+    newline = np.flatnonzero(buf == 10)
     starts = np.concatenate([[0], newline + 1])
     ends = np.concatenate([newline, [len(raw)]])
     kind = _line_kinds(raw, buf, starts, ends)
@@ -85,7 +87,11 @@ def _line_kinds(raw: bytes, buf, starts, ends) -> np.ndarray | None:
     """Each line's statement (V, VN, VT, F or SKIP), from its first bytes; the few
     other lines are read in Python: blank, a comment or an ignored statement (SKIP),
     else None (something obj.py must read: a statement after blanks, an unknown one)."""
-    b0, b1, b2 = buf[starts], buf[starts + 1], buf[starts + 2]
+    length = ends - starts
+    last = len(buf) - 1  # (buf is not empty)
+    b0, b1, b2 = (  # a line's first three bytes, a newline past its end
+        np.where(length > i, buf[np.minimum(starts + i, last)], 10) for i in range(3)
+    )
     blank1 = (b1 == 32) | (b1 == 9)
     blank2 = (b2 == 32) | (b2 == 9)
     v = b0 == ord("v")
@@ -95,7 +101,6 @@ def _line_kinds(raw: bytes, buf, starts, ends) -> np.ndarray | None:
     kind[v & (b1 == ord("t")) & blank2] = VT
     kind[(b0 == ord("f")) & blank1] = F
     kind[b0 == ord("#")] = SKIP
-    length = ends - starts
     kind[(length == 0) | ((length == 1) & (b0 == 13))] = SKIP
     for i in np.flatnonzero(kind == OTHER).tolist():
         words = raw[starts[i] : ends[i]].decode("utf-8").split("#", 1)[0].split()
