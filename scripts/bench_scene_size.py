@@ -249,11 +249,11 @@ def ratios(rows: list[dict]) -> list[str]:
         first = big[f"{backend} first"] / base[f"{backend} first"]
         again = big[f"{backend} again"] / base[f"{backend} again"]
         peak = max(big[f"{backend} first MB"], big[f"{backend} again MB"])
+        memory = f" (goal: at most {MEMORY_GOAL_MB} MB)" if backend == "numpy" else ""
         lines.append(
             f"- {backend}, {big['triangles']:,} / {base['triangles']:,} triangles, whole "
             f"process: {first:.1f}x the first time, {again:.1f}x again (goal: at most "
-            f"{goal:g}x); peak {peak:.0f} MB (goal for the numpy backend: at most "
-            f"{MEMORY_GOAL_MB} MB)"
+            f"{goal:g}x); peak {peak:.0f} MB{memory}"
         )
     big = rows[-1]
     if "mitsuba" in big and "mitsuba" in base:
