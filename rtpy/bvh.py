@@ -50,6 +50,7 @@ BOX_PADDING = 1e-9
 ROUNDING_MARGIN = 1e-8
 LEAF_SIZE = 4  # at most this many objects in a leaf
 TRAVERSAL_COST = 2.0  # cost of visiting a node, in units of one object's hit test
+READABLE_MAX = 32  # BVH builds trees of fewer objects with build_readable (as fast there)
 
 
 class AABB:
@@ -168,12 +169,13 @@ class BVH:
 
     margin   how much every object's box is grown; None: ROUNDING_MARGIN times the
              largest coordinate magnitude of all the boxes
-    readable True: built by build_readable (this module, plain Python), else by
-             rtpy.bvh_build (numpy, thousands of times faster on large lists)
+    readable True: built by build_readable (this module, plain Python); False: by
+             rtpy.bvh_build (numpy, hundreds of times faster on large lists); None:
+             the readable builder below READABLE_MAX objects, where it is as fast
     """
 
     def __init__(
-        self, objects: Sequence[Hittable], margin: float | None = None, readable: bool = False
+        self, objects: Sequence[Hittable], margin: float | None = None, readable: bool | None = None
     ) -> None:
         self.objects = list(objects)
         self.unbounded: list[int] = []
@@ -191,6 +193,8 @@ class BVH:
         boxes = [box.grown(margin) for box in boxes]
         self.tree: Tree | None = None
         if boxes:
+            if readable is None:
+                readable = len(boxes) < READABLE_MAX
             tree = build_readable(boxes) if readable else _build_fast(boxes)
             # positions among the bounded objects -> indices in `objects`
             tree.order = _take(bounded, tree.order)
