@@ -4,8 +4,14 @@ A ray that misses a box cannot hit anything inside it. A BVH is a binary tree of
 axis-aligned bounding boxes (AABBs): each leaf holds a few objects, each interior
 node the box around its two children. A ray tests the root's box, then only the
 children whose boxes it enters, so it visits about log2(n) levels instead of n
-objects. The tree is built top down, each node's objects split in two where the
-surface area heuristic (SAH) predicts the fewest tests per ray.
+objects.
+
+The tree is stored flat (Tree): arrays of boxes, children and leaves, which both
+backends search and which travel to worker processes as they are. It is built by
+rtpy/bvh_build.py (numpy: Morton codes, then the surface area heuristic, a million
+boxes in about a second) or, for reading, by build_readable below: top down, each
+node's objects split where the surface area heuristic (SAH) predicts the fewest
+tests per ray. Both trees give the same answers.
 
 Conventions:
 
@@ -44,6 +50,7 @@ BOX_PADDING = 1e-9
 ROUNDING_MARGIN = 1e-8
 LEAF_SIZE = 4  # at most this many objects in a leaf
 TRAVERSAL_COST = 2.0  # cost of visiting a node, in units of one object's hit test
+READABLE_MAX = 32  # BVH builds trees of fewer objects with build_readable (as fast there)
 
 
 class AABB:
@@ -124,33 +131,33 @@ class AABB:
         )
 
 
-class BVHNode:
-    """A box and either two children (interior node) or a few objects (leaf).
+class Tree:
+    """A BVH as flat arrays, the form both backends search and workers receive.
 
-    `items` holds a leaf's objects with their positions in the scene's list, as
-    (index, object) pairs; it is None for an interior node. An interior node's
-    objects were split along `axis` (0, 1, 2: x, y, z), those with the smaller
-    centroids going left. The box is kept as `bounds` = (x0, y0, z0, x1, y1, z1),
-    the form the search reads.
+    Node 0 is the root; node i has the box lo[i] .. hi[i]. An inner node
+    (count[i] == 0) has the children child[i] and child[i] + 1, its primitives
+    split along axis[i] (0, 1, 2: x, y, z), the left child's lower along it. A leaf
+    holds the count[i] primitives order[child[i] : child[i] + count[i]] (indices
+    into the list the tree was built over). numpy arrays: lo, hi (n, 3) float64;
+    child, count (n,) int32; axis (n,) int8; order (K,) int.
     """
 
-    __slots__ = ("bounds", "left", "right", "items", "axis")
+    def __init__(self, lo, hi, child, count, axis, order) -> None:
+        self.lo, self.hi, self.child, self.count, self.axis = lo, hi, child, count, axis
+        self.order = order
 
-    def __init__(
-        self,
-        box: AABB,
-        left: BVHNode | None = None,
-        right: BVHNode | None = None,
-        items: list[tuple[int, Hittable]] | None = None,
-        axis: int = 0,
-    ) -> None:
-        self.bounds = (box.x0, box.y0, box.z0, box.x1, box.y1, box.z1)
-        self.left, self.right, self.items, self.axis = left, right, items, axis
+    def __len__(self) -> int:
+        """The number of nodes."""
+        return len(self.count)
 
-    @property
-    def box(self) -> AABB:
-        b = self.bounds
-        return AABB(Vec3(b[0], b[1], b[2]), Vec3(b[3], b[4], b[5]))
+    def depth(self) -> int:
+        """The number of levels (a lone leaf is 1)."""
+        levels, frontier = 0, [0]
+        child, count = self.child.tolist(), self.count.tolist()
+        while frontier:
+            levels += 1
+            frontier = [c for i in frontier if count[i] == 0 for c in (child[i], child[i] + 1)]
+        return levels
 
 
 class BVH:
@@ -158,35 +165,81 @@ class BVH:
 
     Built once from the list; it does not see later changes to the list (Scene
     rebuilds it). Objects whose bounding_box() is None or not finite (unbounded
-    shapes) are kept out of the tree, in a leaf of their own with an infinite box,
-    which the search visits first on every ray.
+    shapes) are kept out of the tree; the search tests them first on every ray.
 
-    margin  how much every object's box is grown; None: ROUNDING_MARGIN times the
-            largest coordinate magnitude of all the boxes
+    margin   how much every object's box is grown; None: ROUNDING_MARGIN times the
+             largest coordinate magnitude of all the boxes
+    readable True: built by build_readable (this module, plain Python); False: by
+             rtpy.bvh_build (numpy, hundreds of times faster on large lists); None:
+             the readable builder below READABLE_MAX objects, where it is as fast
     """
 
-    def __init__(self, objects: Sequence[Hittable], margin: float | None = None) -> None:
-        self.unbounded: list[tuple[int, Hittable]] = []
-        bounded: list[tuple[int, Hittable, AABB]] = []
+    def __init__(
+        self, objects: Sequence[Hittable], margin: float | None = None, readable: bool | None = None
+    ) -> None:
+        self.objects = list(objects)
+        self.unbounded: list[int] = []
+        bounded: list[int] = []
+        boxes: list[AABB] = []
         for index, obj in enumerate(objects):
             box = obj.bounding_box()
             if box is None or not box.is_finite():
-                self.unbounded.append((index, obj))
+                self.unbounded.append(index)
             else:
-                bounded.append((index, obj, box))
+                bounded.append(index)
+                boxes.append(box)
         if margin is None:
-            margin = ROUNDING_MARGIN * max((box.magnitude() for _, _, box in bounded), default=0.0)
-        bounded = [(index, obj, box.grown(margin)) for index, obj, box in bounded]
-        self.root: BVHNode | None = _build(bounded) if bounded else None
-        # Where a search starts, the last first.
-        self.start: list[BVHNode] = [] if self.root is None else [self.root]
-        if self.unbounded:
-            inf = math.inf
-            everywhere = AABB(Vec3(-inf, -inf, -inf), Vec3(inf, inf, inf))
-            self.start.append(BVHNode(everywhere, items=self.unbounded))
+            margin = ROUNDING_MARGIN * max((box.magnitude() for box in boxes), default=0.0)
+        boxes = [box.grown(margin) for box in boxes]
+        self.tree: Tree | None = None
+        if boxes:
+            if readable is None:
+                readable = len(boxes) < READABLE_MAX
+            tree = build_readable(boxes) if readable else _build_fast(boxes)
+            # positions among the bounded objects -> indices in `objects`
+            tree.order = _take(bounded, tree.order)
+            self.tree = tree
+        self._lists: tuple | None = None
 
-    def closest_hit(self, ray: Ray, t_min: float, t_max: float) -> tuple[Hittable, float] | None:
-        """(object, t) of the closest hit with t_min < t < t_max, ties going to the
+    @classmethod
+    def over_tree(cls, objects: Sequence[Hittable], tree: Tree) -> BVH:
+        """The BVH over objects (every one bounded) whose tree is already built."""
+        bvh = cls.__new__(cls)
+        bvh.objects, bvh.unbounded, bvh.tree, bvh._lists = objects, [], tree, None
+        return bvh
+
+    def __getstate__(self) -> dict:
+        # The search's lists are made again where they are used, from the arrays.
+        return {**self.__dict__, "_lists": None}
+
+    def lists(self) -> tuple:
+        """The tree as Python lists, which the search reads much faster than numpy
+        arrays: (start, bounds, child, count, axis, order), bounds[i] the tuple
+        (x0, y0, z0, x1, y1, z1) of node i's box, start the nodes a search starts
+        from, the last first. The unbounded objects are one more leaf, last, with an
+        infinite box. Made on the first search."""
+        if self._lists is None:
+            bounds, child, count, axis, order, start = [], [], [], [], [], []
+            t = self.tree
+            if t is not None:
+                import numpy as np
+
+                bounds = list(map(tuple, np.concatenate([t.lo, t.hi], axis=1).tolist()))
+                child, count = t.child.tolist(), t.count.tolist()
+                axis, order, start = t.axis.tolist(), t.order.tolist(), [0]
+            if self.unbounded:
+                inf = math.inf
+                start.append(len(bounds))
+                bounds.append((-inf, -inf, -inf, inf, inf, inf))
+                child.append(len(order))
+                count.append(len(self.unbounded))
+                axis.append(0)
+                order = order + self.unbounded
+            self._lists = (start, bounds, child, count, axis, order)
+        return self._lists
+
+    def closest_hit(self, ray: Ray, t_min: float, t_max: float) -> tuple[int, float] | None:
+        """(index, t) of the closest hit with t_min < t < t_max, ties going to the
         object earliest in the list; None when nothing is hit."""
         return self._search(ray, t_min, t_max, None, False)
 
@@ -196,15 +249,23 @@ class BVH:
 
     def _search(
         self, ray: Ray, t_min: float, t_max: float, ignore: Hittable | None, first: bool
-    ) -> tuple[Hittable, float] | None:
-        """(object, t) of the closest hit with t_min < t < t_max, or with first=True
+    ) -> tuple[int, float] | None:
+        """(index, t) of the closest hit with t_min < t < t_max, or with first=True
         of the first hit found; objects other than `ignore` only.
 
-        Depth first with a stack of nodes; of two children the one on the side the
-        ray comes from along their split axis is visited first, and a box is tested
-        against [t_min, best_t] when its node comes off the stack, so every hit found
-        shrinks the part of the ray still to be searched.
+        Depth first with a stack of nodes (the unbounded objects' leaf first); of
+        two children the one on the side the ray comes from along their
+        split axis is visited first, and a box is tested against [t_min, best_t]
+        when its node comes off the stack, so every hit found shrinks the part of
+        the ray still to be searched.
         """
+        objects = self.objects
+        start, bounds, child, count, axis, order = self.lists()
+        best_t, best_index = t_max, -1
+        # The bound passed to hit_t. Once something is hit it is the next float
+        # above best_t, so that a hit at the same t still comes back and the list
+        # index can decide. (hit_t with a smaller t_max returns the same t or None.)
+        limit = t_max
         o, d = ray.origin, ray.direction
         ox, oy, oz, dx, dy, dz = o.e0, o.e1, o.e2, d.e0, d.e1, d.e2
         # Per axis: 1 / d (inf where d = 0, see the slab test) and the positions in
@@ -216,12 +277,7 @@ class BVH:
         nx, ny, nz = (0 if ix > 0.0 else 3), (1 if iy > 0.0 else 4), (2 if iz > 0.0 else 5)
         fx, fy, fz = 3 - nx, 5 - ny, 7 - nz
         backward = (nx == 3, ny == 4, nz == 5)  # the ray runs toward -x, -y, -z
-        best_t, best_index, best_obj = t_max, -1, None
-        # The bound passed to hit_t. Once something is hit it is the next float
-        # above best_t, so that a hit at the same t still comes back and the list
-        # index can decide. (hit_t with a smaller t_max returns the same t or None.)
-        limit = t_max
-        stack = self.start[:]
+        stack = start[:]
         while stack:
             node = stack.pop()
             # The slab test. The ray is inside the box's x slab for t between
@@ -232,7 +288,7 @@ class BVH:
             # where it runs in a face's plane: nan loses every comparison, so it
             # leaves the interval as it is, as a closed box wants. Written out, not
             # as a loop over the axes or a call: this runs for every node visited.
-            b = node.bounds
+            b = bounds[node]
             x0, x1 = (b[nx] - ox) * ix, (b[fx] - ox) * ix
             y0, y1 = (b[ny] - oy) * iy, (b[fy] - oy) * iy
             enter = x0 if x0 > t_min else t_min
@@ -244,43 +300,58 @@ class BVH:
             z0, z1 = (b[nz] - oz) * iz, (b[fz] - oz) * iz
             if z0 > leave or z1 < enter:
                 continue
-            items = node.items
-            if items is None:
-                if backward[node.axis]:  # the right child, higher along the axis, first
-                    stack.append(node.left)
-                    stack.append(node.right)
+            n, c = count[node], child[node]
+            if n == 0:
+                if backward[axis[node]]:  # the right child, higher along the axis, first
+                    stack.append(c)
+                    stack.append(c + 1)
                 else:
-                    stack.append(node.right)
-                    stack.append(node.left)
+                    stack.append(c + 1)
+                    stack.append(c)
                 continue
-            for index, obj in items:
+            for k in range(c, c + n):
+                index = order[k]
+                obj = objects[index]
                 if obj is ignore:
                     continue
                 t = obj.hit_t(ray, t_min, limit)
                 if t is not None and (t, index) < (best_t, best_index):
                     if first:
-                        return obj, t
-                    best_t, best_index, best_obj = t, index, obj
+                        return index, t
+                    best_t, best_index = t, index
                     limit = math.nextafter(t, math.inf)
-        if best_obj is None:
+        if best_index < 0:
             return None
-        return best_obj, best_t
+        return best_index, best_t
 
     def depth(self) -> int:
-        """Number of levels (a lone leaf is 1; an empty tree 0)."""
-
-        def levels(node: BVHNode | None) -> int:
-            if node is None:
-                return 0
-            if node.items is not None:
-                return 1
-            return 1 + max(levels(node.left), levels(node.right))
-
-        return levels(self.root)
+        """Number of levels of the tree (a lone leaf is 1; an empty tree 0)."""
+        return 0 if self.tree is None else self.tree.depth()
 
 
-def _build(items: list[tuple[int, Hittable, AABB]]) -> BVHNode:
-    """The subtree over `items` (index, object, box).
+def _take(values: list[int], positions) -> object:
+    """values[positions] as a numpy array (positions a numpy array)."""
+    import numpy as np
+
+    return np.asarray(values, dtype=np.int64).take(positions)
+
+
+def _build_fast(boxes: list[AABB]) -> Tree:
+    import numpy as np
+
+    from .bvh_build import build_tree
+
+    lo = np.array([(b.x0, b.y0, b.z0) for b in boxes], dtype=np.float64)
+    hi = np.array([(b.x1, b.y1, b.z1) for b in boxes], dtype=np.float64)
+    return build_tree(lo, hi)
+
+
+# --- the readable builder ------------------------------------------------------------
+
+
+def build_readable(boxes: list[AABB]) -> Tree:
+    """The tree over the boxes, top down in plain Python: each node's boxes split in
+    two where the surface area heuristic predicts the fewest tests per ray.
 
     The surface area heuristic: a ray that passes through a box passes through a
     box inside it with a probability of about the ratio of their surface areas.
@@ -288,46 +359,76 @@ def _build(items: list[tuple[int, Hittable, AABB]]) -> BVHNode:
     TRAVERSAL_COST + (area(left) * n_left + area(right) * n_right) / area. A node
     with more than LEAF_SIZE objects is always split, at its cheapest split.
     """
-    box = items[0][2]
-    for _, _, other in items[1:]:
-        box = box.union(other)
-    n = len(items)
-    if n == 1:
-        return BVHNode(box, items=[(items[0][0], items[0][1])])
-    weighted_area, ordered, k, axis = _cheapest_split(items)
-    area = box.surface_area()
-    # leaf cost <= split cost, both multiplied by area (which may be 0 for a flat box)
-    if n <= LEAF_SIZE and n * area <= TRAVERSAL_COST * area + weighted_area:
-        return BVHNode(box, items=[(index, obj) for index, obj, _ in items])
-    return BVHNode(box, left=_build(ordered[:k]), right=_build(ordered[k:]), axis=axis)
+    lo: list[tuple[float, float, float]] = []
+    hi: list[tuple[float, float, float]] = []
+    child: list[int] = []
+    count: list[int] = []
+    axes: list[int] = []
+    order: list[int] = []
+
+    def new_node() -> int:
+        lo.append((0.0, 0.0, 0.0))
+        hi.append((0.0, 0.0, 0.0))
+        child.append(0)
+        count.append(0)
+        axes.append(0)
+        return len(lo) - 1
+
+    def build(node: int, items: list[tuple[int, AABB]]) -> None:
+        box = items[0][1]
+        for _, other in items[1:]:
+            box = box.union(other)
+        lo[node], hi[node] = (box.x0, box.y0, box.z0), (box.x1, box.y1, box.z1)
+        n = len(items)
+        if n > 1:
+            weighted_area, ordered, k, axis = _cheapest_split(items)
+            area = box.surface_area()
+            # leaf cost <= split cost, both multiplied by area (which may be 0 for a flat box)
+            split = n > LEAF_SIZE or n * area > TRAVERSAL_COST * area + weighted_area
+            if split:
+                left = new_node()
+                new_node()  # the right child, always next to the left one
+                child[node], axes[node] = left, axis
+                build(left, ordered[:k])
+                build(left + 1, ordered[k:])
+                return
+        child[node], count[node] = len(order), n
+        order.extend(index for index, _ in items)
+
+    build(new_node(), list(enumerate(boxes)))
+    import numpy as np
+
+    return Tree(
+        np.array(lo),
+        np.array(hi),
+        np.array(child, dtype=np.int32),
+        np.array(count, dtype=np.int32),
+        np.array(axes, dtype=np.int8),
+        np.array(order, dtype=np.int64),
+    )
 
 
 def _cheapest_split(
-    items: list[tuple[int, Hittable, AABB]],
-) -> tuple[float, list[tuple[int, Hittable, AABB]], int, int]:
+    items: list[tuple[int, AABB]],
+) -> tuple[float, list[tuple[int, AABB]], int, int]:
     """(weighted_area, ordered, k, axis): the split into ordered[:k] and ordered[k:]
     with the least weighted_area = area(left) * k + area(right) * (n - k), trying every
     k on each of the three axes with the items sorted by their centroids along it."""
     n = len(items)
-    best: tuple[float, list[tuple[int, Hittable, AABB]], int, int] = (
-        math.inf,
-        items,
-        n // 2,
-        0,
-    )
-    centroids = [item[2].centroid() for item in items]
+    best: tuple[float, list[tuple[int, AABB]], int, int] = (math.inf, items, n // 2, 0)
+    centroids = [box.centroid() for _, box in items]
     for axis in range(3):
         order = sorted(range(n), key=lambda i: centroids[i][axis])
         ordered = [items[i] for i in order]
         right_area = [0.0] * n  # right_area[k]: surface area of the box around ordered[k:]
-        box = ordered[-1][2]
+        box = ordered[-1][1]
         for k in range(n - 1, 0, -1):
-            box = box.union(ordered[k][2])
+            box = box.union(ordered[k][1])
             right_area[k] = box.surface_area()
-        box = ordered[0][2]  # the box around ordered[:k]
+        box = ordered[0][1]  # the box around ordered[:k]
         for k in range(1, n):
             weighted_area = box.surface_area() * k + right_area[k] * (n - k)
             if weighted_area < best[0]:
                 best = (weighted_area, ordered, k, axis)
-            box = box.union(ordered[k][2])
+            box = box.union(ordered[k][1])
     return best

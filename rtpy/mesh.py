@@ -1,8 +1,10 @@
 """Triangle meshes: SmoothTriangle (a triangle with vertex normals), Transform (scale,
-rotate, translate) and Mesh, which turns a mesh's vertices and faces into triangles.
+rotate, translate) and Mesh, the triangles of a mesh as one object of a scene.
 
-A mesh is not one object in the scene: its triangles are, each on its own, so both
-backends put them in their BVHs with the other shapes.
+A mesh is one object of the scene's list, with a BVH of its own over its triangles
+(a tree of trees, as in the compiled renderers): the scene's search meets the
+mesh's box, and the mesh's search its triangles. Its triangles are arrays, not
+objects, until a ray tests one.
 """
 
 from __future__ import annotations
@@ -10,8 +12,19 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from .bvh import AABB, BOX_PADDING, BVH, ROUNDING_MARGIN, Tree
 from .hit_info import HitInfo
-from .io.values import ANGLE, checked, checked_point, checked_scales, checked_vector, point
+from .hittable import Hittable
+from .io.values import (
+    ANGLE,
+    MAX_COORDINATE,
+    MIN_AREA,
+    checked,
+    checked_point,
+    checked_scales,
+    checked_vector,
+    point,
+)
 from .ray import Ray
 from .triangle import Triangle
 from .vec3 import Vec3, dot, unit_vector
@@ -34,6 +47,9 @@ class SmoothTriangle(Triangle):
 
     def __init__(self, a: Vec3, b: Vec3, c: Vec3, normals: Sequence[Vec3], material) -> None:
         super().__init__(a, b, c, material)
+        self._shade(normals)
+
+    def _shade(self, normals: Sequence[Vec3]) -> None:
         na, nb, nc = normals
         for name, n in zip(("na", "nb", "nc"), normals, strict=True):
             if not _usable(n):
@@ -93,6 +109,25 @@ class Transform:
         q = Vec3(n.x() / s.x(), n.y() / s.y(), n.z() / s.z())
         return Vec3(*(dot(r, q) for r in self.rows))
 
+    def points(self, p):
+        """point() of every row of a (K, 3) numpy array, in the same arithmetic (so
+        the same floats, bit for bit)."""
+        return self._rotate(p * self.scale.tolist(), self.translate.tolist())
+
+    def normals(self, n):
+        """normal() of every row of a (K, 3) numpy array, bit for bit."""
+        return self._rotate(n / self.scale.tolist())
+
+    def _rotate(self, q, shift=None):
+        import numpy as np
+
+        out = np.empty_like(q)
+        for i, r in enumerate(self.rows):  # dot(r, q) (+ shift), term by term as dot() adds
+            out[:, i] = q[:, 0] * r.e0 + q[:, 1] * r.e1 + q[:, 2] * r.e2
+            if shift is not None:
+                out[:, i] += shift[i]
+        return out
+
 
 def _rotation(axis: int, angle: float) -> list[list[float]]:
     c, s = math.cos(angle), math.sin(angle)
@@ -113,47 +148,74 @@ def _usable(n: Vec3) -> bool:
     return math.isfinite(length) and length > 0.0
 
 
-class Mesh:
-    """The triangles of a mesh, placed by a transform.
+class Mesh(Hittable):
+    """A triangle mesh, placed by a transform: one object of a scene, its triangles
+    kept as arrays and searched through a BVH of its own.
 
         mesh = Mesh.from_obj("teapot.obj", Lambertian(), Transform(scale=Vec3(0.5, 0.5, 0.5)))
-        scene = Scene([*mesh.triangles, ...])
+        scene = Scene([mesh, ...])
 
-    positions  vertex positions; normals: vertex normals (may be empty)
-    triangles  triples of corners (position index, normal index or None), as
-               rtpy.io.obj.ObjMesh.triangles
-    A triangle whose three corners have non-zero normals is a SmoothTriangle, else
-    a flat Triangle. Faces that are degenerate after the transform (collinear corners) are
-    left out and counted in `skipped`; `triangles` holds the rest.
+    positions  (P, 3) vertex positions; normals: (Q, 3) vertex normals (may be empty)
+    triangles  (T, 3, 2): per triangle, its three corners (position index, normal
+               index or -1 for none), 0-based, as rtpy.io.obj.ObjMesh.triangles; a
+               list of corner triples ((p, n or None), ...) is read too
+    A triangle whose three corners have usable (finite, non-zero) normals is a
+    SmoothTriangle, else a flat Triangle. Faces that are degenerate after the
+    transform (collinear corners) are left out and counted in `skipped`.
+
+    The mesh is built once: the transformed vertices (`vertices`), the faces kept
+    (`faces`, (T, 3) position indices, and `face_normals`, their normal indices or -1
+    on every corner of a flat one) and the tree over them (`tree`, rtpy.bvh.Tree),
+    all numpy arrays, so a million triangles take about a hundred MB and travel to
+    worker processes with the scene as they are. It answers as the list of its
+    triangles would (mesh[k] is triangle k, a Triangle or SmoothTriangle made when a
+    ray first tests it): the closest hit, ties to the triangle earliest in the file.
+    An emitting mesh is a light only as its triangles: Scene([*mesh.triangles]).
     """
 
-    def __init__(
-        self,
-        positions: Sequence[tuple[float, float, float]],
-        normals: Sequence[tuple[float, float, float]],
-        triangles: Sequence[tuple[tuple[int, int | None], ...]],
-        material,
-        transform: Transform | None = None,
-    ) -> None:
+    def __init__(self, positions, normals, triangles, material, transform: Transform | None = None):
+        import numpy as np
+
         transform = transform or Transform()
-        points = [transform.point(Vec3(*p)) for p in positions]
-        for k, p in enumerate(points):
-            checked(f"vertex {k + 1} (after the transform)", point, p.tolist())
-        shading = [transform.normal(Vec3(*n)) for n in normals]
-        self.triangles: list[Triangle] = []
-        self.skipped = 0
-        for corners in triangles:
-            a, b, c = (points[p] for p, _ in corners)
-            ns = [shading[n] for _, n in corners if n is not None]
-            try:
-                if len(ns) == 3 and all(_usable(n) for n in ns):
-                    tri = SmoothTriangle(a, b, c, ns, material)
-                else:
-                    tri = Triangle(a, b, c, material)
-            except ValueError:
-                self.skipped += 1
-                continue
-            self.triangles.append(tri)
+        self.material = material
+        positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+        normals = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+        corners = _corners(triangles, len(positions), len(normals))
+        self.vertices = points = transform.points(positions)
+        _check_vertices(points)
+        shading = transform.normals(normals)
+        faces = corners[:, :, 0]
+        # Triangle's arithmetic: twice the area |(b - a) x (c - a)|, kept from MIN_AREA.
+        a, b, c = (points.take(faces[:, i], axis=0) for i in range(3))
+        n = _cross(b - a, c - a)
+        kept = np.sqrt(n[:, 0] * n[:, 0] + n[:, 1] * n[:, 1] + n[:, 2] * n[:, 2]) >= MIN_AREA
+        self.skipped = int(len(kept) - np.count_nonzero(kept))
+        self.faces = faces.compress(kept, axis=0).astype(np.int32)
+        corner_normals = corners[:, :, 1].compress(kept, axis=0)
+        x, y, z = shading[:, 0], shading[:, 1], shading[:, 2]
+        length = np.sqrt(x * x + y * y + z * z)  # Vec3.length
+        usable = np.append(np.isfinite(length) & (length > 0.0), False)  # [-1]: none
+        smooth = usable[corner_normals].all(axis=1)
+        self.normals = shading
+        self.face_normals = np.where(smooth[:, None], corner_normals, -1).astype(np.int32)
+        self.tree: Tree | None = None
+        if len(self.faces):
+            from .bvh_build import build_tree
+
+            self.tree = build_tree(*self.triangle_boxes())
+        self.__setstate__({})
+
+    @classmethod
+    def from_arrays(
+        cls, material, vertices, normals, faces, face_normals, tree: Tree, skipped: int = 0
+    ) -> Mesh:
+        """The mesh of arrays a Mesh was built with (its attributes of those names),
+        with its tree, as rtpy.io.mesh_cache reads them back: nothing is computed."""
+        mesh = cls.__new__(cls)
+        mesh.material, mesh.vertices, mesh.normals = material, vertices, normals
+        mesh.faces, mesh.face_normals, mesh.tree, mesh.skipped = faces, face_normals, tree, skipped
+        mesh.__setstate__(mesh.__dict__)
+        return mesh
 
     @classmethod
     def from_obj(cls, path, material, transform: Transform | None = None) -> Mesh:
@@ -163,3 +225,120 @@ class Mesh:
 
         obj = read_obj(path)
         return cls(obj.positions, obj.normals, obj.triangles, material, transform)
+
+    def __len__(self) -> int:
+        return len(self.faces)
+
+    def __getitem__(self, k: int) -> Triangle:
+        """Triangle k (made on first use, then kept)."""
+        tri = self._triangles[k]
+        if tri is None:
+            # As Triangle(a, b, c, material) or SmoothTriangle(...) make it, but
+            # without checking each point again: the constructor checked them all.
+            a, b, c = (Vec3(*p) for p in self.vertices[self.faces[k]].tolist())
+            ns = self.face_normals[k]
+            smooth = ns[0] >= 0
+            kind = SmoothTriangle if smooth else Triangle
+            tri = kind.__new__(kind)
+            tri._place(a, b, c, self.material)
+            if smooth:
+                tri._shade([Vec3(*n) for n in self.normals[ns].tolist()])
+            self._triangles[k] = tri
+        return tri
+
+    @property
+    def triangles(self) -> list[Triangle]:
+        """Every triangle, as objects (for a small mesh: a million objects take GBs)."""
+        return [self[k] for k in range(len(self))]
+
+    def __getstate__(self) -> dict:
+        # The triangles made as objects, and the search over them, are made again
+        # where they are needed.
+        made = ("_triangles", "_bvh", "_last")
+        return {k: v for k, v in self.__dict__.items() if k not in made}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._triangles = [None] * len(self.faces)
+        self._bvh = None if self.tree is None else BVH.over_tree(self, self.tree)
+        self._last: tuple = (None, 0.0, 0)  # hit_t's last hit: (ray, t, triangle)
+
+    def triangle_boxes(self):
+        """(lo, hi), (T, 3) each: every triangle's box as Triangle.bounding_box makes
+        it (padded by BOX_PADDING of its magnitude, at least an ulp), grown by
+        ROUNDING_MARGIN of the mesh's magnitude as the BVH grows a scene's boxes."""
+        import numpy as np
+
+        corners = [self.vertices.take(self.faces[:, i], axis=0) for i in range(3)]
+        lo = np.minimum(np.minimum(corners[0], corners[1]), corners[2])
+        hi = np.maximum(np.maximum(corners[0], corners[1]), corners[2])
+        magnitude = np.maximum(np.abs(lo).max(axis=1), np.abs(hi).max(axis=1))
+        pad = np.maximum(BOX_PADDING * magnitude, np.spacing(magnitude))[:, None]
+        margin = ROUNDING_MARGIN * float(magnitude.max()) + pad
+        return lo - margin, hi + margin
+
+    # --- Hittable -----------------------------------------------------------------
+    def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
+        if self._bvh is None:
+            return None
+        found = self._bvh.closest_hit(ray, t_min, t_max)
+        if found is None:
+            return None
+        self._last = (ray, found[1], found[0])
+        return found[1]
+
+    def hit_info(self, ray: Ray, t: float) -> HitInfo:
+        """The HitInfo of the triangle hit at t: the one hit_t found last when it was
+        this ray and this t (the scene asks right after), else found again by a
+        search of the interval around t alone, which enters only the boxes around
+        that point. Either way the triangle a search of the whole ray finds."""
+        last_ray, last_t, k = self._last
+        if last_ray is not ray or last_t != t:
+            k, _ = self._bvh.closest_hit(
+                ray, math.nextafter(t, -math.inf), math.nextafter(t, math.inf)
+            )
+        return self[k].hit_info(ray, t)
+
+    def bounding_box(self) -> AABB | None:
+        if self.tree is None:
+            return None
+        lo, hi = self.tree.lo[0].tolist(), self.tree.hi[0].tolist()
+        return AABB(Vec3(*lo), Vec3(*hi))
+
+
+def _cross(u, v):
+    """cross() of the rows of two (K, 3) arrays, in its arithmetic."""
+    import numpy as np
+
+    out = np.empty_like(u)
+    out[:, 0] = u[:, 1] * v[:, 2] - u[:, 2] * v[:, 1]
+    out[:, 1] = u[:, 2] * v[:, 0] - u[:, 0] * v[:, 2]
+    out[:, 2] = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+    return out
+
+
+def _corners(triangles, n_positions: int, n_normals: int):
+    """The (T, 3, 2) int64 array of the triangles' corners, checked against the
+    counts of positions and normals (ValueError naming `triangles`)."""
+    import numpy as np
+
+    if not isinstance(triangles, np.ndarray):
+        triangles = [[(p, -1 if n is None else n) for p, n in tri] for tri in triangles]
+    corners = np.asarray(triangles, dtype=np.int64).reshape(-1, 3, 2)
+    p, n = corners[:, :, 0], corners[:, :, 1]
+    if p.size and (p.min() < 0 or p.max() >= n_positions):
+        raise ValueError(f"triangles: a position index is outside 0 .. {n_positions - 1}")
+    if n.size and (n.min() < -1 or n.max() >= n_normals):
+        raise ValueError(f"triangles: a normal index is outside -1 .. {n_normals - 1}")
+    return corners
+
+
+def _check_vertices(points) -> None:
+    """The vertices after the transform are points in range: else the error of the
+    first that is not, naming it as `vertex N (after the transform)`."""
+    import numpy as np
+
+    bad = ~(np.abs(points) <= MAX_COORDINATE).all(axis=1)  # nan fails too
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        checked(f"vertex {k + 1} (after the transform)", point, points[k].tolist())

@@ -14,6 +14,7 @@ from .hittable import Hittable
 from .interval import Interval
 from .io.values import checked, string
 from .light import AreaLight, Light, PointLight
+from .mesh import Mesh
 from .ray import Ray
 from .render_settings import SETTINGS, RenderSettings
 from .vec3 import Color
@@ -84,7 +85,15 @@ class Scene:
         self.update_lights()
 
     def update_lights(self) -> None:
-        """Rebuild the light lists; call it after changing objects or point_lights."""
+        """Rebuild the light lists; call it after changing objects or point_lights.
+        An emitting Mesh is refused: a light is one shape, so an emitting mesh goes
+        into the scene as its triangles (Scene([*mesh.triangles]))."""
+        for k, o in enumerate(self.objects):
+            if isinstance(o, Mesh) and getattr(o.material, "is_emitter", False):
+                raise ValueError(
+                    f"objects[{k}]: a Mesh whose material emits must be added as its "
+                    "triangles, each an area light: Scene([*mesh.triangles, ...])"
+                )
         self.area_lights = [
             AreaLight(o) for o in self.objects if getattr(o.material, "is_emitter", False)
         ]
@@ -111,8 +120,8 @@ class Scene:
             found = self.bvh().closest_hit(ray, interval.min, interval.max)
             if found is None:
                 return None
-            obj, t = found
-            return obj.hit_info(ray, t)
+            index, t = found
+            return self._bvh.objects[index].hit_info(ray, t)
         if not self.objects:
             return None  # the sky alone (week 3's scenes, before this method is written)
         # BEGIN SOLUTION week04: the closest hit over all objects (earliest object wins ties)

@@ -29,6 +29,11 @@ class Triangle(FlatShape):
 
     def __init__(self, a: Vec3, b: Vec3, c: Vec3, material) -> None:
         a, b, c = checked_point("a", a), checked_point("b", b), checked_point("c", c)
+        self._place(a, b, c, material)
+
+    def _place(self, a: Vec3, b: Vec3, c: Vec3, material) -> None:
+        """The triangle's edges, normal and the rest, from points already checked (a
+        Mesh checks its vertices all at once)."""
         self.a, self.b, self.c = a, b, c
         self.e1 = b - a
         self.e2 = c - a

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 import rtpy
 import rtpy.bvh
 import rtpy.scene
-from rtpy.bvh import AABB, BVH, BVHNode
+from rtpy.bvh import AABB, BVH, Tree
 from rtpy.hittable import Hittable
 from rtpy.interval import Interval
 from rtpy.materials import Lambertian
@@ -26,6 +26,7 @@ from rtpy.sphere import Sphere
 from rtpy.triangle import Triangle
 from rtpy.vec3 import Vec3, cross
 
+from .tiers import slow_except
 from .vectors import V
 
 MAT = Lambertian()
@@ -374,6 +375,17 @@ def test_bvh_hits_equal_brute_force_hits_in_tiny_scenes(example):
     assert first_mismatch(example) is None
 
 
+@settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow])
+@given(scenes_with_queries(max_objects=16, rays=6))
+def test_the_readable_builders_tree_finds_the_same_closest_hits(example):
+    scene, rays = example
+    fast, readable = BVH(scene.objects, readable=False), BVH(scene.objects, readable=True)
+    for ray, interval in rays:
+        lo, hi = interval.min, interval.max
+        assert fast.closest_hit(ray, lo, hi) == readable.closest_hit(ray, lo, hi)
+        assert fast.any_hit(ray, lo, hi) == readable.any_hit(ray, lo, hi)
+
+
 @given(shapes, st.lists(st.tuples(unit_floats, unit_floats), max_size=20))
 def test_bounding_box_contains_the_shape(shape, samples):
     box = shape.bounding_box()
@@ -449,12 +461,11 @@ def test_the_equality_check_catches_a_missing_tie_rule(monkeypatch):
         """Meets the objects in reverse list order and keeps the first one found."""
 
         def closest_hit(self, ray, t_min, t_max):
-            items = sorted(item for node in leaves(self.root) for item in node.items)
             best = None
-            for _, obj in reversed(items):
-                t = obj.hit_t(ray, t_min, t_max if best is None else best[1])
+            for index in sorted(self.tree.order.tolist(), reverse=True):
+                t = self.objects[index].hit_t(ray, t_min, t_max if best is None else best[1])
                 if t is not None:
-                    best = (obj, t)
+                    best = (index, t)
             return best
 
     monkeypatch.setattr(rtpy.scene, "BVH", LaterObjectsFirst)
@@ -523,40 +534,33 @@ def test_ray_in_the_plane_of_coplanar_triangles():
 # --- the tree ---------------------------------------------------------------
 
 
-def leaves(node: BVHNode | None):
-    if node is None:
-        return
-    if node.items is not None:
-        yield node
-    else:
-        yield from leaves(node.left)
-        yield from leaves(node.right)
-
-
-def check_node(node: BVHNode) -> None:
-    if node.items is not None:
-        assert 1 <= len(node.items) <= rtpy.bvh.LEAF_SIZE
-        for _, obj in node.items:
-            assert contains_box(node.box, obj.bounding_box())
-        return
-    for child in (node.left, node.right):
-        assert contains_box(node.box, child.box)
-        check_node(child)
+def check_tree(tree: Tree, boxes: list[AABB]) -> None:
+    """Every box in exactly one leaf of at most LEAF_SIZE, inside the leaf's box, and
+    every node's box inside its parent's."""
+    lo, hi, child, count = tree.lo.tolist(), tree.hi.tolist(), tree.child, tree.count
+    seen = []
+    for node in range(len(tree)):
+        box = AABB(Vec3(*lo[node]), Vec3(*hi[node]))
+        if count[node] == 0:
+            for c in (child[node], child[node] + 1):
+                assert contains_box(box, AABB(Vec3(*lo[c]), Vec3(*hi[c])))
+            continue
+        assert 1 <= count[node] <= rtpy.bvh.LEAF_SIZE
+        for index in tree.order[child[node] : child[node] + count[node]].tolist():
+            assert contains_box(box, boxes[index])
+            seen.append(index)
+    assert sorted(seen) == list(range(len(boxes)))
 
 
 def contains_box(outer: AABB, inner: AABB) -> bool:
     return outer.contains(inner.lo) and outer.contains(inner.hi)
 
 
-@given(object_lists(max_size=40))
-def test_tree_holds_every_object_once_inside_nested_boxes(objects):
-    bvh = BVH(objects)
-    check_node(bvh.root)
-    indices = sorted(index for node in leaves(bvh.root) for index, _ in node.items)
-    assert indices == list(range(len(objects)))
-    for node in leaves(bvh.root):
-        for index, obj in node.items:
-            assert objects[index] is obj
+@pytest.mark.parametrize("readable", slow_except([False, True], False))
+@given(objects=object_lists(max_size=40))
+def test_tree_holds_every_object_once_inside_nested_boxes(readable, objects):
+    bvh = BVH(objects, readable=readable)
+    check_tree(bvh.tree, [o.bounding_box() for o in objects])
 
 
 def test_nearer_child_first_and_interval_shrinks():
@@ -605,7 +609,7 @@ def test_unbounded_objects_are_tested_on_every_ray():
     objects.insert(4, plane)
     objects.append(Sphere(V(0, 0, -3), 0.4, MAT))  # coincident with objects[6]
     bvh = BVH(objects)
-    assert bvh.unbounded == [(4, plane)]
+    assert bvh.unbounded == [4]
     scene = bvh_scene(objects)
     for direction in (V(0, -1, -1), V(0, 0, -1), V(0.3, -0.01, -1), V(0, 1, 0)):
         ray = Ray(V(0, 0.5, 0), direction)
@@ -618,7 +622,7 @@ def test_empty_and_single_object():
     assert BVH([]).closest_hit(ray, 0.0, INF) is None
     assert not BVH([]).any_hit(ray, 0.0, INF)
     sphere = Sphere(V(0, 0, -3), 1.0, MAT)
-    assert BVH([sphere]).closest_hit(ray, 0.0, INF) == (sphere, 2.0)
+    assert BVH([sphere]).closest_hit(ray, 0.0, INF) == (0, 2.0)
     assert BVH([sphere]).any_hit(ray, 0.0, INF)
 
 

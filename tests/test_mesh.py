@@ -6,15 +6,19 @@ from __future__ import annotations
 import math
 import random
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from rtpy.bench.meshes import uv_sphere
 from rtpy.hit_info import HitInfo
 from rtpy.interval import Interval
 from rtpy.materials import Lambertian
 from rtpy.mesh import Mesh, SmoothTriangle, Transform
 from rtpy.ray import Ray
+from rtpy.scene import Scene
+from rtpy.sphere import Sphere
 from rtpy.triangle import Triangle
 from rtpy.vec3 import Vec3, cross, dot, unit_vector
 
@@ -167,3 +171,135 @@ def test_from_obj_reads_a_file(tmp_path):
     mesh = Mesh.from_obj(path, MAT, Transform(scale=V(2, 2, 2)))
     assert [type(t) for t in mesh.triangles] == [SmoothTriangle, SmoothTriangle]
     assert mesh.triangles[1].c == V(0, 2, 0)
+
+
+# --------------------------------------------------------------------------- Mesh as one object
+
+
+SPHERE_FACES = len(uv_sphere(600)[1])
+
+
+def sphere_and_soup(seed: int = 1) -> Mesh:
+    """A UV sphere of about 600 triangles, smooth, then 20 random flat triangles
+    crossing it, the first 5 of them again (coincident: ties go to the earlier), and
+    a degenerate one."""
+    rng = np.random.default_rng(seed)
+    positions, faces = uv_sphere(600)
+    soup = rng.uniform(-1.5, 1.5, (60, 3))
+    soup_faces = len(positions) + np.arange(60).reshape(20, 3)
+    soup_faces = np.concatenate([soup_faces, soup_faces[:5], [[0, 0, 1]]])  # repeats, degenerate
+    points = np.concatenate([positions, soup])
+    corners = np.stack([faces, faces], axis=2)  # smooth: the normal index is the vertex's
+    flat = np.stack([soup_faces, np.full(soup_faces.shape, -1)], axis=2)
+    triangles = np.concatenate([corners, flat])
+    return Mesh(points, positions, triangles, MAT, Transform(V(0.2, 0, -3), V(10, 20, 30)))
+
+
+def random_queries(rng, n: int):
+    origins = rng.uniform(-4, 4, (n, 3)) + [0.0, 0.0, -3.0]
+    targets = rng.uniform(-1.2, 1.2, (n, 3)) + [0.2, 0.0, -3.0]
+    return [Ray(V(*o), V(*(t - o))) for o, t in zip(origins, targets.tolist(), strict=True)]
+
+
+def bits(hit) -> tuple | None:
+    if hit is None:
+        return None
+    floats = (hit.t, *hit.point, *hit.normal)
+    return (id(hit.obj), hit.front_face, np.array(floats).tobytes())
+
+
+def test_a_mesh_answers_as_the_list_of_its_triangles():
+    mesh = sphere_and_soup()
+    assert mesh.skipped == 1 and len(mesh) == SPHERE_FACES + 25
+    ground = Sphere(V(0, -101, -3), 100, MAT)
+    scene = Scene([ground, mesh])
+    listed = Scene([ground, *mesh.triangles])  # the old form: each triangle an object
+    rng = np.random.default_rng(2)
+    hits = 0
+    for ray in random_queries(rng, 200):
+        got = scene.find_intersection(ray, EVERYWHERE)
+        want = listed.find_intersection(ray, EVERYWHERE, brute_force=True)
+        assert bits(got) == bits(want)
+        hits += got is not None and got.obj is not ground
+        for t_max in (0.5, 3.0):
+            short = Interval(0.0, t_max)
+            assert scene.find_occlusion(ray, short) == listed.find_occlusion(ray, short, True)
+    assert hits > 70
+
+
+def test_coincident_triangles_resolve_to_the_earlier():
+    mesh = sphere_and_soup()
+    first = SPHERE_FACES + 20
+    repeats = {k: k - 20 for k in range(first, first + 5)}  # soup triangles 0-4 again
+    rng = np.random.default_rng(3)
+    seen = 0
+    for ray in random_queries(rng, 3000):
+        t = mesh.hit_t(ray, 0.0, math.inf)
+        if t is None:
+            continue
+        hit = mesh.hit_info(ray, t)
+        k = next(k for k in range(len(mesh)) if mesh[k] is hit.obj)
+        assert k not in repeats
+        seen += k in repeats.values()
+    assert seen > 0
+
+
+def test_the_arrays_are_the_triangles_of_the_old_construction():
+    """Mesh's vectorized transform, degenerate test and smooth test give the floats
+    and the choices of building each triangle as an object (Triangle, SmoothTriangle
+    and Transform.point on Vec3s)."""
+    mesh = sphere_and_soup()
+    t = Transform(V(0.2, 0, -3), V(10, 20, 30))
+    k = 0
+    for tri in mesh.triangles:
+        a = mesh.vertices[mesh.faces[k, 0]]
+        assert tri.a.tolist() == a.tolist()
+        k += 1
+    p = np.random.default_rng(4).normal(size=(50, 3)) * 1e3
+    for row, q in zip(t.points(p).tolist(), p.tolist(), strict=True):
+        assert row == t.point(V(*q)).tolist()
+    for row, q in zip(t.normals(p).tolist(), p.tolist(), strict=True):
+        assert row == t.normal(V(*q)).tolist()
+
+
+@given(st.tuples(*[st.floats(-1, 1)] * 9), st.floats(1e-13, 1e-11))
+def test_degenerate_faces_are_those_triangle_refuses(corners, size):
+    points = np.array(corners).reshape(3, 3) * size * 1e6
+    mesh = Mesh(points, [], [((0, None), (1, None), (2, None))], MAT)
+    try:
+        Triangle(*(V(*p) for p in points.tolist()), MAT)
+        refused = 0
+    except ValueError:
+        refused = 1
+    assert mesh.skipped == refused and len(mesh) == 1 - refused
+
+
+def test_a_vertex_out_of_range_after_the_transform_is_named():
+    with pytest.raises(ValueError, match=r"vertex 2 \(after the transform\)"):
+        Mesh([(0, 0, 0), (1.5, 0, 0), (0, 1, 0)], [], [[(0, -1), (1, -1), (2, -1)]], MAT,
+             Transform(translate=V(0, 0, 0), scale=V(1e6, 1, 1)))  # fmt: skip
+
+
+def test_an_emitting_mesh_is_refused_as_one_object():
+    from rtpy.materials import DiffuseLight
+
+    mesh = Mesh([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [[(0, -1), (1, -1), (2, -1)]],
+                DiffuseLight(Vec3(1, 1, 1)))  # fmt: skip
+    with pytest.raises(ValueError, match=r"objects\[1\]: a Mesh whose material emits"):
+        Scene([Sphere(V(0, 0, 0), 1, MAT), mesh])
+    assert len(Scene(mesh.triangles).area_lights) == 1
+
+
+def test_a_pickled_mesh_keeps_its_arrays_and_tree_not_its_triangle_objects():
+    import pickle
+
+    mesh = sphere_and_soup()
+    mesh[3]  # one triangle made as an object
+    copy = pickle.loads(pickle.dumps(mesh))
+    assert copy._triangles == [None] * len(mesh)
+    for name in ("vertices", "faces", "face_normals", "normals"):
+        assert np.array_equal(getattr(copy, name), getattr(mesh, name))
+    for name in ("lo", "hi", "child", "count", "order"):
+        assert np.array_equal(getattr(copy.tree, name), getattr(mesh.tree, name))
+    ray = random_queries(np.random.default_rng(5), 1)[0]
+    assert copy.hit_t(ray, 0.0, math.inf) == mesh.hit_t(ray, 0.0, math.inf)

@@ -33,7 +33,7 @@ from typing import Any
 from ..camera import Camera
 from ..light import PointLight
 from ..materials import MATERIALS
-from ..mesh import Mesh, Transform
+from ..mesh import Transform
 from ..quad import Quad
 from ..render_settings import (
     MAX_MAX_DEPTH,
@@ -50,7 +50,8 @@ from ..triangle import Triangle
 from ..vec3 import Color, Vec3
 from . import values
 from .material_params import MATERIAL_RANGES, Param, material_parameters
-from .obj import ObjError, read_obj
+from .mesh_cache import load_mesh
+from .obj import ObjError
 from .scene_tables import SceneError, SceneWarning, TableReader
 from .toml_lines import TomlLines, Where, quote_key
 from .values import (
@@ -357,8 +358,9 @@ class _Loader(TableReader):
         material = self.reference(w, t)
         resolved = self.path.parent / rel
         self.files.append(resolved)
+        transform = self.build(w, "scale", lambda _: Transform(translate, rotate, scale), None)
         try:
-            obj = read_obj(resolved)
+            mesh, faces = load_mesh(resolved, material, transform)
         except FileNotFoundError:
             raise self.fail(w, "path", f"OBJ file not found: {resolved}") from None
         except IsADirectoryError:
@@ -368,16 +370,9 @@ class _Loader(TableReader):
         except ObjError as e:
             at = f" line {e.line}" if e.line is not None else ""
             raise self.fail(w, "path", f"{resolved}{at}: {e.detail}") from None
-        mesh = self.build(
-            w,
-            "scale",
-            lambda m: Mesh(
-                obj.positions, obj.normals, obj.triangles, m, Transform(translate, rotate, scale)
-            ),
-            material,
-        )
-        if not mesh.triangles:
-            faces = len(obj.triangles)
+        except (ValueError, ArithmeticError) as e:  # a vertex out of range once placed
+            raise self.fail(w, "scale", str(e)) from None
+        if not len(mesh):
             detail = f"all {faces} faces are degenerate" if faces else "it has no faces"
             raise self.fail(w, "path", f"empty mesh {resolved}: {detail}")
         if mesh.skipped:
@@ -388,7 +383,8 @@ class _Loader(TableReader):
                 ).as_warning(),
                 stacklevel=2,
             )
-        return mesh.triangles
+        # A light is one shape: an emitting mesh is its triangles, each an area light.
+        return mesh.triangles if getattr(material, "is_emitter", False) else [mesh]
 
     def build(
         self, w: Where, key: str, make: Callable[[Any], Any], material: Any, found: str = ""

@@ -1,9 +1,9 @@
 """Culling for primitive sets: a bounding volume hierarchy, and clusters of planar primitives.
 
-BVH is the batched twin of rtpy/bvh.py: a binary tree of axis-aligned boxes (binned
-surface area heuristic) stored as arrays, which all rays of a batch descend together,
-level by level, so a set of hundreds of spheres costs only the boxes and primitives
-each ray comes near.
+BVH is the batched twin of rtpy/bvh.py's search: the same flat tree (rtpy.bvh.Tree,
+built by rtpy/bvh_build.py), which all rays of a batch descend together, level by
+level, so a set of hundreds of spheres or a mesh of a million triangles costs only
+the boxes and primitives each ray comes near.
 
 Clusters serve a brute-force set of planar primitives (a few dozen quads, as the
 Cornell box): connected groups of primitives (the six quads of a box) are culled by
@@ -18,13 +18,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .. import bvh_build
 from .arrays import max3
 from .ray import ray_columns
 
 if TYPE_CHECKING:
     from .hittable import PrimitiveSet
 
-BVH_LEAF_SIZE = 4
 # Clusters hold at least CLUSTER_SIZE primitives, and their box has at most CLUSTER_AREA
 # of the surface area of the whole set's box.
 CLUSTER_SIZE = 3
@@ -34,86 +34,18 @@ BOX_CHUNK = 8192
 
 
 class BVH:
-    """A binary BVH over K axis-aligned boxes (binned SAH), stored as arrays.
+    """The search of an rtpy.bvh.Tree for many rays at once.
 
-    Node i has box lo[i], hi[i]; an inner node has children left[i], right[i]; a
-    leaf (count[i] > 0) holds primitives order[start[i] : start[i] + count[i]].
+    Built from K axis-aligned boxes (rtpy.bvh_build), or given a tree built already
+    (a Mesh's, which travels with the scene to every worker).
     """
 
-    def __init__(self, lo: np.ndarray, hi: np.ndarray, leaf_size: int = BVH_LEAF_SIZE) -> None:
-        k = len(lo)
-        centroid = 0.5 * (lo + hi)
-        nodes_lo, nodes_hi, left, right, start, count = [], [], [], [], [], []
-        order: list[int] = []
-
-        def build(idx: np.ndarray) -> int:
-            node = len(nodes_lo)
-            nodes_lo.append(lo[idx].min(axis=0))
-            nodes_hi.append(hi[idx].max(axis=0))
-            left.append(-1)
-            right.append(-1)
-            start.append(0)
-            count.append(0)
-            split = None if len(idx) <= leaf_size else self._sah_split(idx, lo, hi, centroid)
-            if split is None:
-                start[node] = len(order)
-                count[node] = len(idx)
-                order.extend(idx.tolist())
-                return node
-            a, b = split
-            left[node] = build(a)
-            right[node] = build(b)
-            return node
-
-        build(np.arange(k))
-        self.lo = np.array(nodes_lo)
-        self.hi = np.array(nodes_hi)
-        self.left = np.array(left, dtype=np.int64)
-        self.right = np.array(right, dtype=np.int64)
-        self.start = np.array(start, dtype=np.int64)
-        self.count = np.array(count, dtype=np.int64)
-        self.order = np.array(order, dtype=np.int64)
-
-    @staticmethod
-    def _sah_split(idx, lo, hi, centroid, bins: int = 16):
-        """Split idx in two by the cheapest of `bins` planes per axis (surface area
-        heuristic), or None when keeping a leaf is cheaper. The boxes on either side
-        of every plane come from running min/max over the bins' boxes; of equal costs
-        the first in (axis, plane) order wins."""
-
-        def area(a, b):
-            e = np.maximum(b - a, 0.0)
-            return 2.0 * (e[..., 0] * e[..., 1] + e[..., 1] * e[..., 2] + e[..., 2] * e[..., 0])
-
-        c, box_lo, box_hi, n = centroid[idx], lo[idx], hi[idx], len(idx)
-        leaf_cost = area(box_lo.min(0), box_hi.max(0)) * n
-        cost = np.full((3, bins - 1), np.inf)
-        binned = []
-        for axis in range(3):
-            cmin, cmax = c[:, axis].min(), c[:, axis].max()
-            if not cmax > cmin:
-                binned.append(None)
-                continue
-            b = np.minimum(((c[:, axis] - cmin) / (cmax - cmin) * bins).astype(int), bins - 1)
-            binned.append(b)
-            bin_lo, bin_hi = np.full((bins, 3), np.inf), np.full((bins, 3), -np.inf)
-            np.minimum.at(bin_lo, b, box_lo)
-            np.maximum.at(bin_hi, b, box_hi)
-            n_left = np.cumsum(np.bincount(b, minlength=bins))[:-1]  # for planes 1 .. bins-1
-            left = area(np.minimum.accumulate(bin_lo)[:-1], np.maximum.accumulate(bin_hi)[:-1])
-            right_lo = np.minimum.accumulate(bin_lo[::-1])[::-1][1:]
-            right_hi = np.maximum.accumulate(bin_hi[::-1])[::-1][1:]
-            split = left * n_left + area(right_lo, right_hi) * (n - n_left)
-            cost[axis] = np.where((n_left > 0) & (n_left < n), split, np.inf)
-        axis, plane = np.unravel_index(np.argmin(cost), cost.shape)
-        if cost[axis, plane] < leaf_cost:
-            m = binned[axis] < plane + 1
-            return idx[m], idx[~m]
-        if len(idx) > 4 * BVH_LEAF_SIZE:
-            # All centroids together (or no better split): halve by index.
-            half = len(idx) // 2
-            return idx[:half], idx[half:]
-        return None
+    def __init__(self, lo: np.ndarray | None = None, hi: np.ndarray | None = None, tree=None):
+        if tree is None:
+            tree = bvh_build.build_tree(lo, hi)
+        self.tree = tree
+        self.lo, self.hi, self.child, self.count = tree.lo, tree.hi, tree.child, tree.count
+        self.order = tree.order
 
     def traverse(
         self,
@@ -128,40 +60,47 @@ class BVH:
 
         test(ray_index, prim_index, t_max_pairs) -> t of each (ray, primitive) pair
         (inf for a miss). Returns (t, prim) per ray: t_max and -1 where nothing is
-        hit before t_max. All rays descend the tree together, one level per
+        hit before t_max; of primitives hit at the same t, the one of the smallest
+        index, as the scalar BVH. All rays descend the tree together, one level per
         iteration; leaves found at a level are tested at once and shrink the rays'
         t_max, which prunes the boxes of later levels.
         """
         n = len(o)
         best_t = np.array(t_max, dtype=np.float64, copy=True)
-        best_p = np.full(n, -1, dtype=np.int64)
+        none = np.iinfo(np.int64).max
+        best_p = np.full(n, none, dtype=np.int64)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             safe = np.where(np.abs(d) < 1e-300, np.copysign(1e-300, d), d)
             inv = 1.0 / safe
+        lo, hi, child, count, order = self.lo, self.hi, self.child, self.count, self.order
         ray = np.arange(n)
         node = np.zeros(n, dtype=np.int64)
         done = np.zeros(n, dtype=bool)
         while ray.size:
             ro, ri = o.take(ray, axis=0), inv.take(ray, axis=0)
             with np.errstate(invalid="ignore", over="ignore"):
-                t0 = (self.lo.take(node, axis=0) - ro) * ri
-                t1 = (self.hi.take(node, axis=0) - ro) * ri
+                t0 = (lo.take(node, axis=0) - ro) * ri
+                t1 = (hi.take(node, axis=0) - ro) * ri
             near = max3(np.minimum(t0, t1))
-            lo = np.maximum(t0, t1)
-            far = np.minimum(np.minimum(lo[:, 0], lo[:, 1]), lo[:, 2])
-            keep = (near <= far) & (far > t_min) & (near < best_t.take(ray))
+            np.maximum(t0, t1, out=t1)
+            far = np.minimum(np.minimum(t1[:, 0], t1[:, 1]), t1[:, 2])
+            # near <= best_t: a primitive hit at best_t itself may still win the tie
+            keep = (near <= far) & (far > t_min) & (near <= best_t.take(ray))
             if any_hit:
                 keep &= ~done.take(ray)
             ray, node = ray.compress(keep), node.compress(keep)
-            cnt = self.count.take(node)
+            cnt = count.take(node)
             leaf = cnt > 0
             if leaf.any():
                 lr, ln, cnt = ray.compress(leaf), node.compress(leaf), cnt.compress(leaf)
                 pr = np.repeat(lr, cnt)
-                first = np.repeat(self.start.take(ln) - (np.cumsum(cnt) - cnt), cnt)
-                pp = self.order.take(first + np.arange(len(pr)))
-                t = test(pr, pp, best_t.take(pr))
-                hit = t < best_t.take(pr)
+                first = np.repeat(child.take(ln) - (np.cumsum(cnt) - cnt), cnt)
+                pp = order.take(first + np.arange(len(pr)))
+                bound = best_t.take(pr)
+                if not any_hit:  # past a hit, the next float up: a tie at best_t comes back
+                    bound = np.where(best_p.take(pr) == none, bound, np.nextafter(bound, np.inf))
+                t = test(pr, pp, bound)
+                hit = t < bound
                 if hit.any():
                     pr, pp, t = pr.compress(hit), pp.compress(hit), t.compress(hit)
                     if any_hit:
@@ -169,13 +108,18 @@ class BVH:
                         best_t[pr] = t
                         best_p[pr] = pp
                     else:
+                        before = best_t.take(pr)
                         np.minimum.at(best_t, pr, t)
-                        win = t == best_t.take(pr)
-                        best_p[pr.compress(win)] = pp.compress(win)
+                        after = best_t.take(pr)
+                        best_p[pr.compress(after < before)] = none  # a nearer hit: a new tie
+                        win = t == after
+                        np.minimum.at(best_p, pr.compress(win), pp.compress(win))
                 inner = ~leaf
                 ray, node = ray.compress(inner), node.compress(inner)
             ray = np.concatenate([ray, ray])
-            node = np.concatenate([self.left.take(node), self.right.take(node)])
+            left = child.take(node).astype(np.int64)
+            node = np.concatenate([left, left + 1])
+        best_p[best_p == none] = -1
         return best_t, best_p
 
 

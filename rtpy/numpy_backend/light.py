@@ -56,7 +56,7 @@ class LightTable:
         point_lights = scene.scene.point_lights
         self.point_position = rows_of(p.position for p in point_lights)
         self.point_intensity = rows_of(p.intensity for p in point_lights)
-        index = {id(obj): i for i, obj in enumerate(scene.objects)}
+        index = {id(obj): int(scene.first[i]) for i, obj in enumerate(scene.objects)}
         area = [index[id(a.shape)] for a in scene.scene.area_lights]
         self.area_object = np.array(area, dtype=np.int64)
         self.n_point = len(point_lights)

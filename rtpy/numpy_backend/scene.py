@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from ..mesh import SmoothTriangle
+from ..mesh import Mesh, SmoothTriangle
 from ..quad import Quad
 from ..scene import Scene
 from ..sphere import Sphere
@@ -29,11 +29,11 @@ from .materials import MaterialTable
 from .onb import tangent_of
 from .quad import QuadSet
 from .sphere import SphereSet
-from .triangle import TriangleSet
+from .triangle import MeshSet, TriangleSet
 from .vec3 import row
 
 INF = math.inf
-SPHERE, QUAD, TRIANGLE, OTHER = 0, 1, 2, 3
+SPHERE, QUAD, TRIANGLE, OTHER = 0, 1, 2, 3  # the sets' kinds; each Mesh is a set of its own
 # Exact types: a subclass may override hit_t (tests do), so it goes to the ScalarSet.
 KINDS = {Sphere: SPHERE, Quad: QUAD, Triangle: TRIANGLE, SmoothTriangle: TRIANGLE}
 SETS = (SphereSet, QuadSet, TriangleSet, ScalarSet)
@@ -43,8 +43,13 @@ class BatchScene:
     """A Scene's objects as primitive sets, its materials as a MaterialTable and its
     lights as a LightTable.
 
-    Object i (index into `objects`) is primitive local[i] of sets[kind[i]];
-    material_id[i] is its material's index in materials.materials (the distinct
+    The queries answer with primitive indices: every object is one primitive, except
+    a Mesh, whose triangles are primitives first[i] .. first[i] + len(mesh) - 1 (in
+    the objects' order, so ties go as if its triangles were in the list in its
+    place). Primitive p is primitive local[p] of sets[kind[p]]: sets 0-3 are the
+    spheres, quads, triangles and shapes without a batched twin, then one MeshSet per
+    mesh, which reads the mesh's arrays and tree as they came from the parent.
+    material_id[p] is its material's index in materials.materials (the distinct
     materials in first-use order). need_uv and need_tangent say what the hits of a
     batch must carry (else those fields are unused() zeros); smooth, that some
     triangles shade with interpolated vertex normals.
@@ -54,31 +59,51 @@ class BatchScene:
         self.scene = scene
         self.objects = list(scene.objects)
         n = len(self.objects)
-        self.kind = np.empty(n, dtype=np.int64)
-        self.local = np.empty(n, dtype=np.int64)
         groups: list[list[int]] = [[], [], [], []]
+        meshes: list[int] = []
+        obj_kind = np.empty(n, dtype=np.int32)
+        obj_local = np.zeros(n, dtype=np.int32)
+        size = np.ones(n, dtype=np.int64)
         for i, obj in enumerate(self.objects):
+            if type(obj) is Mesh:
+                obj_kind[i] = len(SETS) + len(meshes)
+                size[i] = len(obj)
+                meshes.append(i)
+                continue
             kind = KINDS.get(type(obj), OTHER)
-            self.kind[i] = kind
-            self.local[i] = len(groups[kind])
+            obj_kind[i] = kind
+            obj_local[i] = len(groups[kind])
             groups[kind].append(i)
-        self.members = [np.array(g, dtype=np.int64) for g in groups]  # set -> object index
+        self.first = np.concatenate([[0], np.cumsum(size)[:-1]]).astype(np.int64)
+        self.kind = np.repeat(obj_kind, size)
+        # local: the objects' positions in their sets, then 0, 1, ... along each mesh
+        self.local = np.repeat(obj_local, size)
+        self.members = [self.first.take(g).astype(np.int32) for g in groups]
+        for i in meshes:
+            along = np.arange(size[i], dtype=np.int32)
+            self.local[self.first[i] : self.first[i] + size[i]] = along
+            self.members.append(along + np.int32(self.first[i]))
         self.sets: list[PrimitiveSet | None] = [
             SETS[kd]([self.objects[i] for i in g]) if g else None for kd, g in enumerate(groups)
         ]
+        # a mesh with no triangles (all degenerate) is a set of none: no set
+        self.sets.extend(MeshSet(self.objects[i]) if size[i] else None for i in meshes)
         distinct: list = []
         ids: dict[int, int] = {}
-        self.material_id = np.empty(n, dtype=np.int64)
+        obj_material = np.empty(n, dtype=np.int32)
         for i, obj in enumerate(self.objects):
             key = id(obj.material)
             if key not in ids:
                 ids[key] = len(distinct)
                 distinct.append(obj.material)
-            self.material_id[i] = ids[key]
+            obj_material[i] = ids[key]
+        self.material_id = np.repeat(obj_material, size)
         self.materials = MaterialTable(distinct)
         self.need_uv = self.materials.reads_uv
         triangles = self.sets[TRIANGLE]
-        self.smooth = triangles is not None and bool(triangles.smooth.any())
+        self.smooth = (triangles is not None and bool(triangles.smooth.any())) or any(
+            bool((self.objects[i].face_normals[:, 0] >= 0).any()) for i in meshes
+        )
         self.need_tangent = self.materials.reads_tangent
         self.lights = LightTable(self)
         self.background_color = row(scene.background)
@@ -87,15 +112,15 @@ class BatchScene:
     def _order(self) -> list[int]:
         # Brute-force sets first: their hits give the BVH traversals a t_max to prune with.
         return sorted(
-            (kd for kd in range(4) if self.sets[kd] is not None),
+            (kd for kd, s in enumerate(self.sets) if s is not None),
             key=lambda kd: (self.sets[kd].bvh is not None, kd == OTHER),
         )
 
     def find_intersection(
         self, o: np.ndarray, d: np.ndarray, t_max: np.ndarray | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Scene.find_intersection(ray, FORWARD) for rays (o, d): (object index (N,), -1
-        for a miss; t (N,)) of each ray's closest hit with 0 < t < t_max (default inf)."""
+        """Scene.find_intersection(ray, FORWARD) for rays (o, d): (primitive index (N,),
+        -1 for a miss; t (N,)) of each ray's closest hit with 0 < t < t_max (default inf)."""
         n = len(o)
         t_best = np.full(n, INF) if t_max is None else np.array(t_max, dtype=np.float64)
         obj = np.full(n, -1, dtype=np.int64)
@@ -119,7 +144,7 @@ class BatchScene:
     ) -> np.ndarray:
         """Scene.find_occlusion(ray, Interval(0, t_max), ignore=...) for rays (o, d):
         (N,) bool, something (glass included) lies on the ray with 0 < t < t_max;
-        ignore: per ray, an object index not to test (-1: none)."""
+        ignore: per ray, a primitive index not to test (-1: none)."""
         blocked = np.zeros(len(o), dtype=bool)
         for kd in self._order():
             live = np.flatnonzero(~blocked)
@@ -159,7 +184,7 @@ class BatchScene:
         """(local indices, [(kind, positions in obj)]) with a slice for a single kind."""
         kinds = self.kind[obj]
         local = self.local[obj]
-        present = [kd for kd in range(4) if self.sets[kd] is not None]
+        present = [kd for kd, s in enumerate(self.sets) if s is not None]
         if len(present) == 1:
             return local, [(present[0], slice(None))]
         groups = [(kd, np.flatnonzero(kinds == kd)) for kd in present]
@@ -224,7 +249,7 @@ class BatchScene:
         if len(kinds) and (kinds == kinds[0]).all():
             return [(self.sets[kinds[0]], self.local[obj], slice(None))]
         out = []
-        for kd in range(4):
+        for kd in range(len(self.sets)):
             i = np.flatnonzero(kinds == kd)
             if i.size:
                 out.append((self.sets[kd], self.local[obj[i]], i))

@@ -1,5 +1,6 @@
-"""TriangleSet: all triangles of a scene as arrays, the batched twin of rtpy/triangle.py
-(and of rtpy/mesh.py's SmoothTriangle, whose vertex normals it interpolates).
+"""TriangleSet: triangles as arrays, the batched twin of rtpy/triangle.py (and of
+rtpy/mesh.py's SmoothTriangle, whose vertex normals it interpolates); MeshSet: the
+triangles of an rtpy.mesh.Mesh, read from its arrays and searched through its tree.
 
 The all-pairs test is Moller-Trumbore in Plucker form, written as (N, 3) x (3, K)
 matrix products; its t agrees with Triangle.hit_t's to ~1e-15.
@@ -11,9 +12,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..mesh import SmoothTriangle
-from ..triangle import Triangle
-from .arrays import at, dot
+from ..mesh import Mesh, SmoothTriangle
+from ..triangle import PARALLEL_TOLERANCE, Triangle
+from .arrays import at, axpy, dot, scale
+from .bvh import BVH
 from .hittable import INF, PlanarSet, area_direction_pdf
 from .vec3 import rows_of
 
@@ -25,6 +27,10 @@ class TriangleSet(PlanarSet):
     N = e1 x e2, det = -(d . N), u det = e2 . m - d . (e2 x a),
     v det = -(e1 . m) - d . (a x e1), t det = o . N - a . N (all K-sided factors
     are precomputed; the ray-sided ones are (N, 3) x (3, K) products).
+
+    The per-triangle rows the kernels read come through _edges, _plucker, _frame and
+    _vertex_normals, which gather them from precomputed arrays here and compute them
+    from a mesh's vertices in MeshSet.
     """
 
     def __init__(self, triangles: Sequence[Triangle], cluster: bool = True) -> None:
@@ -52,6 +58,31 @@ class TriangleSet(PlanarSet):
             s = triangles[i]
             self.vertex_normals[i] = [[n.e0, n.e1, n.e2] for n in (s.na, s.nb, s.nc)]
         self.build_culling(cluster)
+
+    # --- the rows of triangles k -------------------------------------------------
+    def _edges(self, k):
+        """(a, e1, e2) of triangles k."""
+        return at(self.a, k), at(self.e1, k), at(self.e2, k)
+
+    def _plucker(self, k):
+        """(N, e1, e2, e2 x a, a x e1, a . N, parallel_det2) of triangles k."""
+        return (
+            at(self.N, k),
+            at(self.e1, k),
+            at(self.e2, k),
+            at(self.e2xa, k),
+            at(self.axe1, k),
+            at(self.aN, k),
+            at(self.parallel_det2, k),
+        )
+
+    def _frame(self, k):
+        """(unit normal, plane axes (M, 2), plane determinant) of triangles k."""
+        return self.normal.take(k, axis=0), self.plane_axes[k], self.plane_det[k]
+
+    def _vertex_normals(self, k):
+        """(smooth (M,) bool, unit vertex normals (M, 3, 3)) of triangles k."""
+        return self.smooth[k], self.vertex_normals[k]
 
     def corners(self):
         return np.stack([self.a, self.a + self.e1, self.a + self.e2], 1)
@@ -83,24 +114,24 @@ class TriangleSet(PlanarSet):
 
     def hit_t(self, o, d, k, t_min, t_max):
         m = np.cross(o, d)
-        nn = at(self.N, k)
+        nn, e1, e2, e2xa, axe1, an, parallel_det2 = self._plucker(k)
         det = -dot(d, nn)
-        u_num = dot(at(self.e2, k), m) - dot(d, at(self.e2xa, k))
-        v_num = -dot(at(self.e1, k), m) - dot(d, at(self.axe1, k))
-        t_num = dot(o, nn) - at(self.aN, k)
-        parallel = at(self.parallel_det2, k) * dot(d, d)
+        u_num = dot(e2, m) - dot(d, e2xa)
+        v_num = -dot(e1, m) - dot(d, axe1)
+        t_num = dot(o, nn) - an
+        parallel = parallel_det2 * dot(d, d)
         return self._finish(det, parallel, u_num, v_num, t_num, t_min, t_max)
 
     def surface_uv(self, k, point):
         # Triangle.surface_uv: Cramer's rule in each triangle's coordinate plane.
-        p = point - self.a[k]
-        axes = self.plane_axes[k]
+        a, e1, e2 = self._edges(k)
+        _, axes, det = self._frame(k)
+        p = point - a
         i, j = axes[:, :1], axes[:, 1:]
 
         def pick(a, c):  # (N,) components c of the rows of a
             return np.take_along_axis(a, c, axis=1)[:, 0]
 
-        e1, e2, det = self.e1[k], self.e2[k], self.plane_det[k]
         u = (pick(p, i) * pick(e2, j) - pick(p, j) * pick(e2, i)) / det
         v = (pick(e1, i) * pick(p, j) - pick(e1, j) * pick(p, i)) / det
         return np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
@@ -108,12 +139,12 @@ class TriangleSet(PlanarSet):
     def shading_normal(self, k, point, geo):
         """SmoothTriangle.shading_normal at the hits `point` on triangles k (geometric
         normals geo): the interpolated vertex normal on geo's side; geo for flat ones."""
-        smooth = self.smooth[k]
+        smooth, vertex_normals = self._vertex_normals(k)
         if not smooth.any():
             return geo
         u, v = self.surface_uv(k, point)
         w = np.stack([1.0 - u - v, u, v], axis=1)
-        n = np.einsum("ij,ijk->ik", w, self.vertex_normals[k])
+        n = np.einsum("ij,ijk->ik", w, vertex_normals)
         length = np.sqrt(dot(n, n))
         smooth &= length > 0.0
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -123,10 +154,87 @@ class TriangleSet(PlanarSet):
 
     def direction_pdf(self, k, p, q, n):
         # The density of sampling by area uses the geometric normal, not the shading one.
-        return area_direction_pdf(p, q, self.normal[k], self.area(k))
+        return area_direction_pdf(p, q, self._frame(k)[0], self.area(k))
 
     def sample_point(self, k, r1, r2):
         s = np.sqrt(r1)
         wb, wc = s * (1.0 - r2), s * r2
-        p = self.a[k] + wb[:, None] * self.e1[k] + wc[:, None] * self.e2[k]
-        return p, self.normal[k]
+        a, e1, e2 = self._edges(k)
+        p = a + wb[:, None] * e1 + wc[:, None] * e2
+        return p, self._frame(k)[0]
+
+
+class MeshSet(TriangleSet):
+    """The triangles of a Mesh (local index k = the mesh's triangle k), read from the
+    mesh's vertex and face arrays and searched through the tree the mesh was built
+    with: nothing per triangle is computed or copied in the process that renders.
+    The rows the kernels read are computed for the triangles asked for, with the
+    scalar Triangle's arithmetic, so they equal TriangleSet's of the same triangles
+    bit for bit."""
+
+    def __init__(self, mesh: Mesh) -> None:
+        self.mesh = mesh
+        self.vertices, self.faces = mesh.vertices, mesh.faces
+        self.face_normals, self.vertex_normal_rows = mesh.face_normals, mesh.normals
+        self.bvh = BVH(tree=mesh.tree)
+        self.clusters = None
+
+    def __len__(self) -> int:
+        return len(self.faces)
+
+    @property
+    def objects(self):
+        return self.mesh  # mesh[k] is triangle k, as an object (made on first use)
+
+    def _corners(self, k):
+        f = self.faces.take(k, axis=0)
+        return [self.vertices.take(f[..., i], axis=0) for i in range(3)]
+
+    def _edges(self, k):
+        a, b, c = self._corners(k)
+        return a, b - a, c - a
+
+    def _plucker(self, k):
+        a, e1, e2 = self._edges(k)
+        nn = np.cross(e1, e2)
+        l1, l2 = np.sqrt(dot(e1, e1)), np.sqrt(dot(e2, e2))
+        parallel_det2 = np.square(PARALLEL_TOLERANCE * l1 * l2)
+        return nn, e1, e2, np.cross(e2, a), np.cross(a, e1), dot(a, nn), parallel_det2
+
+    def _frame(self, k):
+        _, e1, e2 = self._edges(k)
+        n = np.cross(e1, e2)
+        normal = scale(n, 1.0 / np.sqrt(dot(n, n)))  # Vec3 / length: times 1 / length
+        drop = np.abs(n).argmax(axis=1)  # Triangle's coordinate plane (first largest)
+        axes = np.stack([(drop + 1) % 3, (drop + 2) % 3], axis=1)
+        return normal, axes, np.take_along_axis(n, drop[:, None], axis=1)[:, 0]
+
+    def _vertex_normals(self, k):
+        idx = self.face_normals.take(k, axis=0)
+        smooth = idx[:, 0] >= 0
+        rows = self.vertex_normal_rows
+        if not smooth.any() or not len(rows):
+            return smooth, np.zeros((len(idx), 3, 3))
+        n = rows.take(np.maximum(idx, 0), axis=0)  # (M, 3, 3), as written after the transform
+        length = np.sqrt(dot(n, n))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            n = n * (1.0 / length)[..., None]  # unit_vector: times 1 / length
+        return smooth, n
+
+    def corners(self):
+        return np.stack(self._corners(np.arange(len(self))), axis=1)
+
+    def bounding_boxes(self):
+        return self.mesh.triangle_boxes()
+
+    def area(self, k):
+        _, e1, e2 = self._edges(k)
+        n = np.cross(e1, e2)
+        return 0.5 * np.sqrt(dot(n, n))
+
+    def geometric(self, k, o, d, t):
+        return axpy(t, d, o), self._frame(k)[0]
+
+    def surface_tangent(self, k, point):
+        _, e1, _ = self._edges(k)
+        return scale(e1, 1.0 / np.sqrt(dot(e1, e1))), np.ones(len(k), dtype=bool)

@@ -25,44 +25,44 @@ f 1 2 3 4
 
 def test_positions_normals_and_a_fanned_quad():
     obj = parse_obj(SQUARE)
-    assert obj.positions == [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
-    assert obj.normals == [(0, 0, 1)]
-    # n corners -> n - 2 triangles fanned from the first, in the file's winding
-    assert obj.triangles == [((0, None), (1, None), (2, None)), ((0, None), (2, None), (3, None))]
+    assert obj.positions.tolist() == [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    assert obj.normals.tolist() == [[0, 0, 1]]
+    # n corners -> n - 2 triangles fanned from the first, in the file's winding; -1: no normal
+    assert obj.triangles.tolist() == [[[0, -1], [1, -1], [2, -1]], [[0, -1], [2, -1], [3, -1]]]
 
 
 def test_a_pentagon_becomes_three_triangles():
     text = "".join(f"v {i} {i * i} 0\n" for i in range(5)) + "f 1 2 3 4 5\n"
     tris = parse_obj(text).triangles
-    assert [tuple(p for p, _ in t) for t in tris] == [(0, 1, 2), (0, 2, 3), (0, 3, 4)]
+    assert tris[:, :, 0].tolist() == [[0, 1, 2], [0, 2, 3], [0, 3, 4]]
 
 
 @pytest.mark.parametrize(
     "face, normals",
     [
-        ("f 1 2 3", [None, None, None]),
-        ("f 1/1 2/1 3/1", [None, None, None]),
+        ("f 1 2 3", [-1, -1, -1]),
+        ("f 1/1 2/1 3/1", [-1, -1, -1]),
         ("f 1//1 2//2 3//1", [0, 1, 0]),
         ("f 1/1/2 2/1/1 3/1/2", [1, 0, 1]),
     ],
 )
 def test_corner_forms(face, normals):
     text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nvn 0 1 0\n" + face + "\n"
-    ((a, b, c),) = parse_obj(text).triangles
+    ((a, b, c),) = parse_obj(text).triangles.tolist()
     assert [a[0], b[0], c[0]] == [0, 1, 2]
     assert [a[1], b[1], c[1]] == normals
 
 
 def test_negative_indices_count_back_from_the_last_defined_above_the_face():
     text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf -3//-1 -2//-1 -1//-1\nv 5 5 5\nf -4 -3 -1\n"
-    first, second = parse_obj(text).triangles
-    assert first == ((0, 0), (1, 0), (2, 0))
+    first, second = parse_obj(text).triangles.tolist()
+    assert first == [[0, 0], [1, 0], [2, 0]]
     assert [p for p, _ in second] == [0, 1, 3]  # -1 is now the fourth vertex
 
 
 def test_homogeneous_w_divides_the_position_and_comments_are_ignored():
     obj = parse_obj("v 2 4 6 2   # w = 2\n\n   # only a comment\n")
-    assert obj.positions == [(1, 2, 3)]
+    assert obj.positions.tolist() == [[1, 2, 3]]
 
 
 @pytest.mark.parametrize(
@@ -106,5 +106,5 @@ def test_read_obj_reads_a_file_and_refuses_non_utf8(tmp_path):
 
 
 def test_a_file_with_no_faces_is_read_as_empty():
-    assert parse_obj("v 0 0 0\n").triangles == []
-    assert parse_obj("").positions == []
+    assert parse_obj("v 0 0 0\n").triangles.shape == (0, 3, 2)
+    assert parse_obj("").positions.shape == (0, 3)

@@ -571,19 +571,28 @@ def mesh_error(tmp_path, obj_text, extra="", name="m.obj") -> SceneError:
     return error_of(mesh_scene(tmp_path, obj_text, extra, name), tmp_path / "s.toml")
 
 
-def test_a_mesh_is_its_triangles_placed_by_scale_rotate_translate(tmp_path):
-    from rtpy.mesh import SmoothTriangle
+def test_a_mesh_is_one_object_of_its_triangles_placed_by_scale_rotate_translate(tmp_path):
+    from rtpy.mesh import Mesh, SmoothTriangle
 
     extra = "scale = [2, 1, 1]\nrotate = [0, 0, 90]\ntranslate = [0, 0, -5]\n"
     scene = load_mesh(tmp_path, TETRA, extra)
-    assert len(scene.objects) == 4
-    assert [type(t) for t in scene.objects] == [SmoothTriangle, Triangle, Triangle, Triangle]
-    first = scene.objects[0]
+    (mesh,) = scene.objects
+    assert isinstance(mesh, Mesh) and len(mesh) == 4
+    assert [type(t) for t in mesh.triangles] == [SmoothTriangle, Triangle, Triangle, Triangle]
+    first = mesh[0]
     # b = (1, 0, 0) scaled to (2, 0, 0), turned about z to (0, 2, 0), moved to z = -5
     assert (first.c - Vec3(0, 2, -5)).length() < 1e-12
-    assert all(t.material is scene.objects[0].material for t in scene.objects)
-    uniform = load_mesh(tmp_path, TETRA, "scale = 3\n")
-    assert uniform.objects[3].a == Vec3(3, 0, 0)  # face 2 3 4 starts at (1, 0, 0)
+    assert all(t.material is mesh.material for t in mesh.triangles)
+    (uniform,) = load_mesh(tmp_path, TETRA, "scale = 3\n").objects
+    assert uniform[3].a == Vec3(3, 0, 0)  # face 2 3 4 starts at (1, 0, 0)
+
+
+def test_an_emitting_mesh_is_its_triangles_each_a_light(tmp_path):
+    lamp = 'type = "diffuse_light"\nemit = [1, 1, 1]'
+    text = mesh_scene(tmp_path, TETRA).replace('type = "lambertian"', lamp)
+    scene = load(text, tmp_path / "s.toml")
+    assert [type(t).__name__ for t in scene.objects] == ["SmoothTriangle"] + ["Triangle"] * 3
+    assert [light.shape for light in scene.area_lights] == scene.objects
 
 
 @pytest.mark.parametrize(
@@ -622,7 +631,7 @@ def test_degenerate_faces_are_skipped_and_counted_in_one_warning(tmp_path):
     text = TETRA + "v 2 0 0\nf 1 2 5\nf 2 5 1\n"  # two faces on one line
     with pytest.warns(SceneWarning) as record:
         scene = load_mesh(tmp_path, text)
-    assert len(scene.objects) == 4 and len(record) == 1
+    assert len(scene.objects[0]) == 4 and scene.objects[0].skipped == 2 and len(record) == 1
     (message,) = str(record[0].message).splitlines()
     assert message.startswith(f"{tmp_path / 's.toml'}: [[objects]] #1 path: skipped 2 degenerate")
 

@@ -1,0 +1,101 @@
+"""The meshes of the scene-size bench (scripts/bench_scene_size.py, docs/bench.md):
+a UV sphere of about n triangles with its vertex normals, written as an OBJ file,
+on a ground sphere under the sky. Made on the fly, never committed.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def uv_sphere(triangles: int) -> tuple[np.ndarray, np.ndarray]:
+    """(positions (P, 3), faces (T, 3) 0-based) of the unit sphere cut into s slices
+    around y and s // 2 stacks, s the smallest count giving at least `triangles`
+    triangles (2 s (stacks - 1) of them), wound counterclockwise seen from outside."""
+    slices = 3
+    while 2 * slices * (max(2, slices // 2) - 1) < triangles:
+        slices += 1
+    stacks = max(2, slices // 2)
+    theta = np.linspace(0.0, np.pi, stacks + 1)[1:-1]  # the rings between the poles
+    phi = np.linspace(0.0, 2.0 * np.pi, slices, endpoint=False)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    ring = np.stack([np.sin(t) * np.cos(p), np.cos(t), np.sin(t) * np.sin(p)], -1)
+    positions = np.concatenate([[[0.0, 1.0, 0.0]], ring.reshape(-1, 3), [[0.0, -1.0, 0.0]]])
+    j = np.arange(slices)
+    jn = (j + 1) % slices
+    south = len(positions) - 1
+
+    def at(i, k):  # vertex k of ring i
+        return 1 + i * slices + k
+
+    caps = [
+        np.stack([np.zeros(slices, dtype=np.int64), at(0, jn), at(0, j)], 1),
+        np.stack([np.full(slices, south), at(stacks - 2, j), at(stacks - 2, jn)], 1),
+    ]
+    bands = []
+    for i in range(stacks - 2):
+        a, b, c, d = at(i, j), at(i, jn), at(i + 1, j), at(i + 1, jn)
+        bands += [np.stack([a, b, d], 1), np.stack([a, d, c], 1)]
+    return positions, np.concatenate([caps[0], *bands, caps[1]])
+
+
+def write_obj(path: Path, positions: np.ndarray, faces: np.ndarray) -> None:
+    """An OBJ file of the positions, their normals (the unit sphere's: the positions)
+    and the faces, corners written v//vn."""
+    v = "v {:.7g} {:.7g} {:.7g}\n".format
+    vn = "vn {:.7g} {:.7g} {:.7g}\n".format
+    f = "f {0}//{0} {1}//{1} {2}//{2}\n".format
+    xyz = positions.T.tolist()
+    with open(path, "w") as out:
+        out.write(f"# a UV sphere of {len(faces)} triangles (rtpy/bench/meshes.py)\n")
+        out.write("".join(map(v, *xyz)))
+        out.write("".join(map(vn, *xyz)))
+        out.write("".join(map(f, *(faces + 1).T.tolist())))
+
+
+SCENE = """\
+# A UV sphere of {triangles} triangles read from {obj}, on a ground sphere, under the sky
+[camera]
+look_from = [0, 1.2, 4]
+look_at = [0, 0.2, 0]
+vfov = 30
+aspect_ratio = 1.7777777777777777
+width = 128
+
+[render]
+sky = true
+max_depth = 4
+spp = 16
+
+[materials.ground]
+type = "lambertian"
+albedo = [0.5, 0.5, 0.5]
+
+[materials.model]
+type = "lambertian"
+albedo = [0.8, 0.3, 0.2]
+
+[[objects]]
+type = "sphere"
+center = [0, -1000, 0]
+radius = 999
+material = "ground"
+
+[[objects]]
+type = "mesh"
+path = "{obj}"
+material = "model"
+"""
+
+
+def write_scene(folder: Path, triangles: int) -> Path:
+    """The scene file (and its OBJ file) of a sphere of about `triangles` triangles
+    in `folder`; its name says the size (sphere_1000.toml)."""
+    positions, faces = uv_sphere(triangles)
+    obj = folder / f"sphere_{triangles}.obj"
+    write_obj(obj, positions, faces)
+    scene = folder / f"sphere_{triangles}.toml"
+    scene.write_text(SCENE.format(triangles=len(faces), obj=obj.name))
+    return scene

@@ -1,0 +1,131 @@
+"""Large meshes built once: a scene file's mesh, read, placed and given its tree, is
+kept on disk and read back by the next render of the same file and transform.
+
+Reading a million-triangle OBJ file and building its tree take a few seconds; reading
+the arrays back takes a few hundredths. A mesh of at least MIN_FACES faces is kept in
+$RTPY_CACHE/meshes, else $XDG_CACHE_HOME/rtpy/meshes, else ~/.cache/rtpy/meshes,
+one folder of .npy files per entry. An entry is found by the OBJ file's resolved
+path, size and modification time (as Python checks its .pyc files against their
+source), the transform, the rtpy version and FORMAT, so a changed file or transform
+is read and built again. RTPY_MESH_CACHE=0 turns the cache off. The cache never
+stops a render: an entry that cannot be written is not written, one that cannot be
+read is built again, and the oldest entries are removed beyond MAX_BYTES.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..bvh import Tree
+from ..mesh import Mesh, Transform
+from .obj import read_obj
+
+FORMAT = 1
+MIN_FACES = 50_000
+MAX_BYTES = 2 << 30
+ARRAYS = ("vertices", "normals", "faces", "face_normals")
+TREE = ("lo", "hi", "child", "count", "axis", "order")
+
+
+def cache_folder() -> Path | None:
+    """Where meshes are kept, or None when RTPY_MESH_CACHE=0."""
+    if os.environ.get("RTPY_MESH_CACHE", "1") == "0":
+        return None
+    if os.environ.get("RTPY_CACHE"):
+        return Path(os.environ["RTPY_CACHE"]) / "meshes"
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "rtpy" / "meshes"
+
+
+def load_mesh(path: Path, material, transform: Transform) -> tuple[Mesh, int]:
+    """(the mesh of the OBJ file at path, the number of faces the file has): from the
+    cache when it has it, else read (rtpy.io.obj.read_obj, its errors), built, and
+    kept when it is large."""
+    folder = cache_folder()
+    entry = None if folder is None else folder / _key(path, transform)
+    if entry is not None and entry.is_dir():
+        found = _read(entry, material)
+        if found is not None:
+            return found
+    obj = read_obj(path)
+    mesh = Mesh(obj.positions, obj.normals, obj.triangles, material, transform)
+    faces = len(obj.triangles)
+    if entry is not None and len(mesh) >= MIN_FACES:
+        _write(entry, mesh, faces)
+    return mesh, faces
+
+
+def _key(path: Path, transform: Transform) -> str:
+    from .. import __version__
+
+    stat = path.stat()
+    parts = [
+        FORMAT,
+        __version__,
+        str(path.resolve()),
+        stat.st_size,
+        stat.st_mtime_ns,
+        [v.tolist() for v in (transform.translate, transform.scale, *transform.rows)],
+    ]
+    return hashlib.sha256(json.dumps(parts).encode()).hexdigest()[:32]
+
+
+def _read(entry: Path, material) -> tuple[Mesh, int] | None:
+    try:
+        meta = json.loads((entry / "meta.json").read_text())
+        arrays = {name: np.load(entry / f"{name}.npy") for name in ARRAYS + TREE}
+    except (OSError, ValueError):
+        return None  # removed or damaged meanwhile: built again
+    mesh = Mesh.from_arrays(
+        material,
+        *(arrays[name] for name in ARRAYS),
+        Tree(*(arrays[name] for name in TREE)),
+        meta["skipped"],
+    )
+    os.utime(entry / "meta.json")  # used: the last to go when the cache is pruned
+    return mesh, meta["faces"]
+
+
+def _write(entry: Path, mesh: Mesh, faces: int) -> None:
+    try:
+        entry.parent.mkdir(parents=True, exist_ok=True)
+        temporary = Path(tempfile.mkdtemp(dir=entry.parent, prefix=".writing-"))
+    except OSError:
+        return
+    try:
+        for name in ARRAYS:
+            np.save(temporary / f"{name}.npy", getattr(mesh, name))
+        for name in TREE:
+            np.save(temporary / f"{name}.npy", getattr(mesh.tree, name))
+        meta = {"faces": faces, "skipped": mesh.skipped}
+        (temporary / "meta.json").write_text(json.dumps(meta))
+        os.replace(temporary, entry)  # whole, or not at all (another process was first)
+    except OSError:
+        pass
+    finally:
+        shutil.rmtree(temporary, ignore_errors=True)
+    _prune(entry.parent)
+
+
+def _prune(folder: Path) -> None:
+    """Remove the least recently used entries while the cache holds more than MAX_BYTES."""
+    entries = []
+    for entry in folder.iterdir():
+        try:
+            size = sum(f.stat().st_size for f in entry.iterdir())
+            entries.append(((entry / "meta.json").stat().st_mtime, size, entry))
+        except OSError:
+            continue
+    total = sum(size for _, size, _ in entries)
+    for _, size, entry in sorted(entries):
+        if total <= MAX_BYTES:
+            break
+        shutil.rmtree(entry, ignore_errors=True)
+        total -= size
