@@ -21,16 +21,36 @@ from PIL import Image
 
 import rtpy
 from rtpy.io.bundled import bundled_dir, bundled_scenes
-from rtpy.io.cli import MAX_WORKERS, UsageError, build_parser, main, parse_set, validate_overrides
+from rtpy.io.cli import (
+    MAX_WORKERS,
+    UsageError,
+    build_parser,
+    given_settings,
+    main,
+    parse_set,
+    prepare,
+)
 from rtpy.io.image import read_pfm
 from rtpy.materials import MATERIALS
 from rtpy.render_settings import SETTINGS
+from rtpy.renderer import Renderer
 
 from ..commands import modules_imported_by, read_until, rtpy_command, run_cli
 from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
+
+
+def checked_by_the_command_line(*options: str) -> dict:
+    """What the render gets from the command line's options, once rtpy.render's
+    boundary has checked them: key -> its value as rtpy uses it."""
+    args = build_parser(every_command=False).parse_args(["render", "scene.toml", *options])
+    scene = rtpy.Scene([], camera=rtpy.Camera(width=4))
+    given = given_settings(args)
+    renderer = prepare(args, scene, Path("scene.toml"), given, None, None)
+    where = {"width": renderer.camera, "background": renderer.scene, "sky": renderer.scene}
+    return {key: getattr(where.get(key, renderer.settings), key) for key in given}
 
 
 # --- the commands that need no files of the test's, run at once on every core ------------
@@ -366,7 +386,7 @@ def test_unwritable_output_is_reported_before_rendering(
     before = sorted(p.name for p in tmp_path.iterdir())
     monkeypatch.chdir(tmp_path)
     rendered = []
-    monkeypatch.setattr(rtpy, "render", lambda *a, **k: rendered.append(1))
+    monkeypatch.setattr(Renderer, "render", lambda *a, **k: rendered.append(1))
     argv = ["render", "cornell", *SMALL, "-o", output]
     if linear is not None:
         argv += ["--linear", linear]
@@ -433,7 +453,7 @@ def test_linear_exr_without_openexr_exits_2_before_rendering(tmp_path, capsys, m
     def no_render(*args, **kwargs):
         raise AssertionError("rendered although the output cannot be written")
 
-    monkeypatch.setattr("rtpy.render", no_render)
+    monkeypatch.setattr(Renderer, "render", no_render)
     out, png = tmp_path / "x.exr", tmp_path / "x.png"
     status = main(["render", "cornell", *SMALL, "-o", str(png), "--linear", str(out)])
     err = capsys.readouterr().err
@@ -570,7 +590,7 @@ def test_workers_that_cannot_start_stop_the_render_with_one_error(tmp_path):
     out = tmp_path / "o.png"
     result = render_under(
         "spawn", "week08_three_balls", "--plugin", str(tmp_path / "parent_only.py"),
-        "-j", "2", "--width", "48", "--spp", "1", "-q", "-o", str(out),
+        "-j", "2", "--width", "160", "--spp", "1", "-q", "-o", str(out),  # 4 units of 1 spp
     )  # fmt: skip
     assert result.returncode == 1, result.stderr
     errors = [line for line in result.stderr.splitlines() if line.startswith("rtpy: error:")]
@@ -627,7 +647,7 @@ def test_a_set_value_is_one_line_refusal_or_applied_as_its_toml(key, text):
     """Any text after KEY=: refused in one line naming --set KEY, or applied as the one
     TOML value it is (a bare word as itself); never a second key smuggled past."""
     try:
-        overrides = validate_overrides(parse_set([f"{key}={text}"]))
+        overrides = checked_by_the_command_line("--set", f"{key}={text}")
     except UsageError as e:  # one terminal line (other characters shown as a scene file's)
         assert str(e).startswith(f"--set {key}") and not {"\n", "\r"} & set(str(e))
         return
@@ -649,7 +669,7 @@ def test_a_line_break_never_smuggles_a_second_key(spp, other):
 
 
 def test_a_second_key_in_set_or_a_flag_exits_2_before_rendering(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(rtpy, "render", lambda *a, **k: pytest.fail("rendered"))
+    monkeypatch.setattr(Renderer, "render", lambda *a, **k: pytest.fail("rendered"))
     out = str(tmp_path / "x.png")
     for option in (["--set", "spp=4\nwidth=8"], ["--spp", "4\nwidth = 8"]):
         assert main(["render", "cornell", "--quiet", "-o", out, *option]) == 2
