@@ -55,11 +55,17 @@ class PixelSums:
         """Every pass of the plan is added."""
         return self.passes == len(self.plan.passes)
 
+    def holds(self, unit: Unit) -> bool:
+        """The unit's sums are added (a resumed render need not render it)."""
+        return unit.batch < self.passes or (
+            unit.batch == self.passes and unit.region in self._added
+        )
+
     def add(self, unit: Unit, sums: np.ndarray) -> bool:
         """Add the sums (height, width, 3) of `unit`'s region, now or once its pass is
         in progress; True if a pass became whole. A unit added before (a unit a
         cluster ran twice, or one a resumed render had) is ignored."""
-        if unit.batch < self.passes or (unit.batch == self.passes and unit.region in self._added):
+        if self.holds(unit):
             return False
         self._waiting[(unit.batch, unit.region)] = (unit, sums)
         return self._advance()

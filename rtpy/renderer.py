@@ -110,7 +110,8 @@ class Renderer:
         start = time.perf_counter()
         run = _Run(self, plan, sums, executor, start)
         timeout = CLOCK_SECONDS if self.time_limit else None
-        work = executor.run(backend, plan.units(resumed), timeout)
+        units = (unit for unit in plan.units(resumed) if not sums.holds(unit))
+        work = executor.run(backend, units, timeout)
         try:
             for result in work:
                 now = time.perf_counter()

@@ -211,3 +211,45 @@ def test_preview_arguments_are_checked(kwargs, error):
     scene, camera = small_scene()
     with pytest.raises(error, match="preview"):
         rtpy.render(scene, camera=camera, spp=1, **kwargs)
+
+
+# --- time limit -------------------------------------------------------------------------
+
+
+class Clock:
+    """A perf_counter that moves one second each time it is read: the loop reads it
+    at the start and after each unit, so the time limit is met after a known unit."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def perf_counter(self) -> float:
+        self.now += 1.0
+        return self.now
+
+
+@pytest.mark.parametrize("limit,samples", [(2.5, 4), (1e-6, 1)])
+def test_a_time_limit_keeps_whole_passes_at_least_one(monkeypatch, limit, samples):
+    """40 x 22 at 8 spp: one unit per pass (1, 1, 2, 4 spp), one second each on the
+    clock. A limit of 2.5 s ends after the third pass, one of a microsecond after the
+    first: the image of that many samples, bit for bit, not interrupted."""
+    scene, camera = small_scene()
+    monkeypatch.setattr("rtpy.renderer.time", Clock())
+    image = rtpy.render(scene, camera=camera, spp=8, seed=5, time=limit)
+    assert image.samples_min == image.samples_max == samples and image.spp == 8
+    assert image.stats["stopped"] == "time limit" and not image.interrupted
+    monkeypatch.undo()
+    fewer = rtpy.render(scene, camera=camera, spp=samples, seed=5)
+    np.testing.assert_array_equal(image.linear, fewer.linear)
+
+
+def test_time_is_the_time_limit_setting():
+    scene, camera = small_scene()
+    image = rtpy.render(scene, camera=camera.with_width(8), spp=2, time_limit=1e5)
+    assert image.samples_min == 2 and image.stats["stopped"] is None
+    with pytest.raises(ValueError, match="time and time_limit are one setting"):
+        rtpy.render(scene, camera=camera, time=1, time_limit=2)
+    with pytest.raises(
+        ValueError, match=re.escape("time_limit: expected a number in [0, 1000000)")
+    ):
+        rtpy.render(scene, camera=camera, time=-1)
