@@ -7,8 +7,9 @@ rtpy version, the options that change the sums (the render settings but gamma an
 the time limit, the image size, the backend) and a digest of the scene (its pickle,
 with the camera, and the plugins' source files). The file is an .npz of three
 arrays, `sums` (height, width, 4: r, g, b sums and each pixel's count, of the whole
-passes), `current` (height, width, 5: the same and the pass of each unit,
-rtpy.pixel_sums) and `key` (that description, as JSON), written atomically
+passes), `current` (the rows from `first_row` on that hold units of the pass in
+progress, each pixel's sums, count and pass: rtpy.pixel_sums) and `key` (that
+description, as JSON, with first_row), written atomically
 (rtpy.files): as units finish, at most every CHECKPOINT_SECONDS, and when the
 render stops (Ctrl-C, SIGTERM, its time limit). A crash loses what came after the
 last write.
@@ -74,11 +75,13 @@ class Checkpoint:
     def save(self, total: np.ndarray, current: np.ndarray) -> None:
         """Write the whole passes `total` and the units of the pass in progress
         `current` (rtpy.pixel_sums) with this render's key."""
-        key = np.array(json.dumps(self.key()))
+        rows = np.flatnonzero(current[:, :, 3].any(axis=1))  # those the units hold
+        first, last = (int(rows[0]), int(rows[-1]) + 1) if rows.size else (0, 0)
+        key = np.array(json.dumps({**self.key(), "first_row": first}))
 
         def write(tmp: Path) -> None:
             with open(tmp, "wb") as f:  # a file object: savez would add ".npz" to a name
-                np.savez(f, sums=total, current=current, key=key)
+                np.savez(f, sums=total, current=current[first:last], key=key)
 
         atomic_write(self.path, write)
 
@@ -90,7 +93,7 @@ class Checkpoint:
         try:
             with np.load(self.path, allow_pickle=False) as data:
                 key, sums = json.loads(str(data["key"])), np.array(data["sums"])
-                current = np.array(data["current"])
+                rows = np.array(data["current"])
         except (OSError, ValueError, KeyError, zipfile.BadZipFile, EOFError) as err:
             raise self._error(f"not a saved render ({type(err).__name__}: {err})") from None
         if not isinstance(key, dict) or key.get("format") != FORMAT:
@@ -103,12 +106,19 @@ class Checkpoint:
                 raise self._error(f"saved with {name} = {saved.get(name)!r}, not {value!r}")
         if key.get("scene") != self.scene:
             raise self._error("saved for another scene (the scene, its files or plugins changed)")
-        for name, array, channels in (("sums", sums, 4), ("current", current, 5)):
-            shape = (plan.height, plan.width, channels)
+        first = key.get("first_row")
+        if not (isinstance(first, int) and 0 <= first <= plan.height - len(rows)):
+            raise self._error(f"its first row {first!r} does not fit the image")
+        current = np.zeros((plan.height, plan.width, 5))
+        for name, array, shape in (
+            ("sums", sums, (plan.height, plan.width, 4)),
+            ("current", rows, (len(rows), plan.width, 5)),
+        ):
             if array.shape != shape or array.dtype != np.float64:
                 raise self._error(f"its {name} are {array.dtype} {array.shape}, not {shape}")
             if not (np.isfinite(array).all() and (array >= 0.0).all()):
                 raise self._error(f"its {name} are not finite and non-negative")
+        current[first : first + len(rows)] = rows
         counts = sums[..., 3]
         samples = int(counts.flat[0])
         if not ((counts == samples).all() and plan.passes_holding(samples) is not None):

@@ -132,6 +132,7 @@ class Renderer:
         if run.stopped and self.checkpoint and run.unsaved:
             with signals.finishing_if_handled():  # a signal now lets the save finish
                 self.checkpoint.save(sums.total, sums.current())
+            run.saved = True
         whole = sums.whole_samples()
         return run.image(sums.mean(), whole, whole, False, seconds, paths=whole * pixels)
 
@@ -165,6 +166,7 @@ class _Run:
         self.renderer, self.plan, self.sums, self.executor = renderer, plan, sums, executor
         self.start = self.last_preview = self.last_save = start
         self.unsaved = 0  # units added since the checkpoint was saved
+        self.saved = False  # the checkpoint holds this run's units
         self.resumed_samples = plan.samples_after(sums.passes)
         self.rendered = 0  # paths traced by this run
         self.stopped: str | None = None  # "interrupted" or "time limit"
@@ -176,7 +178,7 @@ class _Run:
         self.unsaved += 1
         if r.checkpoint and not sums.done and now - self.last_save >= CHECKPOINT_SECONDS:
             r.checkpoint.save(sums.total, sums.current())
-            self.last_save, self.unsaved = now, 0
+            self.last_save, self.unsaved, self.saved = now, 0, True
         if r.preview and not sums.done and now - self.last_preview >= r.preview_seconds:
             fewest, most = sums.samples_range()
             r.preview(self.image(sums.snapshot(), fewest, most, True, now - self.start))
@@ -195,6 +197,7 @@ class _Run:
             "passes": self.sums.passes,
             "resumed_samples": self.resumed_samples,
             "stopped": self.stopped,
+            "checkpoint_saved": self.saved,
             "workers": self.executor.workers,
             "executor": self.executor.name,
             "integrator": r.settings.integrator,

@@ -152,6 +152,7 @@ def test_another_rtpy_version_is_refused(stopped_state, monkeypatch):
         ("format", "its format differs"),
         ("counts", "not those of whole passes"),
         ("negative", "not finite and non-negative"),
+        ("rows", "its first row 10000 does not fit"),
     ],
 )
 def test_a_file_that_is_not_a_saved_render_is_refused(stopped_state, corrupt, message):
@@ -166,8 +167,10 @@ def test_a_file_that_is_not_a_saved_render_is_refused(stopped_state, corrupt, me
             key["format"] = FORMAT + 1
         elif corrupt == "counts":
             arrays["sums"][0, 0, 3] += 1
+        elif corrupt == "rows":
+            key["first_row"] = 10000
         else:
-            arrays["current"][0, 0, 0] = -1.0
+            arrays["sums"][0, 0, 0] = -1.0
         arrays["key"] = np.array(json.dumps(key))
         with open(state, "wb") as f:
             np.savez(f, **arrays)

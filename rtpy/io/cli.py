@@ -239,14 +239,17 @@ def parse_set(items: list[str]) -> dict:
 
 def given_settings(args: argparse.Namespace) -> dict[str, tuple[str, object]]:
     """The render settings the command line gives: key -> (the option that gave it,
-    its value read as TOML); a flag (--spp) wins over --set spp=."""
+    its value read as TOML); UsageError for a flag (--spp) and --set of one key."""
     given = {key: (f"--set {key}", value) for key, value in parse_set(args.set).items()}
     flags = {name: flag(name) for name, setting in SETTINGS.items() if setting.flag}
     flags["time_limit"] = "--time"
     for key, option in flags.items():
         text = getattr(args, key)
-        if text is not None:
-            given[key] = (option, read_value(text, option))
+        if text is None:
+            continue
+        if key in given:
+            raise UsageError(f"{option} and --set {key} set one value: give one of them")
+        given[key] = (option, read_value(text, option))
     return given
 
 
@@ -383,7 +386,12 @@ def _render(args: argparse.Namespace) -> int:
 def write_outputs(image, outputs: list[Path], renderer) -> int:
     """Write the image of a render, finished or stopped, and say what it holds."""
     stopped_by = image.stats["stopped"]
+    kept = ""
+    if stopped_by and image.stats["checkpoint_saved"]:
+        kept = f"; --resume continues it ({renderer.checkpoint.path})"
     if stopped_by == "interrupted" and image.samples_min == 0:
+        if kept:
+            return stopped(f"interrupted before a pass over the image finished: no image{kept}")
         return stopped("interrupted before a pass over the image finished: nothing was written")
     if stopped_by == "interrupted":
         print(
@@ -401,7 +409,6 @@ def write_outputs(image, outputs: list[Path], renderer) -> int:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_WRITE_FAILED
     files = ", ".join(str(p) for p in written)
-    kept = f"; --resume continues it ({renderer.checkpoint.path})" if stopped_by else ""
     if stopped_by == "interrupted":
         return stopped(
             f"interrupted: wrote {files} holding {image.samples_min} of {image.spp} samples "

@@ -209,7 +209,8 @@ def write(tmp_path: Path, text: str) -> Path:
     slow_except(
         [
             (["--set", "bogus=1"], "bogus"),
-            (["--set", "spp=0"], "spp"),
+            (["--set", "max_depth=0"], "--set max_depth: expected"),
+            (["--set", "spp=2"], "--spp and --set spp set one value"),
             (["--set", "background=[1, 2]"], "background"),
             (["--set", "nee"], "KEY=VALUE"),
             (["-o", "no/such/dir/x.png"], "does not exist"),
@@ -355,7 +356,13 @@ def test_second_ctrl_c_exits_at_once(tmp_path, workers):
     _, rest = proc.communicate(timeout=60)
     assert proc.returncode == 130, seen + rest
     assert "interrupted again" in rest and "Traceback" not in seen + rest
-    assert list(tmp_path.iterdir()) == []
+    # No image, no temporary file; the render's state, saved whole after the first
+    # Ctrl-C, is kept for --resume.
+    state = tmp_path / "big.png.resume.npz"
+    assert list(tmp_path.iterdir()) in ([], [state])
+    if state.exists():
+        with np.load(state) as saved:
+            assert saved["sums"].shape == (3000, 3000, 4) and "rtpy" in str(saved["key"])
     # the workers have ended (stopped at the first Ctrl-C, killed at the second)
     assert all(wait_for_exit(pid) for pid in workers_pids), "worker processes still running"
 
@@ -774,3 +781,83 @@ def test_a_quiet_render_loads_no_progress_bar_and_no_other_command(tmp_path):
     unneeded = {"tqdm", "rtpy.bench", "rtpy.grading", "importlib.metadata"}
     unneeded |= {"rtpy.testing.chi_square", "rtpy.testing.material_checks"}
     assert not loaded & unneeded
+
+
+# --- time limits, resume, clusters ------------------------------------------------------
+
+LONG = ["--width", "16", "--spp", "100000", "-j", "1", "--quiet"]  # 9 minutes of passes
+
+
+def test_a_time_limit_ends_a_long_render_with_whole_passes_and_its_state(tmp_path, capsys):
+    out = tmp_path / "out.npy"
+    argv = ["render", "week08_three_balls", *LONG, "-o", str(tmp_path / "o.png")]
+    assert main([*argv, "--linear", str(out), "--time", "0.5"]) == 0
+    err = capsys.readouterr().err
+    held = re.search(r"16x9, (\d+) of 100000 spp in the time limit of 0\.5 s", err)
+    assert held and int(held[1]) >= 1 and "--resume continues it" in err, err
+    image = np.load(out)
+    assert np.isfinite(image).all() and image.max() > 0
+    assert (tmp_path / "o.png.resume.npz").exists()
+
+
+def test_resume_of_another_render_is_one_line_exit_2_and_keeps_every_file(tmp_path, capsys):
+    argv = ["render", "week08_three_balls", *LONG, "-o", str(tmp_path / "o.png"), "--time", "0.3"]
+    assert main(argv) == 0
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    capsys.readouterr()
+    assert main([*argv, "--resume", "--seed", "5"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"rtpy: error: --resume: {tmp_path / 'o.png.resume.npz'}: saved with seed = 0, not 5; "
+        "render without --resume to start over\n"
+    )
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    assert main(argv) == 0  # without --resume: it starts over, and says so
+    assert "rtpy: note: starting over; --resume continues the render in" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_a_render_stopped_by_its_time_limit_and_resumed_is_the_uninterrupted_one(tmp_path):
+    """issue 29's check, as a user runs it: `--time`, then the same command with
+    --resume, gives the image of the render never stopped, bit for bit (2 workers;
+    about 3 s of rendering, stopped after half a second)."""
+    args = ["render", "cornell", "--width", "24", "--spp", "32", "-j", "2", "-q"]
+    full, part = tmp_path / "full.npy", tmp_path / "part.npy"
+    done = run_cli(*args, "-o", str(tmp_path / "full.png"), "--linear", str(full))
+    assert done.returncode == 0, done.stderr
+    stop = [*args, "-o", str(tmp_path / "part.png"), "--linear", str(part)]
+    stopped = run_cli(*stop, "--time", "0.5")
+    held = re.search(r"(\d+) of 32 spp in the time limit", stopped.stderr)
+    assert stopped.returncode == 0 and held and int(held[1]) < 32, stopped.stderr
+    resumed = run_cli(*stop, "--resume")
+    assert resumed.returncode == 0 and f"({held[1]} resumed)" in resumed.stderr, resumed.stderr
+    np.testing.assert_array_equal(np.load(part), np.load(full))
+    assert not (tmp_path / "part.png.resume.npz").exists()
+
+
+@pytest.mark.parametrize(
+    "extra,message",
+    [
+        (["--cluster", "nowhere"], '--cluster nowhere: expected "local" or a scheduler\'s'),
+        (["--time", "-2"], "--time: expected a number in [0, 1000000), found -2"),
+        (["--time", "soon"], "--time: expected a number"),
+    ],
+)
+def test_bad_time_and_cluster_options_exit_2(tmp_path, capsys, extra, message):
+    assert main(["render", "cornell", *SMALL, "-o", str(tmp_path / "o.png"), *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("rtpy: error: ") and message in err and len(err.splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_cluster_without_dask_says_how_to_install_it(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed fails
+    assert (
+        main(["render", "cornell", *SMALL, "-o", str(tmp_path / "o.png"), "--cluster", "local"])
+        == 2
+    )
+    err = capsys.readouterr().err
+    assert (
+        err
+        == "rtpy: error: --cluster local: needs Dask distributed (pip install 'rtpy[cluster]')\n"
+    )
