@@ -181,7 +181,7 @@ def _local_cluster(distributed, workers: int):
             n_workers=workers,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",  # any free port: none is taken for granted
             silence_logs=logging.ERROR,
         )
 
