@@ -105,7 +105,19 @@ def build_parser(prog: str = "rtpy", every_command: bool = True) -> argparse.Arg
     )
     parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    add_render_parser(sub)
+    sub.add_parser("scenes", help="list the bundled scenes")
+    if not every_command:
+        return parser
+    from ..bench.command import add_parser as add_bench_parser
 
+    add_bench_parser(sub)
+    add_assignment_commands(sub, seconds)
+    return parser
+
+
+def add_render_parser(sub) -> None:
+    """The `render` command and its options."""
     r = sub.add_parser(
         "render",
         help="render a scene file to an image",
@@ -176,15 +188,6 @@ def build_parser(prog: str = "rtpy", every_command: bool = True) -> argparse.Arg
         metavar="FILE.py",
         help="import FILE.py first (registers a student's materials by register_material)",
     )
-
-    sub.add_parser("scenes", help="list the bundled scenes")
-    if not every_command:
-        return parser
-    from ..bench.command import add_parser as add_bench_parser
-
-    add_bench_parser(sub)
-    add_assignment_commands(sub, seconds)
-    return parser
 
 
 def load_plugins(paths: list[str]) -> None:
