@@ -25,15 +25,8 @@ class Flat(Backend):
         return lambda unit: np.full((unit.y1 - unit.y0, unit.x1 - unit.x0, 3), 0.5 * unit.spp)
 
 
-@pytest.fixture
-def registry():
-    saved = dict(BACKEND_REGISTRY)
-    yield BACKEND_REGISTRY
-    BACKEND_REGISTRY.clear()
-    BACKEND_REGISTRY.update(saved)
-
-
-def test_a_registered_backend_is_found_by_its_name(registry):
+def test_a_registered_backend_is_found_by_its_name(monkeypatch):
+    monkeypatch.setitem(BACKEND_REGISTRY, "flat", None)  # taken out again after the test
     register_backend("flat")(Flat)
     scene, camera = small_scene()
     image = rtpy.render(scene, camera=camera, spp=3, backend="flat")
@@ -42,7 +35,7 @@ def test_a_registered_backend_is_found_by_its_name(registry):
     assert Flat(scene, camera, rtpy.RenderSettings()).plan(8, 8, 3).paths_per_unit == 64
 
 
-def test_an_unknown_name_lists_the_registered_ones(registry):
+def test_an_unknown_name_lists_the_registered_ones():
     scene, camera = small_scene()
     with pytest.raises(ValueError, match=r"^backend must be one of scalar, numpy; got 'gpu'$"):
         make_backend("gpu", scene, camera, rtpy.RenderSettings())
