@@ -125,14 +125,18 @@ class Renderer:
                     break
         except KeyboardInterrupt:
             run.stopped = "interrupted"
+        except BaseException:
+            try:
+                run.keep()  # a failure (a worker lost, a bug): what is finished, for --resume
+            except Exception:  # the failure, not this, is the error to report
+                pass
+            raise
         finally:
             work.close()  # cancels the units not finished, ends the workers
             bar.close()
         seconds = time.perf_counter() - start
-        if run.stopped and self.checkpoint and run.unsaved:
-            with signals.finishing_if_handled():  # a signal now lets the save finish
-                self.checkpoint.save(sums.total, sums.current())
-            run.saved = True
+        if run.stopped:
+            run.keep()
         whole = sums.whole_samples()
         return run.image(sums.mean(), whole, whole, False, seconds, paths=whole * pixels)
 
@@ -170,6 +174,14 @@ class _Run:
         self.resumed_samples = plan.samples_after(sums.passes)
         self.rendered = 0  # paths traced by this run
         self.stopped: str | None = None  # "interrupted" or "time limit"
+
+    def keep(self) -> None:
+        """Save the checkpoint, if there is one and units came since it was saved."""
+        checkpoint = self.renderer.checkpoint
+        if checkpoint is not None and self.unsaved:
+            with signals.finishing_if_handled():  # a signal now lets the save finish
+                checkpoint.save(self.sums.total, self.sums.current())
+            self.unsaved, self.saved = 0, True
 
     def add(self, unit, unit_sums: np.ndarray, now: float) -> None:
         r, sums = self.renderer, self.sums

@@ -76,10 +76,9 @@ def test_a_render_stopped_by_its_time_limit_resumes_to_the_same_image(tmp_path, 
     np.testing.assert_array_equal(resumed.linear, full.linear)
 
 
-def test_a_crash_loses_only_what_came_after_the_last_checkpoint(tmp_path, monkeypatch, stopping):
-    """A crash (a bug, a full disk; a killed process writes nothing more either)
-    leaves the state of the last checkpoint, here after every unit."""
-    monkeypatch.setattr("rtpy.renderer.CHECKPOINT_SECONDS", 0.0)
+def test_a_failure_mid_render_keeps_what_is_finished(tmp_path, stopping):
+    """A failure (a bug in a material, a worker lost) saves the state before it is
+    raised: the resumed render is the uninterrupted one."""
     state = tmp_path / "s.npz"
     scene, camera = stopping
     full = rtpy.render(scene, camera=camera, spp=SPP, seed=9)
@@ -91,6 +90,23 @@ def test_a_crash_loses_only_what_came_after_the_last_checkpoint(tmp_path, monkey
     resumed = rtpy.render(scene, camera=camera, spp=SPP, seed=9, checkpoint=state, resume=True)
     assert resumed.stats["resumed_samples"] >= 1
     np.testing.assert_array_equal(resumed.linear, full.linear)
+
+
+def test_the_state_is_saved_as_the_render_goes(tmp_path, monkeypatch):
+    """A crash that writes nothing more (a killed process, a power cut) loses only
+    what came after the last save: here one after every unit, each holding more."""
+    monkeypatch.setattr("rtpy.renderer.CHECKPOINT_SECONDS", 0.0)
+    state = tmp_path / "s.npz"
+    scene, camera = small_scene()
+    held = []
+
+    def look(image) -> None:
+        with np.load(state) as saved:
+            held.append(saved["sums"][..., 3].sum() + saved["current"][..., 3].sum())
+
+    rtpy.render(scene, camera=camera.with_width(120), spp=SPP, checkpoint=state,
+                preview=look, preview_seconds=0)  # fmt: skip
+    assert len(held) > 10 and held == sorted(held) and len(set(held)) == len(held)
 
 
 @pytest.fixture
