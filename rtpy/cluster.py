@@ -26,6 +26,7 @@ import logging
 import pickle
 import sys
 import threading
+import time
 import uuid
 from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING
@@ -88,6 +89,7 @@ class DaskCluster(Executor):
         import distributed
 
         before = set(multiprocessing.active_children())
+        started = time.perf_counter()
         client, close = None, _nothing
         pending: dict = {}
         try:
@@ -96,6 +98,7 @@ class DaskCluster(Executor):
             token = uuid.uuid4().hex
             payload = (token, plugin_sources(), pickle.dumps(backend))
             [shared] = client.scatter([payload], broadcast=True, hash=False)
+            self.startup_seconds = time.perf_counter() - started
             ahead = 2 * self.workers
             count = 0
 
@@ -174,7 +177,6 @@ def _local_cluster(distributed, workers: int):
     lost); it waits for them on the thread that starts the cluster."""
     import multiprocessing
     import signal
-    import time
 
     def start():
         return distributed.LocalCluster(

@@ -46,12 +46,15 @@ class Executor:
     units not finished and ends whatever the executor started. Failures raise
     WorkerError.
 
-    name     what image.stats["executor"] says
-    workers  how many units it renders at once
+    name             what image.stats["executor"] says
+    workers          how many units it renders at once
+    startup_seconds  how long its last run took to start (a cluster's processes,
+                     reaching a scheduler, sending the scene), before any unit
     """
 
     name = ""
     workers = 1
+    startup_seconds = 0.0
 
     def run(
         self, backend: Backend, units: Iterator[Unit], timeout: float | None = None

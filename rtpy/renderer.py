@@ -212,6 +212,7 @@ class _Run:
             "checkpoint_saved": self.saved,
             "workers": self.executor.workers,
             "executor": self.executor.name,
+            "executor_startup_seconds": self.executor.startup_seconds,
             "integrator": r.settings.integrator,
             "backend": r.backend.name,
             "peak_rss_mb": peak_memory_mb(children=True),

@@ -10,12 +10,12 @@ Dask against local worker processes, and scaling on a Dask cluster.
   with the paths of that first pass (one sample per pixel) beside those of a first
   pass of spp / 8 samples, as the scalar backend's passes were before they grew
   from one;
-- Dask against -j 2: `python -m rtpy render cornell --backend numpy --width 256
-  --spp 64` with `-j 2` and with `--cluster local -j 2`, alternating, whole process
-  and the render alone (the seconds the command reports); the median of the rounds'
-  ratios (goal: at most 1.10);
-- scaling: the same render on a real `dask scheduler` with one `dask worker`, then
-  two (each --nthreads 1, on 127.0.0.1), the render alone; and -j 1 against -j 2.
+- Dask against -j 2, and scaling: `python -m rtpy render cornell --backend numpy
+  --width 256 --spp 64` on -j 1, -j 2, a real `dask scheduler` with one `dask worker`
+  and one with two (each --nthreads 1, on 127.0.0.1, both running throughout) and
+  `--cluster local -j 2`, one after another in each round; the medians of the render
+  alone (the seconds the command reports), and of the local cluster's whole command
+  against -j 2's (goal: a cluster at most 1.10 times as long as -j 2).
 
 Every measurement is a whole process, one at a time; the machine is shared, so the
 ratios are of the same round. --write-doc writes the table into docs/bench.md and
@@ -87,56 +87,71 @@ def reported(err: str) -> float:
     return float(REPORTED.findall(err)[-1])
 
 
-def dask_against_local(rounds: int, folder: Path) -> dict:
-    out = ["-o", str(folder / "c.png")]
-    ratios, alone = [], []
-    for _ in range(rounds):
-        local = rtpy("render", *CORNELL, "-j", "2", *out, cwd=folder)
-        dask = rtpy("render", *CORNELL, "-j", "2", "--cluster", "local", *out, cwd=folder)
-        ratios.append(dask[0] / local[0])
-        alone.append(reported(dask[1]) / reported(local[1]))
-    return {"whole": statistics.median(ratios), "alone": statistics.median(alone)}
-
-
 def start_dask(*args: str, folder: Path, log: str) -> subprocess.Popen:
     with open(folder / log, "w") as f:
         return subprocess.Popen([sys.executable, "-m", "dask", *args], cwd=folder,
                                 stdout=f, stderr=f)  # fmt: skip
 
 
-def scaling(rounds: int, folder: Path) -> dict:
-    """The render alone on a real scheduler with one worker, then two; and -j 1, -j 2."""
-    file = folder / "scheduler.json"
-    procs = [start_dask("scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                        "--scheduler-file", str(file), folder=folder, log="s.log")]  # fmt: skip
+def scheduler(workers: int, folder: Path, procs: list) -> str:
+    """A `dask scheduler` with `workers` `dask worker` processes (one thread each) on
+    127.0.0.1, added to procs; its address once they are all connected."""
+    import distributed
+
+    file = folder / f"scheduler{workers}.json"
+    procs.append(start_dask("scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                            "--scheduler-file", str(file), folder=folder,
+                            log=f"scheduler{workers}.log"))  # fmt: skip
+    deadline = time.monotonic() + 90
+    while not file.exists() and time.monotonic() < deadline:
+        time.sleep(0.05)  # polling for the file, with a deadline
+    address = json.loads(file.read_text())["address"]
+    for k in range(workers):
+        procs.append(start_dask("worker", address, "--nthreads", "1", "--no-nanny", "--host",
+                                "127.0.0.1", "--no-dashboard", folder=folder,
+                                log=f"worker{workers}-{k}.log"))  # fmt: skip
+    with distributed.Client(address, timeout=90) as client:
+        client.wait_for_workers(workers, timeout=90)
+    return address
+
+
+def comparisons(rounds: int, folder: Path) -> dict:
+    """Rounds of the same render on -j 1, -j 2, a scheduler with one and with two
+    workers (both running throughout) and --cluster local -j 2, one after another in
+    each round: the medians of the render alone (the seconds rtpy prints) and of the
+    local cluster's whole command against -j 2's."""
+    procs: list[subprocess.Popen] = []
+    out = ["-o", str(folder / "c.png")]
     try:
-        deadline = time.monotonic() + 90
-        while not file.exists() and time.monotonic() < deadline:
-            time.sleep(0.05)
-        address = json.loads(file.read_text())["address"]
-        out = ["-o", str(folder / "c.png"), "--cluster", address]
-        result: dict[str, list[float]] = {"dask 1": [], "dask 2": [], "-j 1": [], "-j 2": []}
-        for workers in (1, 2):
-            procs.append(start_dask("worker", address, "--nthreads", "1", "--no-nanny",
-                                    "--host", "127.0.0.1", "--no-dashboard", folder=folder,
-                                    log=f"w{workers}.log"))  # fmt: skip
-            for _ in range(rounds):
-                result[f"dask {workers}"].append(reported(rtpy("render", *CORNELL, *out,
-                                                               cwd=folder)[1]))  # fmt: skip
+        one, two = scheduler(1, folder, procs), scheduler(2, folder, procs)
+        runs = {
+            "-j 1": ["-j", "1"], "-j 2": ["-j", "2"], "dask 1": ["--cluster", one],
+            "dask 2": ["--cluster", two], "local": ["-j", "2", "--cluster", "local"],
+        }  # fmt: skip
+        alone: dict[str, list[float]] = {name: [] for name in runs}
+        whole: dict[str, list[float]] = {"local": [], "-j 2": []}
         for _ in range(rounds):
-            for j in ("1", "2"):
-                seconds = reported(rtpy("render", *CORNELL, "-j", j, "-o",
-                                        str(folder / "c.png"), cwd=folder)[1])  # fmt: skip
-                result[f"-j {j}"].append(seconds)
-        return {k: statistics.median(v) for k, v in result.items()}
+            for name, options in runs.items():
+                seconds, err = rtpy("render", *CORNELL, *options, *out, cwd=folder)
+                alone[name].append(reported(err))
+                if name in whole:
+                    whole[name].append(seconds)
+            print({k: v[-1] for k, v in alone.items()}, flush=True)
+        result = {name: statistics.median(v) for name, v in alone.items()}
+        ratios = [a / b for a, b in zip(whole["local"], whole["-j 2"], strict=True)]
+        result["local whole / -j 2 whole"] = statistics.median(ratios)
+        return result
     finally:
-        for proc in procs:
+        for proc in reversed(procs):  # the workers first: they would wait for the scheduler
             proc.terminate()
-        for proc in procs:
-            proc.wait(timeout=60)
+            try:
+                proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
 
 
-def section(first: dict, versus: dict, scale: dict, before: dict, after: dict) -> str:
+def section(first: dict, results: dict, before: dict, after: dict) -> str:
     load = lambda m: " / ".join(f"{x:.1f}" for x in m["load_average"] or ())  # noqa: E731
     lines = [
         BEGIN, "", "```sh", "python scripts/bench_cluster.py --write-doc", "```", "",
@@ -152,20 +167,38 @@ def section(first: dict, versus: dict, scale: dict, before: dict, after: dict) -
             f"| first image, {name}, scalar -j 2, whole command: a pass of {n:,} paths "
             f"(one of spp / 8 would be {n * -(-spp // 8):,}) | {seconds:.1f} s |"
         )
-    verdict = "within" if versus["alone"] <= GOAL else "beyond"
+    r = results
+    verdict = "within" if r["dask 2"] / r["-j 2"] <= GOAL else "beyond"
     lines += [
-        f"| `--cluster local -j 2` / `-j 2`, cornell 256x256 x 64 spp numpy, whole command "
-        f"| {versus['whole']:.2f}x |",
-        f"| the same, the render alone (goal at most {GOAL:.2f}x) | {versus['alone']:.2f}x, "
-        f"{verdict} the goal |",
-        f"| a scheduler with 1 worker / 2 workers, render alone | "
-        f"{scale['dask 1'] / scale['dask 2']:.2f}x ({scale['dask 1']:.1f} s, "
-        f"{scale['dask 2']:.1f} s) |",
-        f"| -j 1 / -j 2, render alone | {scale['-j 1'] / scale['-j 2']:.2f}x "
-        f"({scale['-j 1']:.1f} s, {scale['-j 2']:.1f} s) |",
+        f"| a `dask scheduler` with 2 workers / `-j 2`, cornell 256x256 x 64 spp numpy, "
+        f"the render alone (goal: at most {GOAL:.2f}x) | {r['dask 2'] / r['-j 2']:.2f}x, "
+        f"{verdict} the goal ({r['dask 2']:.1f} s, {r['-j 2']:.1f} s) |",
+        f"| `--cluster local -j 2` / `-j 2`, the render alone, which starts the cluster "
+        f"| {r['local'] / r['-j 2']:.2f}x ({r['local']:.1f} s) |",
+        f"| the same, whole command | {r['local whole / -j 2 whole']:.2f}x |",
+        f"| a scheduler with 1 worker / with 2 workers, the render alone | "
+        f"{r['dask 1'] / r['dask 2']:.2f}x ({r['dask 1']:.1f} s, {r['dask 2']:.1f} s) |",
+        f"| -j 1 / -j 2, the render alone | {r['-j 1'] / r['-j 2']:.2f}x "
+        f"({r['-j 1']:.1f} s, {r['-j 2']:.1f} s) |",
         "", END,
     ]  # fmt: skip
     return "\n".join(lines)
+
+
+def summary(r: dict) -> str:
+    """The figures docs/cluster.md quotes, in a sentence each."""
+    return "\n".join([
+        BEGIN, "",
+        f"- Overhead: the Cornell box at 256x256 and 64 spp (numpy backend) renders in "
+        f"{r['dask 2']:.1f} s on a running scheduler with two workers against "
+        f"{r['-j 2']:.1f} s on `-j 2` ({r['dask 2'] / r['-j 2']:.2f}x); "
+        f"`--cluster local -j 2`, which starts its scheduler and worker processes "
+        f"for the render, takes {r['local']:.1f} s ({r['local'] / r['-j 2']:.2f}x).",
+        f"- Scaling: one worker {r['dask 1']:.1f} s, two {r['dask 2']:.1f} s "
+        f"({r['dask 1'] / r['dask 2']:.2f}x); `-j 1` {r['-j 1']:.1f} s, `-j 2` "
+        f"{r['-j 2']:.1f} s ({r['-j 1'] / r['-j 2']:.2f}x); 2x is the ceiling of 2 cores.",
+        "", "The whole table is in [bench.md](bench.md#renders-anywhere).", "", END,
+    ])  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -178,10 +211,10 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="rtpy-bench-cluster-") as tmp:
         folder = Path(tmp)
         first = {name: first_image(name, a, folder) for name, a in FIRST_IMAGE.items()}
-        versus = dask_against_local(args.repeat, folder)
-        scale = scaling(args.repeat, folder)
-    table = section(first, versus, scale, before, machine())
-    figures = summary(versus, scale)
+        print("first image:", first, flush=True)
+        results = comparisons(args.repeat, folder)
+    table = section(first, results, before, machine())
+    figures = summary(results)
     print(table, figures, sep="\n\n")
     if args.write_doc:
         for doc, text in ((BENCH_DOC, table), (CLUSTER_DOC, figures)):
@@ -191,23 +224,6 @@ def main(argv: list[str] | None = None) -> int:
                 raise SystemExit(f"{doc} has no section between this script's markers")
             doc.write_text(page[:first_at] + text + page[last_at + len(END) :])
     return 0
-
-
-def summary(versus: dict, scale: dict) -> str:
-    """The figures docs/cluster.md quotes, in a sentence each."""
-    return "\n".join([
-        BEGIN, "",
-        f"- Overhead: the Cornell box at 256x256 and 64 spp (numpy backend) renders "
-        f"{versus['alone']:.2f} times as long on `--cluster local -j 2` as on `-j 2` "
-        f"(the render alone), {versus['whole']:.2f} times as long as a whole command, "
-        f"which starts the local cluster (its scheduler and worker processes) too.",
-        f"- Scaling: on a `dask scheduler` with one, then two `dask worker` processes "
-        f"on this 2-core machine, the same render takes {scale['dask 1']:.1f} s and "
-        f"{scale['dask 2']:.1f} s ({scale['dask 1'] / scale['dask 2']:.2f}x); `-j 1` "
-        f"and `-j 2` take {scale['-j 1']:.1f} s and {scale['-j 2']:.1f} s "
-        f"({scale['-j 1'] / scale['-j 2']:.2f}x).",
-        "", "The whole table is in [bench.md](bench.md#renders-anywhere).", "", END,
-    ])  # fmt: skip
 
 
 if __name__ == "__main__":
