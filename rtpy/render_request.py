@@ -86,7 +86,6 @@ def prepare_render(
 ) -> Renderer:
     """The Renderer of render(scene, ...), every value checked (render's parameters)."""
     from .backend import make_backend
-    from .io.preview import preview_target
     from .io.values import Range, checked, integer
     from .renderer import Renderer
 
@@ -122,7 +121,7 @@ def prepare_render(
         workers=workers,
         quiet=not show_progress,
         backend=chosen,
-        preview=preview_target(preview, scene.files),
+        preview=_preview(preview, scene),
         preview_seconds=float(preview_seconds),
         executor=executor,
         time_limit=render_settings.time_limit,
@@ -156,6 +155,16 @@ def _scene_with(scene: Scene, background, sky) -> Scene:
     if sky is not None:
         scene.sky = SETTINGS["sky"].check(sky)
     return scene
+
+
+def _preview(preview, scene: Scene):
+    """A function of the image so far, or None: a file name or True made into one by
+    rtpy.io.preview (a function or None is one already: the command line's)."""
+    if preview is None or (callable(preview) and not isinstance(preview, bool)):
+        return preview
+    from .io.preview import preview_target
+
+    return preview_target(preview, scene.files)
 
 
 def _checkpoint(path, backend):

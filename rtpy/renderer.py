@@ -91,6 +91,7 @@ class Renderer:
         self.preview, self.preview_seconds = preview, preview_seconds
         self.executor, self.time_limit = executor, time_limit
         self.checkpoint, self.resume = checkpoint, resume
+        self.saved = False  # the checkpoint holds the last render's units
         if not isinstance(backend, Backend):
             backend = make_backend(backend, scene, camera, settings)
         self.backend = backend
@@ -182,6 +183,7 @@ class _Run:
             with signals.finishing_if_handled():  # a signal now lets the save finish
                 checkpoint.save(self.sums.total, self.sums.current())
             self.unsaved, self.saved = 0, True
+            self.renderer.saved = True
 
     def add(self, unit, unit_sums: np.ndarray, now: float) -> None:
         r, sums = self.renderer, self.sums
@@ -191,6 +193,7 @@ class _Run:
         if r.checkpoint and not sums.done and now - self.last_save >= CHECKPOINT_SECONDS:
             r.checkpoint.save(sums.total, sums.current())
             self.last_save, self.unsaved, self.saved = now, 0, True
+            r.saved = True
         if r.preview and not sums.done and now - self.last_preview >= r.preview_seconds:
             fewest, most = sums.samples_range()
             r.preview(self.image(sums.snapshot(), fewest, most, True, now - self.start))

@@ -9,7 +9,12 @@ import pytest
 import rtpy
 from rtpy.backend import BACKEND_REGISTRY, Backend, make_backend, register_backend
 
-from .test_renderer import small_scene
+
+def small_scene() -> tuple[rtpy.Scene, rtpy.Camera]:
+    """One ball under the sky, 24 x 13 pixels (this file ships with week 4, before
+    the renderer's tests do)."""
+    ball = rtpy.Sphere(rtpy.Vec3(0, 0, -1), 0.5, rtpy.Lambertian())
+    return rtpy.Scene([ball], sky=True), rtpy.Camera(width=24)
 
 
 class Flat(Backend):

@@ -12,7 +12,7 @@ from rtpy import Camera, Color
 from rtpy.render_request import AspectError, prepare_render
 from rtpy.render_settings import SettingError
 
-from .test_renderer import small_scene
+from .test_backend import small_scene
 
 
 @pytest.mark.parametrize(

@@ -381,7 +381,8 @@ def _render(args: argparse.Namespace) -> int:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_WORKERS_FAILED
     except WriteError as err:  # a preview, or the render's state
-        print(f"rtpy: error: {err}", file=sys.stderr)
+        kept = f"; --resume continues the render ({state})" if renderer.saved else ""
+        print(f"rtpy: error: {err}{kept}", file=sys.stderr)
         return EXIT_WRITE_FAILED
     return write_outputs(image, [p for p in (output, linear) if p is not None], renderer)
 

@@ -767,10 +767,12 @@ def test_a_preview_that_cannot_be_written_stops_the_render_in_one_line(
     preview = tmp_path / "preview.png"
     argv = ["render", "cornell", *SMALL, "--spp", "4", "-j", "1", "-o", str(tmp_path / "out.png")]
     assert main([*argv, "--preview", str(preview), "--preview-seconds", "0"]) == 1
+    state = tmp_path / "out.png.resume.npz"  # what was finished, kept
     assert capsys.readouterr().err == (
-        f"rtpy: error: cannot write '{preview}': {os.strerror(errno.EIO)}\n"
+        f"rtpy: error: cannot write '{preview}': {os.strerror(errno.EIO)}; "
+        f"--resume continues the render ({state})\n"
     )
-    assert list(tmp_path.iterdir()) == []
+    assert list(tmp_path.iterdir()) == [state]
 
 
 def test_a_quiet_render_loads_no_progress_bar_and_no_other_command(tmp_path):
