@@ -12,6 +12,8 @@ import pytest
 from rtpy.pixel_sums import PixelSums
 from rtpy.plan import Plan
 
+from .tiers import slow_except
+
 PLAN = Plan(40, 20, 7, 64)  # passes of 1, 1, 2, 3 samples: 20, 20, 40 and 40 units
 
 
@@ -99,7 +101,7 @@ def interrupt_at(opcode: int):
     return tracer
 
 
-@pytest.mark.parametrize("seed", [3, 4])
+@pytest.mark.parametrize("seed", slow_except([3, 4], 3))
 def test_a_ctrl_c_at_any_bytecode_leaves_whole_passes_and_a_state_to_resume(seed):
     """Ctrl-C raises KeyboardInterrupt between any two bytecodes, also inside
     PixelSums.add. After it, `total` must hold whole passes (the counts equal), and

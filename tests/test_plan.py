@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rtpy.plan import MAX_PASS_SPP, Plan, pass_sizes
@@ -39,7 +39,8 @@ def test_each_pass_holds_at_most_the_samples_before_it(spp, cap):
     assert longer[: len(sizes) - 1] == sizes[:-1]
 
 
-@given(st.integers(1, 300), st.integers(1, 60), st.integers(1, 200), st.integers(1, 5000))
+@settings(max_examples=50)
+@given(st.integers(1, 120), st.integers(1, 30), st.integers(1, 100), st.integers(1, 5000))
 def test_units_cover_every_pixel_once_per_pass_within_the_path_budget(
     width, height, spp, paths_per_unit
 ):

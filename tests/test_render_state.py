@@ -64,7 +64,7 @@ def test_a_render_stopped_by_its_time_limit_resumes_to_the_same_image(tmp_path, 
     resumed render renders the rest (fewer paths than the whole)."""
     state = tmp_path / "s.npz"
     scene, camera = small_scene()
-    camera = camera.with_width(120)  # 120 x 67: passes of 2, 2, 4, ... units
+    camera = camera.with_width(100)  # 100 x 56: passes of 2, 2, 3, ... units
     kw = dict(camera=camera, spp=SPP, seed=8, checkpoint=state)
     full = rtpy.render(scene, camera=camera, spp=SPP, seed=8)
     with monkeypatch.context() as m:
@@ -104,7 +104,7 @@ def test_the_state_is_saved_as_the_render_goes(tmp_path, monkeypatch):
         with np.load(state) as saved:
             held.append(saved["sums"][..., 3].sum() + saved["current"][..., 3].sum())
 
-    rtpy.render(scene, camera=camera.with_width(120), spp=SPP, checkpoint=state,
+    rtpy.render(scene, camera=camera.with_width(100), spp=SPP, checkpoint=state,
                 preview=look, preview_seconds=0)  # fmt: skip
     assert len(held) > 10 and held == sorted(held) and len(set(held)) == len(held)
 
