@@ -5,7 +5,9 @@ A module loaded from a file path is not on sys.path, so a worker process started
 `spawn` or `forkserver` cannot import it by name when it rebuilds the scene. Each
 plugin is therefore loaded under a name derived from its resolved path alone (the
 same in every process) and listed in PLUGINS; the renderer's workers load the listed
-plugins before they rebuild the scene.
+plugins before they rebuild the scene. Workers on other machines (rtpy.cluster) have
+not the file: they receive its source (plugin_sources) and run it under the same name
+(load_plugin_source).
 """
 
 from __future__ import annotations
@@ -60,3 +62,25 @@ def load_listed_plugins(plugins: dict[str, str]) -> None:
     """Load the plugins another process listed in its PLUGINS (a worker's start-up)."""
     for path in plugins.values():
         load_plugin(path)
+
+
+def plugin_sources() -> dict[str, tuple[str, str]]:
+    """The plugins loaded here, for another machine: module name -> (the file's path
+    here, its source)."""
+    return {name: (path, Path(path).read_text(encoding="utf-8")) for name, path in PLUGINS.items()}
+
+
+def load_plugin_source(name: str, source: str, path: str) -> ModuleType:
+    """Run a plugin's `source` (from another machine's file `path`) as the module
+    `name` that machine gave it (once). PluginError as load_plugin's."""
+    if name in sys.modules:
+        return sys.modules[name]
+    module = ModuleType(name)
+    module.__file__ = path
+    sys.modules[name] = module
+    try:
+        exec(compile(source, path, "exec"), module.__dict__)
+    except Exception as err:
+        del sys.modules[name]
+        raise PluginError(f"{path}: {type(err).__name__}: {err}") from err
+    return module

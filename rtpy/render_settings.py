@@ -35,7 +35,6 @@ from .sampler import SAMPLERS
 from .vec3 import Color
 
 __all__ = [
-    "BACKENDS",
     "INTEGRATOR_NAMES",
     "MAX_MAX_DEPTH",
     "MAX_SPP",
@@ -49,7 +48,6 @@ __all__ = [
 ]
 
 INTEGRATOR_NAMES = ("center", "jittered", "direct", "whitted", "path")
-BACKENDS = ("scalar", "numpy")  # rtpy.renderer.make_backend builds them
 
 # Sanity limits: larger values would exhaust memory or never finish.
 MAX_WIDTH = 16384
@@ -217,6 +215,14 @@ SETTINGS: dict[str, Setting] = {
             flag=True,
         ),
         Setting(
+            "time_limit",
+            "float",
+            0.0,
+            "seconds of rendering at most: whole passes until they are spent (at least "
+            "one), spp the most samples per pixel; 0 = no limit",
+            Range(0, 1e6, hi_open=True),
+        ),
+        Setting(
             "width",
             "int",
             400,
@@ -256,6 +262,7 @@ class RenderSettings:
     gamma: float | str = SETTINGS["gamma"].default
     mis: bool = SETTINGS["mis"].default
     sampler: str = SETTINGS["sampler"].default
+    time_limit: float = SETTINGS["time_limit"].default
 
     def __post_init__(self) -> None:
         for f in fields(self):

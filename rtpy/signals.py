@@ -7,7 +7,7 @@ moment it starts importing until it exits:
   (`defer`): an import cut in the middle would end in a traceback; the command then
   stops before doing anything;
 - while it works (`stop_on_signals`), the first signal raises KeyboardInterrupt, so a
-  render stops and keeps what is finished, a write is undone (rtpy.io.image);
+  render stops and keeps what is finished, a write is undone (rtpy.files);
 - a second signal ends the process at once: worker processes are killed, temporary
   files removed, and nothing is half-written.
 
@@ -26,8 +26,10 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from .exit_status import EXIT_SIGNALLED
+
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-EXIT_STATUS = {signal.SIGINT: 130, signal.SIGTERM: 143}
+EXIT_STATUS = EXIT_SIGNALLED  # 130 after SIGINT, 143 after SIGTERM
 NOTHING_WRITTEN = "interrupted: nothing was written"
 
 _received: list[int] = []  # the signals received, in order
@@ -88,6 +90,20 @@ def finishing() -> Iterator[None]:
     work that is better finished than undone (writing a finished image); the
     command then ends with its status. A second one ends the process at once."""
     with _handled_by(_record):
+        yield
+
+
+@contextmanager
+def finishing_if_handled() -> Iterator[None]:
+    """`finishing` where rtpy's handlers stop the work (its command line); nothing
+    elsewhere: a program that imports rtpy keeps its own handlers (a Ctrl-C there
+    undoes the write, as any atomic write, rtpy.files)."""
+    if threading.current_thread() is threading.main_thread() and (
+        signal.getsignal(signal.SIGINT) is _raise
+    ):
+        with finishing():
+            yield
+    else:
         yield
 
 
@@ -170,8 +186,8 @@ def end_now() -> None:
 
 
 def _remove_temporary_files() -> None:
-    """rtpy.io.image.remove_temporary_files, if that module is imported (whole)."""
-    remove = getattr(sys.modules.get("rtpy.io.image"), "remove_temporary_files", None)
+    """rtpy.files.remove_temporary_files, if that module is imported (whole)."""
+    remove = getattr(sys.modules.get("rtpy.files"), "remove_temporary_files", None)
     if remove is not None:
         remove()
 

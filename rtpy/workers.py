@@ -1,5 +1,5 @@
-"""Worker processes: the units of a render on other processes, under every start
-method.
+"""Worker processes: the executor that renders the units of a render on other
+processes of this machine, under every start method.
 
 A worker process receives the backend (the scene, camera and settings) once, when
 it starts. Under the `fork` start method it inherits the object; under `spawn` and
@@ -17,18 +17,29 @@ import os
 import pickle
 import signal
 import sys
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections.abc import Callable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import TYPE_CHECKING
 
 from . import signals
+from .executor import Executor, Result, WorkerError
 from .plugins import PLUGINS, load_listed_plugins
 
 if TYPE_CHECKING:
     import numpy as np
 
-    from .renderer import Backend, Unit
+    from .backend import Backend
+    from .plan import Unit
+
+__all__ = [
+    "START_ADVICE",
+    "WorkerError",
+    "WorkerProcesses",
+    "available_cpus",
+    "cannot_rebuild",
+    "end_processes",
+]
 
 _render_one: Callable[[Unit], np.ndarray] | None = None
 _start_error = ""
@@ -47,11 +58,6 @@ def available_cpus() -> int:
     if hasattr(os, "sched_getaffinity"):  # Linux and some other Unix systems
         return len(os.sched_getaffinity(0)) or 1
     return os.cpu_count() or 1
-
-
-class WorkerError(RuntimeError):
-    """The worker processes cannot rebuild the render (a class the scene uses cannot
-    be imported by a process started by spawn or forkserver), or one ended abruptly."""
 
 
 START_ADVICE = (
@@ -113,59 +119,90 @@ def _stop_workers(executor: ProcessPoolExecutor) -> None:
     executor._result_queue._writer.close()
 
 
-def run_on_workers(backend: Backend, units: list[Unit], workers: int):
-    """Yield (unit, sums) for every unit as worker processes finish them, in the order
-    they finish; the processes start by the default start method
-    (multiprocessing.get_context()). Raises WorkerError if they cannot start or one
-    ends abruptly."""
-    context = multiprocessing.get_context()
-    method = context.get_start_method()
-    try:
-        payload = backend if method == "fork" else pickle.dumps(backend)
-    except (pickle.PicklingError, AttributeError, TypeError) as err:  # a local class
-        raise cannot_rebuild(f"{type(err).__name__}: {err}", method) from None
-    if sys.platform == "win32":
-        workers = min(workers, WINDOWS_MAX_WORKERS)
-    if method == "forkserver":  # started now, not with the signals blocked below
-        from multiprocessing import forkserver
+class WorkerProcesses(Executor):
+    """`workers` processes of this machine, started by the default start method
+    (multiprocessing.get_context()) when a render starts and ended when it stops;
+    each has two units at a time ahead of it."""
 
-        forkserver.ensure_running()
-    before = set(multiprocessing.active_children())
-    executor = None
-    try:
-        # A signal while the processes start waits until they all are in the
-        # executor's table, so that stopping the pool stops every one of them.
-        with signals.held():
-            executor = ProcessPoolExecutor(
-                workers,
-                mp_context=context,
-                initializer=_init_worker,
-                initargs=(dict(PLUGINS), payload),
-            )
-            futures = [executor.submit(_run_unit, unit) for unit in units]
-        for future in as_completed(futures):
-            yield future.result()
-    except WorkerError as err:
-        _stop_workers(executor)
-        raise cannot_rebuild(str(err), method) from None
-    except BrokenProcessPool:
-        raise WorkerError(
-            f"a worker process (start method {method!r}) ended abruptly: it was killed, "
-            f"ran out of memory or failed while starting (its error is above). {START_ADVICE}"
-        ) from None
-    except BaseException:
-        if executor is not None:
-            _stop_workers(executor)  # at once on Ctrl-C or an error
-        raise
-    finally:
-        if executor is not None:
-            executor.shutdown(wait=True, cancel_futures=True)
-        _end_processes(before)
+    name = "worker processes"
+
+    def __init__(self, workers: int) -> None:
+        self.workers = workers
+
+    def run(
+        self, backend: Backend, units: Iterator[Unit], timeout: float | None = None
+    ) -> Iterator[Result | None]:
+        context = multiprocessing.get_context()
+        method = context.get_start_method()
+        try:
+            payload = backend if method == "fork" else pickle.dumps(backend)
+        except (pickle.PicklingError, AttributeError, TypeError) as err:  # a local class
+            raise cannot_rebuild(f"{type(err).__name__}: {err}", method) from None
+        workers = (
+            min(self.workers, WINDOWS_MAX_WORKERS) if sys.platform == "win32" else self.workers
+        )
+        if method == "forkserver":  # started now, not with the signals blocked below
+            from multiprocessing import forkserver
+
+            forkserver.ensure_running()
+        before = set(multiprocessing.active_children())
+        executor = None
+        pending: dict[Future, Unit] = {}
+        try:
+            # A signal while the processes start waits until they all are in the
+            # executor's table, so that stopping the pool stops every one of them
+            # (they start with the first units submitted).
+            with signals.held():
+                executor = ProcessPoolExecutor(
+                    workers,
+                    mp_context=context,
+                    initializer=_init_worker,
+                    initargs=(dict(PLUGINS), payload),
+                )
+                _submit(executor, pending, units, 2 * workers)
+            while pending:
+                done, _ = wait(pending, timeout=timeout, return_when=FIRST_COMPLETED)
+                if not done:
+                    yield None
+                for future in done:
+                    del pending[future]
+                    result = future.result()
+                    _submit(executor, pending, units, 2 * workers)
+                    yield result
+        except WorkerError as err:
+            _stop_workers(executor)
+            raise cannot_rebuild(str(err), method) from None
+        except BrokenProcessPool:
+            raise WorkerError(
+                f"a worker process (start method {method!r}) ended abruptly: it was killed, "
+                f"ran out of memory or failed while starting (its error is above). {START_ADVICE}"
+            ) from None
+        except BaseException:
+            if executor is not None:
+                _stop_workers(executor)  # at once on Ctrl-C, an error or a stop
+            raise
+        finally:
+            if executor is not None:
+                executor.shutdown(wait=True, cancel_futures=True)
+            end_processes(before)
 
 
-def _end_processes(before: set) -> None:
+def _submit(executor: ProcessPoolExecutor, pending: dict, units: Iterator[Unit], ahead: int):
+    """Submit units until `ahead` are pending (or there are no more)."""
+    while len(pending) < ahead:
+        unit = next(units, None)
+        if unit is None:
+            return
+        pending[executor.submit(_run_unit, unit)] = unit
+
+
+def end_processes(before: set, grace: float = 0.0) -> None:
     """End and join the child processes started since the children `before` were
-    (those the executor did not: one it was starting when it failed or was stopped)."""
-    for process in set(multiprocessing.active_children()) - before:
+    (those the executor did not: one it was starting when it failed or was stopped),
+    after `grace` seconds for them to end on their own."""
+    left = set(multiprocessing.active_children()) - before
+    for process in left:
+        process.join(grace)
+    for process in left:
         process.terminate()
         process.join()

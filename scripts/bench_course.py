@@ -236,7 +236,7 @@ def region_lines() -> dict[str, set[int]]:
 def classify(raw: str, regions: dict[str, set[int]]) -> tuple[Counter, Counter, int]:
     """From py-spy's raw stacks: samples per share ("regions", "Vec3 from regions",
     "elsewhere"), samples per function elsewhere, and the samples inside the render
-    (stacks through renderer.render_unit). A sample belongs to its innermost rtpy
+    (stacks through scalar_backend.render_unit). A sample belongs to its innermost rtpy
     frame (builtins such as math.sqrt count for their caller); a Vec3 method outside
     the regions called from a region's line is "Vec3 from regions"."""
     shares, elsewhere, total = Counter(), Counter(), 0

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import rtpy
-from rtpy.io.cli import UsageError, parse_set, validate_overrides
+from rtpy.io.cli import UsageError
 from rtpy.io.scene_file import SceneError, load_scene_text
 from rtpy.render_settings import (
     RENDER_KEYS,
@@ -26,6 +26,7 @@ from rtpy.sphere import Sphere
 from rtpy.vec3 import Color, Vec3
 
 from .io.scene_text import VALUES, toml_value
+from .io.test_cli import checked_by_the_command_line
 
 
 def test_render_settings_fields_are_the_field_settings_with_their_defaults():
@@ -115,7 +116,7 @@ def through_api(key: str, value) -> str | object:
 
 def through_command_line(key: str, value) -> str | object:
     try:
-        (checked,) = validate_overrides(parse_set([f"{key}={toml_value(value)}"])).values()
+        (checked,) = checked_by_the_command_line("--set", f"{key}={toml_value(value)}").values()
     except UsageError as e:
         return str(e).removeprefix(f"--set {key}: ")
     return checked

@@ -1,83 +1,18 @@
-"""Renderer: work units, determinism across worker counts, interrupted renders, and the
-one loop that drives any backend."""
+"""Renderer: the one loop for any backend and executor: determinism across worker
+counts, Ctrl-C and time limits keeping whole passes, previews, the progress bar."""
 
 from __future__ import annotations
 
-import math
 import re
-import sys
 
 import numpy as np
 import pytest
-from hypothesis import given
-from hypothesis import strategies as st
 
 import rtpy
 from rtpy import Camera, Color, DiffuseLight, Lambertian, Metal, Scene, Sphere, Vec3
-from rtpy.renderer import (
-    MAX_BATCHES,
-    MAX_PASS_SPP,
-    Backend,
-    PixelSums,
-    Renderer,
-    plan_bands,
-    plan_units,
-)
-
-
-@pytest.mark.parametrize("width,height,spp", [(1, 1, 1), (16, 16, 16), (37, 21, 5), (40, 3, 64)])
-def test_units_cover_every_pixel_with_exactly_spp_samples(width, height, spp):
-    counts = np.zeros((height, width), dtype=int)
-    for unit in plan_units(width, height, spp):
-        counts[unit.y0 : unit.y1, unit.x0 : unit.x1] += unit.spp
-    np.testing.assert_array_equal(counts, spp)
-
-
-@given(st.integers(1, 300), st.integers(1, 60), st.integers(1, 200), st.integers(1, 5000))
-def test_bands_cover_every_pixel_once_per_batch_within_the_path_budget(
-    width, height, spp, paths_per_unit
-):
-    units = plan_bands(width, height, spp, paths_per_unit)
-    counts = np.zeros((height, width), dtype=int)
-    regions: dict[int, set] = {}
-    for unit in units:
-        counts[unit.y0 : unit.y1, unit.x0 : unit.x1] += unit.spp
-        assert (unit.x1 - unit.x0) * (unit.y1 - unit.y0) * unit.spp <= paths_per_unit
-        regions.setdefault(unit.batch, set()).add((unit.region, unit.x0, unit.y0, unit.x1, unit.y1))
-    np.testing.assert_array_equal(counts, spp)
-    assert len({frozenset(r) for r in regions.values()}) == 1  # the same regions every batch
-    assert [u.batch for u in units] == sorted(u.batch for u in units)
-    # As few passes as hold `wanted` samples per pixel each: enough to fill a unit, and
-    # at least spp / MAX_BATCHES up to MAX_PASS_SPP, within the budget
-    fill = paths_per_unit // (width * height)
-    longer = min(math.ceil(spp / MAX_BATCHES), MAX_PASS_SPP, paths_per_unit)
-    wanted = min(spp, max(1, fill, longer))
-    assert len(regions) == math.ceil(spp / wanted)
-
-
-@pytest.mark.parametrize(
-    "width,height,spp,passes,pass_spp,bands",
-    [
-        (1920, 1080, 1, 1, 1, 32),  # more pixels than a unit holds paths: 1 spp
-        (256, 256, 64, 8, 8, 8),  # an eighth of the samples a pass: 8 x 8192 pixels
-        (256, 256, 4096, 256, 16, 16),  # at most 16 a pass: 16 x 4096 pixels
-        (48, 48, 20000, 715, 28, 1),  # a small image: 28 spp fill a unit of 2304 pixels
-    ],
-)
-def test_bands_as_docs_numpy_backend_describes_them(width, height, spp, passes, pass_spp, bands):
-    """docs/numpy-backend.md's examples and test_cli's Ctrl-C render, counted by hand, for
-    units of 65,536 paths."""
-    units = plan_bands(width, height, spp, 65536)
-    assert len({u.batch for u in units}) == passes
-    assert max(u.spp for u in units) == pass_spp
-    assert len({u.region for u in units}) == bands
-
-
-def test_units_run_batch_by_batch():
-    """Every tile gets its first batch before any tile gets a second one, so an
-    interrupted render covers the whole image."""
-    batches = [u.batch for u in plan_units(64, 48, 16)]
-    assert batches == sorted(batches)
+from rtpy.backend import Backend
+from rtpy.plan import Plan
+from rtpy.renderer import Renderer
 
 
 def small_scene() -> tuple[Scene, Camera]:
@@ -126,8 +61,8 @@ class Counting(Backend):
     def uses_center_ray(self) -> bool:
         return False  # no integrator at all
 
-    def plan_units(self, width, height, spp):
-        return plan_units(width, height, spp, tile=8)
+    def plan(self, width, height, spp):
+        return Plan(width, height, spp, 8 * width)  # at 1 spp, bands of 8 rows
 
     def start(self):
         return lambda unit: np.full(
@@ -137,13 +72,17 @@ class Counting(Backend):
 
 @pytest.mark.parametrize("workers", [1, 2])
 def test_the_loop_drives_any_backend(workers):
-    scene, camera = small_scene()  # 40 x 22: tiles of 8 x 8, five per row
-    renderer = Renderer(scene, camera.with_width(40), rtpy.RenderSettings(spp=5), workers)
-    renderer.backend = Counting(scene, camera, renderer.settings)
+    """Counting's sample is its unit's region, so a pixel's mean is the mean of its
+    regions over the passes: passes of 1, 1 and 2 spp in bands of 8, 8 and 4 rows."""
+    scene, camera = small_scene()  # 40 x 22
+    settings = rtpy.RenderSettings(spp=4)
+    renderer = Renderer(scene, camera, settings, workers, backend=Counting(scene, camera, settings))
     image = renderer.render()
-    tile = np.arange(image.height)[:, None] // 8 * 5 + np.arange(image.width)[None, :] // 8
-    np.testing.assert_array_equal(image.linear, np.repeat(tile[..., None], 3, axis=2))
-    assert image.stats["backend"] == "counting" and image.samples_min == image.samples_max == 5
+    rows = np.arange(image.height)[:, None]
+    expected = (rows // 8 + rows // 8 + 2 * (rows // 4)) / 4 * np.ones(image.width)
+    np.testing.assert_array_equal(image.linear, np.repeat(expected[..., None], 3, axis=2))
+    assert image.stats["backend"] == "counting" and image.samples_min == image.samples_max == 4
+    assert image.stats["workers"] == workers and image.stats["passes"] == 3
 
 
 class InterruptAfter(Sphere):
@@ -160,115 +99,35 @@ class InterruptAfter(Sphere):
         return super().hit_t(ray, t_min, t_max)
 
 
-def test_ctrl_c_keeps_finished_samples():
+def test_ctrl_c_keeps_the_whole_passes_the_image_of_fewer_samples():
+    """Ctrl-C half-way through the third pass (of 1, 1, 2, 4 spp): the image of the
+    first two, the same samples in every pixel (no black holes), bit for bit the
+    render of 2 spp."""
     scene, camera = small_scene()
-    pixels = camera.width * camera.height
-    scene.add_object(InterruptAfter(calls=pixels * 8))  # about a quarter of the work
+    sphere = InterruptAfter(calls=10**12)  # counts its intersection tests
+    scene.add_object(sphere)
+
+    def tests_made(spp: int) -> tuple[int, np.ndarray]:
+        sphere.calls = 10**12
+        image = rtpy.render(scene, camera=camera, spp=spp, seed=1)
+        return 10**12 - sphere.calls, image.linear
+
+    two, two_spp = tests_made(2)
+    four, _ = tests_made(4)
+    sphere.calls = (two + four) // 2  # in the third pass, which holds 2 spp
     image = rtpy.render(scene, camera=camera, spp=8, seed=1)
-    assert image.interrupted
-    assert 1 <= image.samples_min < 8
-    assert image.samples_max < 8
-    assert image.stats["paths"] < pixels * 8
-    # Every pixel holds some finished samples: no black holes in the image.
-    assert (image.linear.sum(axis=2) > 0).all()
-    assert np.isfinite(image.linear).all()
-
-
-def test_pixel_sums_do_not_depend_on_the_order_units_arrive_in():
-    """Workers finish units in any order; PixelSums adds each tile's batches in batch
-    order, so the image is bit for bit the same (adding in arrival order is not:
-    float addition is not associative), and a unit is kept only until it is added.
-    At every moment each pixel has the same samples, give or take one pass (a batch
-    of 1 spp here)."""
-    units = plan_units(40, 20, 6)
-    rng = np.random.default_rng(1)
-    sums = [rng.random((u.y1 - u.y0, u.x1 - u.x0, 3)) * 10.0 ** rng.integers(-8, 8) for u in units]
-    in_order, shuffled = PixelSums(40, 20, 6), PixelSums(40, 20, 6)  # 6 tiles
-    naive = np.zeros((20, 40, 3))
-    for unit, s in zip(units, sums, strict=True):
-        in_order.add(unit, s)
-    for i in rng.permutation(len(units)):
-        shuffled.add(units[i], sums[i])
-        u = units[i]
-        naive[u.y0 : u.y1, u.x0 : u.x1] += sums[i]
-        assert shuffled.counts.max() - shuffled.counts.min() <= 1
-    assert not shuffled._waiting and not in_order._waiting  # everything added
-    np.testing.assert_array_equal(shuffled.total, in_order.total)
-    np.testing.assert_array_equal(shuffled.counts, np.full((20, 40), 6))
-    assert not np.array_equal(naive, in_order.total[..., :3])
-
-
-def test_pixel_sums_after_ctrl_c_drop_the_units_that_wait():
-    """A unit waits for an earlier batch of its region, or while it would put its
-    region more than a pass ahead of another; after Ctrl-C they are dropped."""
-    units = plan_units(32, 16, 3)  # two tiles, batches 0, 1, 2
-    acc = PixelSums(32, 16, 2)
-    ones = np.ones((16, 16, 3))
-    acc.add(units[0], ones)  # tile 0, batch 0
-    acc.add(units[2], ones)  # tile 0, batch 1: two passes ahead of tile 1: waits
-    acc.add(units[5], ones)  # tile 1, batch 2: its batches 0 and 1 are not there
-    assert acc.passes == 0 and len(acc._waiting) == 2
-    acc.add(units[1], ones)  # tile 1, batch 0: pass 0 finished, tile 0's batch 1 added
-    assert acc.passes == 1 and list(acc._waiting) == [(1, 2)]
-    acc.finish()
-    assert not acc._waiting
-    np.testing.assert_array_equal(acc.counts[:, :16], 2)
-    np.testing.assert_array_equal(acc.counts[:, 16:], 1)
-
-
-def interrupt_at(opcode: int):
-    """A tracer raising KeyboardInterrupt (a Ctrl-C's) before the opcode-th bytecode
-    that PixelSums' own methods execute, counting from 1."""
-    seen = 0
-
-    def tracer(frame, event, arg):
-        nonlocal seen
-        if event == "call":
-            if frame.f_code.co_qualname.split(".")[0] != "PixelSums":
-                return None
-            frame.f_trace_opcodes = True
-            return tracer
-        if event == "opcode":
-            seen += 1
-            if seen == opcode:
-                raise KeyboardInterrupt
-        return tracer
-
-    return tracer
-
-
-def test_pixel_sums_keep_every_sum_with_its_count_whatever_bytecode_ctrl_c_cuts():
-    """Ctrl-C raises KeyboardInterrupt between any two bytecodes, also inside
-    PixelSums.add; after it, each pixel's sum must be that of as many batches as its
-    count says, and every count within a pass of the others. Batch b of 1 spp adds
-    2**b, so a sum names the batches in it."""
-    units = plan_units(32, 16, 3)  # 2 tiles x batches 0, 1, 2
-    order = [units[i] for i in (0, 3, 1, 5, 4, 2)]  # tile 0: batch 2 before batch 1
-    for opcode in range(1, 10_000):
-        acc = PixelSums(32, 16, 2)
-        sys.settrace(interrupt_at(opcode))
-        try:
-            for unit in order:
-                acc.add(unit, np.full((unit.y1 - unit.y0, unit.x1 - unit.x0, 3), 2.0**unit.batch))
-        except KeyboardInterrupt:
-            interrupted = True
-        else:
-            interrupted = False
-        finally:
-            sys.settrace(None)
-        acc.finish()
-        counts = [[int(b).bit_count() for b in row] for row in acc.total[..., 0]]
-        np.testing.assert_array_equal(acc.counts, counts, err_msg=f"cut at bytecode {opcode}")
-        assert acc.counts.max() - acc.counts.min() <= 1, f"cut at bytecode {opcode}"
-        if not interrupted:
-            assert opcode > 100 and (acc.counts == 3).all()  # every cut was tried
-            break
+    pixels = camera.width * camera.height
+    assert image.interrupted and image.stats["stopped"] == "interrupted"
+    assert image.samples_min == image.samples_max == 2
+    assert image.stats["paths"] == pixels * 2 < image.stats["paths_rendered"] + pixels * 2
+    assert (image.linear.sum(axis=2) > 0).all() and np.isfinite(image.linear).all()
+    np.testing.assert_array_equal(image.linear, two_spp)
 
 
 def test_more_workers_than_units_start_no_idle_process(monkeypatch):
     """An image of one unit renders in this process whatever the worker count."""
     scene, camera = small_scene()
-    monkeypatch.setattr("rtpy.renderer.run_on_workers", None)  # calling it would fail
+    monkeypatch.setattr("rtpy.renderer.WorkerProcesses", None)  # calling it would fail
     image = rtpy.render(scene, camera=camera.with_width(8), integrator="center", workers=4)
     assert image.samples_min == 1
 
@@ -312,25 +171,25 @@ def test_bad_progress_options_are_refused(options, error, message):
 
 def test_previews_are_whole_frames_that_sharpen_and_leave_the_image_alone():
     """With preview_seconds=0 a preview follows every unit but the last: each holds
-    more samples than the one before, every pixel within one pass of the others
-    (batches are passes), and the final image is the one rendered without previews."""
+    more samples than the one before, every pixel within one pass of the others, and
+    the final image is the one rendered without previews."""
     scene, camera = small_scene()
     previews = []
     image = rtpy.render(scene, camera=camera, spp=8, seed=3, preview=previews.append,
                         preview_seconds=0)  # fmt: skip
-    units = plan_units(camera.width, camera.height, 8)
-    assert len(previews) == len(units) - 1
+    plan = Plan(camera.width, camera.height, 8, 4096)
+    assert len(previews) == plan.count_units() - 1
     paths = [p.stats["paths"] for p in previews]
     assert paths == sorted(set(paths)) and paths[-1] < image.stats["paths"]
     for p in previews:
-        assert p.interrupted and p.samples_max - p.samples_min <= 1  # 8 passes of 1 spp
+        assert p.interrupted and p.samples_max - p.samples_min <= max(plan.passes)
         assert np.isfinite(p.linear).all()
     alone = rtpy.render(scene, camera=camera, spp=8, seed=3)
     np.testing.assert_array_equal(image.linear, alone.linear)
     assert not image.interrupted
-    # Batch b of 8 draws what batch b of any spp >= b + 1 draws: the preview holding
-    # k whole passes is the image of k spp.
-    for k in (1, 2):
+    # Pass k of 8 spp draws what pass k of any spp that has it draws: the preview
+    # holding k whole passes is the image of their samples.
+    for k in (1, 2, 4):
         whole = [p for p in previews if p.samples_min == p.samples_max == k][0]
         fewer = rtpy.render(scene, camera=camera, spp=k, seed=3)
         np.testing.assert_array_equal(whole.linear, fewer.linear)
@@ -352,3 +211,45 @@ def test_preview_arguments_are_checked(kwargs, error):
     scene, camera = small_scene()
     with pytest.raises(error, match="preview"):
         rtpy.render(scene, camera=camera, spp=1, **kwargs)
+
+
+# --- time limit -------------------------------------------------------------------------
+
+
+class Clock:
+    """A perf_counter that moves one second each time it is read: the loop reads it
+    at the start and after each unit, so the time limit is met after a known unit."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def perf_counter(self) -> float:
+        self.now += 1.0
+        return self.now
+
+
+@pytest.mark.parametrize("limit,samples", [(2.5, 4), (1e-6, 1)])
+def test_a_time_limit_keeps_whole_passes_at_least_one(monkeypatch, limit, samples):
+    """40 x 22 at 8 spp: one unit per pass (1, 1, 2, 4 spp), one second each on the
+    clock. A limit of 2.5 s ends after the third pass, one of a microsecond after the
+    first: the image of that many samples, bit for bit, not interrupted."""
+    scene, camera = small_scene()
+    monkeypatch.setattr("rtpy.renderer.time", Clock())
+    image = rtpy.render(scene, camera=camera, spp=8, seed=5, time=limit)
+    assert image.samples_min == image.samples_max == samples and image.spp == 8
+    assert image.stats["stopped"] == "time limit" and not image.interrupted
+    monkeypatch.undo()
+    fewer = rtpy.render(scene, camera=camera, spp=samples, seed=5)
+    np.testing.assert_array_equal(image.linear, fewer.linear)
+
+
+def test_time_is_the_time_limit_setting():
+    scene, camera = small_scene()
+    image = rtpy.render(scene, camera=camera.with_width(8), spp=2, time_limit=1e5)
+    assert image.samples_min == 2 and image.stats["stopped"] is None
+    with pytest.raises(ValueError, match="time and time_limit are one setting"):
+        rtpy.render(scene, camera=camera, time=1, time_limit=2)
+    with pytest.raises(
+        ValueError, match=re.escape("time_limit: expected a number in [0, 1000000)")
+    ):
+        rtpy.render(scene, camera=camera, time=-1)

@@ -10,7 +10,6 @@ without a handler running (rtpy/signals.py).
 
 from __future__ import annotations
 
-import itertools
 import os
 import random
 import re
@@ -27,17 +26,17 @@ import numpy as np
 import pytest
 
 import rtpy
-from rtpy import signals
-from rtpy.io import image
-from rtpy.renderer import Unit, make_backend
+from rtpy import files, signals
+from rtpy.backend import make_backend
+from rtpy.pixel_sums import PixelSums
 
 from .commands import read_until, rtpy_command
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 
 SCENE = "week08_three_balls"
-WIDTH = 32  # 32x18: 4 tiles for the scalar backend
-SPP = {"scalar": 8, "numpy": 128}  # 8 passes of 1 sample; 2 passes of 64 (2 units)
+WIDTH = 32  # 32x18
+SPP = {"scalar": 8, "numpy": 128}  # passes of 1, 1, 2, 4; and 1, 1, 2, ..., 64
 RTPY_FILES = str(Path(rtpy.__file__).parent) + os.sep
 
 
@@ -140,7 +139,7 @@ def test_an_error_an_interrupt_caused_counts_as_the_interrupt():
 def test_stopping_removes_the_temporary_files_of_interrupted_writes(tmp_path, capsys):
     """A Ctrl-C between the creation of a temporary file and the try that removes
     it leaves the file listed; the command's end removes it."""
-    tmp = image._new_temporary_file(tmp_path / "out.png")
+    tmp = files._new_temporary_file(tmp_path / "out.png")
     assert tmp.exists()
     assert signals.stopped("interrupted: nothing was written") in (130, 143)
     assert not tmp.exists() and "rtpy: interrupted: nothing was written" in capsys.readouterr().err
@@ -251,52 +250,35 @@ def group_processes(pgid: int) -> list[str]:
 
 
 @cache
-def plan(backend_name: str, spp: int):
-    """The backend the command makes for this scene and spp, and its units of work."""
+def whole_passes(backend_name: str) -> dict[int, np.ndarray]:
+    """samples -> the image of the first passes holding them, at SPP[backend_name],
+    rendered here: what the command writes, bit for bit, whatever its workers."""
     scene = rtpy.load_scene(SCENE)
     camera = scene.camera.with_width(WIDTH)
+    spp = SPP[backend_name]
     backend = make_backend(backend_name, scene, camera, scene.settings.with_overrides(spp=spp))
-    return backend, backend.plan_units(camera.width, camera.height, spp)
-
-
-@cache
-def unit_sums(backend_name: str) -> dict[int, list[tuple[Unit, np.ndarray]]]:
-    """region -> [(unit, sums)] of every batch at SPP[backend_name], rendered here: the
-    sums the command adds, bit for bit, whatever its number of workers."""
-    backend, units = plan(backend_name, SPP[backend_name])
+    plan = backend.plan(camera.width, camera.height, spp)
     render_one = backend.start()
-    regions: dict[int, list] = {}
-    for unit in units:
-        regions.setdefault(unit.region, []).append((unit, render_one(unit)))
-    return regions
+    results = [(unit, render_one(unit)) for unit in plan.units()]
+    images = {}
+    for passes in range(1, len(plan.passes) + 1):
+        sums = PixelSums(plan)
+        for unit, unit_sums in results:
+            if unit.batch < passes:
+                sums.add(unit, unit_sums)
+        images[plan.samples_after(passes)] = sums.mean()
+    return images
 
 
-def samples_per_region(run: Run, linear: np.ndarray) -> set[int] | None:
-    """The samples each region of the image holds, read from its values: each
-    region must be the mean of some of its batches (added in batch order, as
-    rtpy.renderer.PixelSums adds them), else AssertionError. None when the run's
-    spp is not SPP[backend] (not checked: its batches are not rendered here)."""
+def samples_of(run: Run, linear: np.ndarray) -> int | None:
+    """The samples per pixel of the whole passes the image is, bit for bit, else
+    AssertionError; None when the run's spp is not SPP[backend] (not rendered here)."""
     if run.samples != SPP[run.backend]:
         return None
-    counts = set()
-    for units in unit_sums(run.backend).values():
-        u = units[0][0]
-        pixels = linear[u.y0 : u.y1, u.x0 : u.x1]
-        for n in range(1, len(units) + 1):
-            for subset in itertools.combinations(units, n):
-                total = np.zeros_like(pixels)
-                for _, sums in subset:
-                    total += sums
-                spp = sum(unit.spp for unit, _ in subset)
-                if np.array_equal(pixels, total / spp):
-                    counts.add(spp)
-                    break
-            else:
-                continue
-            break
-        else:
-            raise AssertionError(f"region {u.region} is no mean of its batches")
-    return counts
+    for samples, image in whole_passes(run.backend).items():
+        if np.array_equal(linear, image):
+            return samples
+    raise AssertionError("the image is not that of whole passes")
 
 
 def check(run: Run, proc: subprocess.Popen, err: str, outputs: list[Path], folder: Path):
@@ -314,20 +296,16 @@ def check(run: Run, proc: subprocess.Popen, err: str, outputs: list[Path], folde
     assert not [p.name for p in folder.iterdir() if p.suffix == ".tmp"], "temporary files"
     assert group_processes(proc.pid) == [], "processes left running"
     written = [p for p in outputs if p.exists() and p.read_bytes() != OLD]
-    held = re.search(r"holding (\d+)-(\d+) of (\d+) samples per pixel", err)
+    held = re.search(r"holding (\d+) of (\d+) samples per pixel", err)
     if "rtpy: wrote" in err or "interrupted while writing" in err:  # a finished image
         assert written == outputs
-        assert samples_per_region(run, np.load(outputs[1])) in (None, {run.samples})
+        assert samples_of(run, np.load(outputs[1])) in (None, run.samples)
     elif held is not None:
-        fewest, most = int(held[1]), int(held[2])
-        counts = samples_per_region(run, np.load(outputs[1]))
-        assert counts is None or (min(counts), max(counts)) == (fewest, most)
-        one_pass = max(unit.spp for unit in plan(run.backend, run.samples)[1])
-        assert 1 <= fewest and most - fewest <= one_pass and written == outputs
+        assert written == outputs and 1 <= int(held[1]) < run.samples
+        assert samples_of(run, np.load(outputs[1])) in (None, int(held[1]))
     elif "stopped at once" in err:  # the outputs written whole before it, or untouched
         if outputs[1] in written:
-            counts = samples_per_region(run, np.load(outputs[1]))
-            assert counts is None or max(counts) - min(counts) <= max(SPP.values())
+            samples_of(run, np.load(outputs[1]))  # whole passes
     else:
         assert written == [], "an output changed though the message says nothing was written"
 
@@ -365,7 +343,7 @@ def test_a_signal_at_a_random_moment(tmp_path, index):
     """SIGINT or SIGTERM (sometimes twice) at a random moment of a small render, with
     and without an existing output: the right exit status, no traceback, no
     temporary file, no process left, and the outputs untouched or written whole
-    with every pixel within one pass of the others, as the message says."""
+    holding whole passes, as the message says."""
     seed = LOOP_SEED + index
     if replay_seed() is not None:
         if index:
@@ -382,8 +360,8 @@ def test_a_signal_at_a_random_moment(tmp_path, index):
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_sigterm_after_a_pass_writes_it_and_exits_143(tmp_path):
-    """SIGTERM once the progress bar shows the first pass done (scalar, 2 workers):
-    exit 143, the image of the finished passes, within one pass in every pixel."""
+    """SIGTERM once the progress bar shows the first passes done (scalar, 2 workers):
+    exit 143, the image of the finished passes."""
     run = Run("scalar", 2, signal.SIGTERM, delay=-1.0, again=None, existing=True, spp=16)
     proc, outputs = start(run, tmp_path)  # delay < 0: with the progress bar
     seen = read_until(proc, lambda text: re.search(r"(2[5-9]|[3-9]\d)%\|", text) is not None)

@@ -121,7 +121,7 @@ def test_a_worker_ignores_ctrl_c_and_ends_at_once_on_sigterm():
     from concurrent.futures import ProcessPoolExecutor
 
     from rtpy.render_settings import RenderSettings
-    from rtpy.renderer import ScalarBackend
+    from rtpy.scalar_backend import ScalarBackend
     from rtpy.workers import _init_worker
 
     backend = ScalarBackend(*small_scene(), RenderSettings())

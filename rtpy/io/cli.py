@@ -1,11 +1,11 @@
 """Command line: `python -m rtpy render SCENE ...` and `python -m rtpy scenes`; the
 other commands are in rtpy.io.cli_assignment and rtpy.bench.command.
 
-Exit status: 0 done, 1 the work failed: the worker processes (nothing is written) or
-writing an output (disk full, file too large, I/O error: one line naming the file; an
-output that was there is untouched), 2 bad input (scene file, option or output path;
-nothing is written), 130 interrupted by Ctrl-C (SIGINT) and 143 by SIGTERM (the
-passes finished are written first; rtpy.signals).
+The values of a render are checked once, by rtpy.render's boundary
+(rtpy.render_request.prepare_render): the command line reads them (TOML values of
+--set and the flags) and names the option in the one line of an error. Exit
+statuses: rtpy.exit_status (0 done, 1 the workers or a write failed, 2 bad input,
+130 and 143 after SIGINT and SIGTERM, the whole passes written first).
 """
 
 from __future__ import annotations
@@ -16,7 +16,10 @@ import tomllib
 import warnings
 from pathlib import Path
 
-from ..render_settings import BACKENDS, SETTINGS, SettingError, unknown_setting
+from ..backends import BACKENDS
+from ..exit_status import EXIT_BAD_INPUT, EXIT_WORKERS_FAILED, EXIT_WRITE_FAILED
+from ..files import OutputError, WriteError
+from ..render_settings import SETTINGS, SettingError, unknown_setting
 from ..signals import (
     NOTHING_WRITTEN,
     caused_by_interrupt,
@@ -27,13 +30,8 @@ from ..signals import (
 )
 from ..workers import WorkerError, available_cpus
 from .cli_assignment import add_assignment_commands
-from .image import OutputError, WriteError, check_image_path, check_linear_path
+from .image import check_image_path, check_linear_path, write_image
 from .outputs import check_output
-
-EXIT_WORKERS_FAILED = 1
-EXIT_WRITE_FAILED = 1
-EXIT_BAD_INPUT = 2
-
 
 MAX_WORKERS = 256  # more processes than that only exhaust the machine
 
@@ -107,7 +105,19 @@ def build_parser(prog: str = "rtpy", every_command: bool = True) -> argparse.Arg
     )
     parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    add_render_parser(sub)
+    sub.add_parser("scenes", help="list the bundled scenes")
+    if not every_command:
+        return parser
+    from ..bench.command import add_parser as add_bench_parser
 
+    add_bench_parser(sub)
+    add_assignment_commands(sub, seconds)
+    return parser
+
+
+def add_render_parser(sub) -> None:
+    """The `render` command and its options."""
     r = sub.add_parser(
         "render",
         help="render a scene file to an image",
@@ -153,6 +163,23 @@ def build_parser(prog: str = "rtpy", every_command: bool = True) -> argparse.Arg
         default="scalar",
         help="scalar: the readable reference (default); numpy: vectorized, many times faster",
     )
+    r.add_argument(
+        "--time",
+        dest="time_limit",
+        metavar="SECONDS",
+        help="render whole passes until SECONDS are spent (at least one; --spp the most)",
+    )
+    r.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the render stopped with these outputs (its state: OUT.png.resume.npz)",
+    )
+    r.add_argument(
+        "--cluster",
+        metavar="ADDRESS",
+        help="render on Dask distributed: a scheduler's tcp://host:8786, or local "
+        "(a local cluster of -j workers); pip install 'rtpy[cluster]'",
+    )
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     r.add_argument(
         "--plugin",
@@ -161,15 +188,6 @@ def build_parser(prog: str = "rtpy", every_command: bool = True) -> argparse.Arg
         metavar="FILE.py",
         help="import FILE.py first (registers a student's materials by register_material)",
     )
-
-    sub.add_parser("scenes", help="list the bundled scenes")
-    if not every_command:
-        return parser
-    from ..bench.command import add_parser as add_bench_parser
-
-    add_bench_parser(sub)
-    add_assignment_commands(sub, seconds)
-    return parser
 
 
 def load_plugins(paths: list[str]) -> None:
@@ -222,28 +240,52 @@ def parse_set(items: list[str]) -> dict:
     return result
 
 
-def validate_overrides(overrides: dict, as_flags: bool = False) -> dict:
-    """Check command-line overrides against their settings (as strictly as the scene
-    file's own values); the values as rtpy uses them (background a Color)."""
-    checked = {}
-    for key, value in overrides.items():
-        try:
-            checked[key] = SETTINGS[key].check(value)
-        except SettingError as e:
-            option = flag(key) if as_flags else f"--set {key}"
-            raise UsageError(e.for_option(option)) from None
-    return checked
+def given_settings(args: argparse.Namespace) -> dict[str, tuple[str, object]]:
+    """The render settings the command line gives: key -> (the option that gave it,
+    its value read as TOML); UsageError for a flag (--spp) and --set of one key."""
+    given = {key: (f"--set {key}", value) for key, value in parse_set(args.set).items()}
+    flags = {name: flag(name) for name, setting in SETTINGS.items() if setting.flag}
+    flags["time_limit"] = "--time"
+    for key, option in flags.items():
+        text = getattr(args, key)
+        if text is None:
+            continue
+        if key in given:
+            raise UsageError(f"{option} and --set {key} set one value: give one of them")
+        given[key] = (option, read_value(text, option))
+    return given
 
 
-def check_width(scene, path: Path, overrides: dict, option: str) -> None:
-    """A width override must give an image within the size limits with the scene's
-    aspect ratio (checked before anything is allocated)."""
-    if "width" not in overrides or scene.camera is None:
-        return
+def prepare(args: argparse.Namespace, scene, path: Path, given: dict, preview, state):
+    """The Renderer of the command, its values checked by rtpy.render's boundary;
+    UsageError naming the option of a value it refuses."""
+    from ..render_request import AspectError, prepare_render
+
+    def write_preview(image) -> None:
+        write_image(preview, image.linear, image.gamma)
+
     try:
-        scene.camera.with_width(overrides["width"])
-    except ValueError as e:
-        raise UsageError(f"{option} {overrides['width']} with {path}'s aspect ratio: {e}") from None
+        return prepare_render(
+            scene,
+            workers=args.workers,
+            quiet=args.quiet,
+            backend=args.backend,
+            preview=write_preview if preview is not None else None,
+            preview_seconds=args.preview_seconds,
+            cluster=args.cluster,
+            checkpoint=state,
+            resume=args.resume,
+            **{key: value for key, (_, value) in given.items()},
+        )
+    except AspectError as e:
+        option = given["width"][0]
+        raise UsageError(f"{option} {e.width} with {path}'s aspect ratio: {e.reason}") from None
+    except SettingError as e:
+        raise UsageError(e.for_option(given.get(e.key, (f"--set {e.key}",))[0])) from None
+    except (TypeError, ValueError) as e:
+        if str(e).startswith("cluster: "):  # the only other value the command passes on
+            raise UsageError(f"--cluster {args.cluster}: {str(e)[len('cluster: ') :]}") from None
+        raise
 
 
 def check_backend(name: str) -> None:
@@ -278,8 +320,11 @@ def command_render(args: argparse.Namespace) -> int:
 
 
 def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
-    """(output, linear, preview) paths, each writable, none of them a file the render
-    reads (the scene file, its images and meshes, the plugins) or another output."""
+    """(output, linear, preview, state) paths, each writable, none of them a file the
+    render reads (the scene file, its images and meshes, the plugins) or another
+    output; state is where the render is kept to be resumed, beside the output."""
+    from ..render_state import state_path
+
     inputs = [*scene.files, *args.plugin]
     output = check_output(
         args.output if args.output is not None else f"{path.stem}.png",
@@ -293,11 +338,13 @@ def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
     if args.preview:
         others = [output] + ([linear] if linear else [])
         preview = check_output(args.preview, "--preview", inputs, others, check_image_path)
-    return output, linear, preview
+    others = [p for p in (output, linear, preview) if p is not None]
+    state = check_output(state_path(output), "-o", inputs, others)
+    return output, linear, preview, state
 
 
 def _render(args: argparse.Namespace) -> int:
-    from .. import render
+    from ..render_state import ResumeError
     from .bundled import resolve_scene
     from .scene_file import SceneError, SceneWarning, load_scene
 
@@ -309,65 +356,83 @@ def _render(args: argparse.Namespace) -> int:
             scene = load_scene(path)
         for warning in caught:  # one line each, as errors are
             print(f"rtpy: warning: {warning.message}", file=sys.stderr)
-        overrides = validate_overrides(parse_set(args.set))
-        flags = {name: getattr(args, name) for name, setting in SETTINGS.items() if setting.flag}
-        given = {k: read_value(v, flag(k)) for k, v in flags.items() if v is not None}
-        overrides.update(validate_overrides(given, as_flags=True))
-        check_width(scene, path, overrides, "--width" if args.width is not None else "--set width")
-        output, linear, preview = check_outputs(args, scene, path)
+        given = given_settings(args)
+        output, linear, preview, state = check_outputs(args, scene, path)
         check_backend(args.backend)
+        renderer = prepare(args, scene, path, given, preview, state)
     except (SceneError, OutputError, UsageError) as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if state.exists() and not args.resume:
+        print(
+            f"rtpy: note: starting over; --resume continues the render in {state}", file=sys.stderr
+        )
 
     try:
-        image = render(
-            scene,
-            workers=args.workers,
-            quiet=args.quiet,
-            backend=args.backend,
-            preview=preview,
-            preview_seconds=args.preview_seconds,
-            **overrides,
+        image = renderer.render()
+    except ResumeError as err:
+        print(
+            f"rtpy: error: --resume: {err}; render without --resume to start over", file=sys.stderr
         )
+        return EXIT_BAD_INPUT
     except WorkerError as err:
         if received() is not None:  # the signal ended the workers too
             raise KeyboardInterrupt from None
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_WORKERS_FAILED
-    except WriteError as err:  # a preview
-        print(f"rtpy: error: {err}", file=sys.stderr)
+    except WriteError as err:  # a preview, or the render's state
+        kept = f"; --resume continues the render ({state})" if renderer.saved else ""
+        print(f"rtpy: error: {err}{kept}", file=sys.stderr)
         return EXIT_WRITE_FAILED
-    if image.interrupted and image.samples_min == 0:
+    return write_outputs(image, [p for p in (output, linear) if p is not None], renderer)
+
+
+def write_outputs(image, outputs: list[Path], renderer) -> int:
+    """Write the image of a render, finished or stopped, and say what it holds."""
+    stopped_by = image.stats["stopped"]
+    kept = ""
+    if stopped_by and image.stats["checkpoint_saved"]:
+        kept = f"; --resume continues it ({renderer.checkpoint.path})"
+    if stopped_by == "interrupted" and image.samples_min == 0:
+        if kept:
+            return stopped(f"interrupted before a pass over the image finished: no image{kept}")
         return stopped("interrupted before a pass over the image finished: nothing was written")
-    if image.interrupted:
+    if stopped_by == "interrupted":
         print(
             "rtpy: interrupted: writing the samples finished so far "
             "(Ctrl-C again stops at once, writing nothing)",
             file=sys.stderr,
             flush=True,
         )
-
     # The image in hand is written whole, even after a signal (a second one ends at
     # once, leaving no file half-written: rtpy.signals).
     try:
         with finishing():
-            written = [image.save(path) for path in (output, linear) if path is not None]
+            written = [write_image(p, image.linear, image.gamma) for p in outputs]
     except WriteError as err:
         print(f"rtpy: error: {err}", file=sys.stderr)
         return EXIT_WRITE_FAILED
-    stats = image.stats
     files = ", ".join(str(p) for p in written)
-    if image.interrupted:
+    if stopped_by == "interrupted":
         return stopped(
-            f"interrupted: wrote {files} holding {image.samples_min}-{image.samples_max} "
-            f"of {image.spp} samples per pixel"
+            f"interrupted: wrote {files} holding {image.samples_min} of {image.spp} samples "
+            f"per pixel{kept}"
         )
-    if received() is not None:  # while writing the finished image
-        return stopped(f"interrupted while writing: wrote {files}, complete")
+    if stopped_by is None:
+        renderer.checkpoint.remove()
+    if received() is not None:  # while writing the image
+        return stopped(f"interrupted while writing: wrote {files}{kept or ', complete'}")
+    stats, resumed = image.stats, image.stats["resumed_samples"]
+    samples = (
+        f"{image.spp} spp" if stopped_by is None else f"{image.samples_min} of {image.spp} spp"
+    )
+    if stopped_by:
+        samples += f" in the time limit of {renderer.time_limit:g} s"
+    if resumed:
+        samples += f" ({resumed} resumed)"
     print(
-        f"rtpy: wrote {files}: {image.width}x{image.height}, {image.spp} spp, "
-        f"{stats['seconds']:.2f} s, {stats['paths_per_second']:,.0f} paths/s",
+        f"rtpy: wrote {files}: {image.width}x{image.height}, {samples}, "
+        f"{stats['seconds']:.2f} s, {stats['paths_per_second']:,.0f} paths/s{kept}",
         file=sys.stderr,
     )
     return 0

@@ -7,7 +7,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .image import OutputError, WriteError, check_writable
+from ..exit_status import EXIT_BAD_INPUT, EXIT_WRITE_FAILED
+from ..files import OutputError, WriteError, check_writable
 
 WEEK_HELP = "the week's two digits, 03 to 08"
 
@@ -45,7 +46,6 @@ def command_assignment(args: argparse.Namespace) -> int:
     """Run `assignment ...` or `grade`: 0 done (grade: every grader passed), 1 a grader
     failed or a write failed, 2 a bad week or output (nothing written)."""
     from ..grading.assignment import AssignmentError, check_week, map_tests
-    from .cli import EXIT_BAD_INPUT, EXIT_WRITE_FAILED
 
     try:
         week = None if getattr(args, "week", None) is None else check_week(args.week)

@@ -9,7 +9,9 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterable
 
-from .image import RenderedImage, StrPath, check_image_path
+from ..files import StrPath
+from ..rendered_image import RenderedImage
+from .image import check_image_path
 from .outputs import check_output
 
 Preview = Callable[[RenderedImage], object]

@@ -1,16 +1,15 @@
-"""NumpyBackend: the numpy backend of rtpy.renderer's one renderer loop.
+"""NumpyBackend: the numpy backend of rtpy.renderer's one render loop.
 
-The loop (rtpy/renderer.py) is the scalar renderer's: units of work (batch, tile),
-run batch by batch on one or more processes, each unit drawing from its own
-generator seeded by (seed, tile, batch), and sums combined in a fixed order, so the
-same seed gives the same image, bit for bit, with any number of worker processes.
-What differs is the unit: all samples of the batch for every pixel of a band of
-rows are traced together as one wavefront of about MAX_RAYS paths, whatever the
-image size and spp (numpy's cost per call is paid per segment of a wavefront, so
-small wavefronts are slow), and memory is bounded by the unit size, not by image
-size times spp. (The scalar and numpy backends draw
-different random numbers: their images agree up to Monte Carlo noise, not bit for
-bit.)
+The loop (rtpy/renderer.py) and the plan (rtpy/plan.py) are the scalar backend's:
+passes over the image cut into units of work, each unit drawing from its own
+generator seeded by (seed, region, pass), sums added in pass order, so the same
+seed gives the same image, bit for bit, wherever the units run. What differs is the
+unit: all its samples for every pixel of its band of rows are traced together as
+one wavefront of at most MAX_RAYS paths (numpy's cost per call is paid per segment
+of a wavefront, so small wavefronts are slow), and memory is bounded by the unit
+size, not by image size times spp. (The scalar and numpy backends draw different
+random numbers: their images agree up to Monte Carlo noise, not bit for bit.)
+Registered as "numpy" by rtpy.backends.
 """
 
 from __future__ import annotations
@@ -22,7 +21,8 @@ from functools import partial
 
 import numpy as np
 
-from ..renderer import Backend, Unit, plan_bands
+from ..backend import Backend
+from ..plan import Plan, Unit
 from .camera import CameraRays
 from .integrators import BatchIntegrator, make_integrator
 from .sampler import BATCH_SAMPLERS, LaneSampler
@@ -33,11 +33,6 @@ from .scene import BatchScene
 # live and each segment costs hundreds of numpy calls whatever their length; the
 # arrays of a unit's rays (a few MB each) bound the memory of a render.
 MAX_RAYS = 65536
-
-
-def plan_units(width: int, height: int, spp: int) -> list[Unit]:
-    """All units of work, batch-major, of at most about MAX_RAYS camera paths."""
-    return plan_bands(width, height, spp, MAX_RAYS)
 
 
 def render_unit(
@@ -75,12 +70,13 @@ class NumpyBackend(Backend):
     CameraRays, the integrator's batched twin."""
 
     name = "numpy"
+    paths_per_unit = MAX_RAYS
 
     def make_integrator(self) -> BatchIntegrator:
         return make_integrator(self.settings)
 
-    def plan_units(self, width: int, height: int, spp: int) -> list[Unit]:
-        return plan_units(width, height, spp)
+    def plan(self, width: int, height: int, spp: int) -> Plan:
+        return Plan(width, height, spp, MAX_RAYS)  # read now: a test may make it smaller
 
     def start(self) -> Callable[[Unit], np.ndarray]:
         keep_freed_memory()

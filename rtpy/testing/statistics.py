@@ -1,4 +1,4 @@
-"""Statistics for checks that must not fail by chance, and peak memory.
+"""Statistics for checks that must not fail by chance.
 
 - Multiple tests: a check that makes n tests at once and must reject a correct
   renderer with probability at most alpha tests each at sidak_alpha(alpha, n)
@@ -9,21 +9,20 @@
   p-value of a chi-square statistic x with k degrees of freedom.
 - block_z_test compares two images block by block against the noise each side
   measured (used by the graders and by the backends' agreement test).
-- peak_memory_mb / reset_peak_memory: the peak resident memory of a piece of
-  work (used by `rtpy bench` and the numpy renderer's stats).
+- peak_memory_mb / reset_peak_memory: rtpy.memory's, kept here by name.
 
-The module imports only numpy and the standard library, and `resource` only
-when peak memory is asked for (Windows has no `resource`).
+The module imports only numpy and the standard library.
 """
 
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass
 from statistics import NormalDist
 
 import numpy as np
+
+from ..memory import max_rss_mb, peak_memory_mb, reset_peak_memory  # importable from here too
 
 __all__ = [
     "BLOCK",
@@ -34,6 +33,7 @@ __all__ = [
     "bonferroni_z",
     "chi2_sf",
     "gamma_q",
+    "max_rss_mb",
     "normal_quantile",
     "peak_memory_mb",
     "reset_peak_memory",
@@ -211,57 +211,3 @@ def block_z_test(
     z = np.abs(a - b) / np.sqrt(var + floor)
     blocks_x = -(-np.shape(mean_a)[1] // block)
     return BlockTest(z, bonferroni_z(alpha, z.size), a, b, blocks_x, block)
-
-
-# --- peak memory -----------------------------------------------------------------------------
-
-
-def reset_peak_memory() -> bool:
-    """Start measuring a new peak: reset the kernel's high-water mark of this
-    process's resident memory (Linux). False where that is not possible; then
-    peak_memory_mb reports the peak since the process started."""
-    try:
-        with open("/proc/self/clear_refs", "w") as f:
-            f.write("5")
-        return True
-    except OSError:
-        return False
-
-
-def _high_water_mark_mb() -> float | None:
-    """VmHWM of /proc/self/status (Linux): the peak since start or the last reset."""
-    try:
-        with open("/proc/self/status") as f:
-            for line in f:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) / 1024.0
-    except (OSError, ValueError, IndexError):
-        pass
-    return None
-
-
-def max_rss_mb(children: bool) -> float:
-    """getrusage's ru_maxrss in MB (kilobytes on Linux, bytes on macOS): the peak of this
-    process since it started, or with children=True of its largest finished child; NaN
-    without the `resource` module (Windows)."""
-    try:
-        import resource
-    except ImportError:
-        return math.nan
-    who = resource.RUSAGE_CHILDREN if children else resource.RUSAGE_SELF
-    value = resource.getrusage(who).ru_maxrss
-    return value / (1024.0 * 1024.0) if sys.platform == "darwin" else value / 1024.0
-
-
-def peak_memory_mb(children: bool = False) -> float:
-    """Peak resident memory in MB of this process: since the last
-    reset_peak_memory() on Linux, since the process started elsewhere. With
-    children=True, the largest finished child process (a render's workers) counts
-    too. NaN where the platform reports neither."""
-    own = _high_water_mark_mb()
-    if own is None:
-        own = max_rss_mb(children=False)
-    if not children:
-        return own
-    known = [mb for mb in (own, max_rss_mb(children=True)) if not math.isnan(mb)]
-    return max(known, default=math.nan)

@@ -21,16 +21,36 @@ from PIL import Image
 
 import rtpy
 from rtpy.io.bundled import bundled_dir, bundled_scenes
-from rtpy.io.cli import MAX_WORKERS, UsageError, build_parser, main, parse_set, validate_overrides
+from rtpy.io.cli import (
+    MAX_WORKERS,
+    UsageError,
+    build_parser,
+    given_settings,
+    main,
+    parse_set,
+    prepare,
+)
 from rtpy.io.image import read_pfm
 from rtpy.materials import MATERIALS
 from rtpy.render_settings import SETTINGS
+from rtpy.renderer import Renderer
 
 from ..commands import modules_imported_by, read_until, rtpy_command, run_cli
 from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 
 SMALL = ["--width", "16", "--spp", "1", "--quiet"]
+
+
+def checked_by_the_command_line(*options: str) -> dict:
+    """What the render gets from the command line's options, once rtpy.render's
+    boundary has checked them: key -> its value as rtpy uses it."""
+    args = build_parser(every_command=False).parse_args(["render", "scene.toml", *options])
+    scene = rtpy.Scene([], camera=rtpy.Camera(width=4))
+    given = given_settings(args)
+    renderer = prepare(args, scene, Path("scene.toml"), given, None, None)
+    where = {"width": renderer.camera, "background": renderer.scene, "sky": renderer.scene}
+    return {key: getattr(where.get(key, renderer.settings), key) for key in given}
 
 
 # --- the commands that need no files of the test's, run at once on every core ------------
@@ -189,7 +209,8 @@ def write(tmp_path: Path, text: str) -> Path:
     slow_except(
         [
             (["--set", "bogus=1"], "bogus"),
-            (["--set", "spp=0"], "spp"),
+            (["--set", "max_depth=0"], "--set max_depth: expected"),
+            (["--set", "spp=2"], "--spp and --set spp set one value"),
             (["--set", "background=[1, 2]"], "background"),
             (["--set", "nee"], "KEY=VALUE"),
             (["-o", "no/such/dir/x.png"], "does not exist"),
@@ -335,7 +356,13 @@ def test_second_ctrl_c_exits_at_once(tmp_path, workers):
     _, rest = proc.communicate(timeout=60)
     assert proc.returncode == 130, seen + rest
     assert "interrupted again" in rest and "Traceback" not in seen + rest
-    assert list(tmp_path.iterdir()) == []
+    # No image, no temporary file; the render's state, saved whole after the first
+    # Ctrl-C, is kept for --resume.
+    state = tmp_path / "big.png.resume.npz"
+    assert list(tmp_path.iterdir()) in ([], [state])
+    if state.exists():
+        with np.load(state) as saved:
+            assert saved["sums"].shape == (3000, 3000, 4) and "rtpy" in str(saved["key"])
     # the workers have ended (stopped at the first Ctrl-C, killed at the second)
     assert all(wait_for_exit(pid) for pid in workers_pids), "worker processes still running"
 
@@ -366,7 +393,7 @@ def test_unwritable_output_is_reported_before_rendering(
     before = sorted(p.name for p in tmp_path.iterdir())
     monkeypatch.chdir(tmp_path)
     rendered = []
-    monkeypatch.setattr(rtpy, "render", lambda *a, **k: rendered.append(1))
+    monkeypatch.setattr(Renderer, "render", lambda *a, **k: rendered.append(1))
     argv = ["render", "cornell", *SMALL, "-o", output]
     if linear is not None:
         argv += ["--linear", linear]
@@ -433,7 +460,7 @@ def test_linear_exr_without_openexr_exits_2_before_rendering(tmp_path, capsys, m
     def no_render(*args, **kwargs):
         raise AssertionError("rendered although the output cannot be written")
 
-    monkeypatch.setattr("rtpy.render", no_render)
+    monkeypatch.setattr(Renderer, "render", no_render)
     out, png = tmp_path / "x.exr", tmp_path / "x.png"
     status = main(["render", "cornell", *SMALL, "-o", str(png), "--linear", str(out)])
     err = capsys.readouterr().err
@@ -570,7 +597,7 @@ def test_workers_that_cannot_start_stop_the_render_with_one_error(tmp_path):
     out = tmp_path / "o.png"
     result = render_under(
         "spawn", "week08_three_balls", "--plugin", str(tmp_path / "parent_only.py"),
-        "-j", "2", "--width", "48", "--spp", "1", "-q", "-o", str(out),
+        "-j", "2", "--width", "160", "--spp", "1", "-q", "-o", str(out),  # 4 units of 1 spp
     )  # fmt: skip
     assert result.returncode == 1, result.stderr
     errors = [line for line in result.stderr.splitlines() if line.startswith("rtpy: error:")]
@@ -627,7 +654,7 @@ def test_a_set_value_is_one_line_refusal_or_applied_as_its_toml(key, text):
     """Any text after KEY=: refused in one line naming --set KEY, or applied as the one
     TOML value it is (a bare word as itself); never a second key smuggled past."""
     try:
-        overrides = validate_overrides(parse_set([f"{key}={text}"]))
+        overrides = checked_by_the_command_line("--set", f"{key}={text}")
     except UsageError as e:  # one terminal line (other characters shown as a scene file's)
         assert str(e).startswith(f"--set {key}") and not {"\n", "\r"} & set(str(e))
         return
@@ -649,7 +676,7 @@ def test_a_line_break_never_smuggles_a_second_key(spp, other):
 
 
 def test_a_second_key_in_set_or_a_flag_exits_2_before_rendering(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(rtpy, "render", lambda *a, **k: pytest.fail("rendered"))
+    monkeypatch.setattr(Renderer, "render", lambda *a, **k: pytest.fail("rendered"))
     out = str(tmp_path / "x.png")
     for option in (["--set", "spp=4\nwidth=8"], ["--spp", "4\nwidth = 8"]):
         assert main(["render", "cornell", "--quiet", "-o", out, *option]) == 2
@@ -740,10 +767,12 @@ def test_a_preview_that_cannot_be_written_stops_the_render_in_one_line(
     preview = tmp_path / "preview.png"
     argv = ["render", "cornell", *SMALL, "--spp", "4", "-j", "1", "-o", str(tmp_path / "out.png")]
     assert main([*argv, "--preview", str(preview), "--preview-seconds", "0"]) == 1
+    state = tmp_path / "out.png.resume.npz"  # what was finished, kept
     assert capsys.readouterr().err == (
-        f"rtpy: error: cannot write '{preview}': {os.strerror(errno.EIO)}\n"
+        f"rtpy: error: cannot write '{preview}': {os.strerror(errno.EIO)}; "
+        f"--resume continues the render ({state})\n"
     )
-    assert list(tmp_path.iterdir()) == []
+    assert list(tmp_path.iterdir()) == [state]
 
 
 def test_a_quiet_render_loads_no_progress_bar_and_no_other_command(tmp_path):
@@ -754,3 +783,83 @@ def test_a_quiet_render_loads_no_progress_bar_and_no_other_command(tmp_path):
     unneeded = {"tqdm", "rtpy.bench", "rtpy.grading", "importlib.metadata"}
     unneeded |= {"rtpy.testing.chi_square", "rtpy.testing.material_checks"}
     assert not loaded & unneeded
+
+
+# --- time limits, resume, clusters ------------------------------------------------------
+
+LONG = ["--width", "16", "--spp", "100000", "-j", "1", "--quiet"]  # 9 minutes of passes
+
+
+def test_a_time_limit_ends_a_long_render_with_whole_passes_and_its_state(tmp_path, capsys):
+    out = tmp_path / "out.npy"
+    argv = ["render", "week08_three_balls", *LONG, "-o", str(tmp_path / "o.png")]
+    assert main([*argv, "--linear", str(out), "--time", "0.5"]) == 0
+    err = capsys.readouterr().err
+    held = re.search(r"16x9, (\d+) of 100000 spp in the time limit of 0\.5 s", err)
+    assert held and int(held[1]) >= 1 and "--resume continues it" in err, err
+    image = np.load(out)
+    assert np.isfinite(image).all() and image.max() > 0
+    assert (tmp_path / "o.png.resume.npz").exists()
+
+
+def test_resume_of_another_render_is_one_line_exit_2_and_keeps_every_file(tmp_path, capsys):
+    argv = ["render", "week08_three_balls", *LONG, "-o", str(tmp_path / "o.png"), "--time", "0.3"]
+    assert main(argv) == 0
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    capsys.readouterr()
+    assert main([*argv, "--resume", "--seed", "5"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"rtpy: error: --resume: {tmp_path / 'o.png.resume.npz'}: saved with seed = 0, not 5; "
+        "render without --resume to start over\n"
+    )
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    assert main(argv) == 0  # without --resume: it starts over, and says so
+    assert "rtpy: note: starting over; --resume continues the render in" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_a_render_stopped_by_its_time_limit_and_resumed_is_the_uninterrupted_one(tmp_path):
+    """issue 29's check, as a user runs it: `--time`, then the same command with
+    --resume, gives the image of the render never stopped, bit for bit (2 workers;
+    about 3 s of rendering, stopped after half a second)."""
+    args = ["render", "cornell", "--width", "24", "--spp", "32", "-j", "2", "-q"]
+    full, part = tmp_path / "full.npy", tmp_path / "part.npy"
+    done = run_cli(*args, "-o", str(tmp_path / "full.png"), "--linear", str(full))
+    assert done.returncode == 0, done.stderr
+    stop = [*args, "-o", str(tmp_path / "part.png"), "--linear", str(part)]
+    stopped = run_cli(*stop, "--time", "0.5")
+    held = re.search(r"(\d+) of 32 spp in the time limit", stopped.stderr)
+    assert stopped.returncode == 0 and held and int(held[1]) < 32, stopped.stderr
+    resumed = run_cli(*stop, "--resume")
+    assert resumed.returncode == 0 and f"({held[1]} resumed)" in resumed.stderr, resumed.stderr
+    np.testing.assert_array_equal(np.load(part), np.load(full))
+    assert not (tmp_path / "part.png.resume.npz").exists()
+
+
+@pytest.mark.parametrize(
+    "extra,message",
+    [
+        (["--cluster", "nowhere"], '--cluster nowhere: expected "local" or a scheduler\'s'),
+        (["--time", "-2"], "--time: expected a number in [0, 1000000), found -2"),
+        (["--time", "soon"], "--time: expected a number"),
+    ],
+)
+def test_bad_time_and_cluster_options_exit_2(tmp_path, capsys, extra, message):
+    assert main(["render", "cornell", *SMALL, "-o", str(tmp_path / "o.png"), *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("rtpy: error: ") and message in err and len(err.splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_cluster_without_dask_says_how_to_install_it(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed fails
+    assert (
+        main(["render", "cornell", *SMALL, "-o", str(tmp_path / "o.png"), "--cluster", "local"])
+        == 2
+    )
+    err = capsys.readouterr().err
+    assert (
+        err
+        == "rtpy: error: --cluster local: needs Dask distributed (pip install 'rtpy[cluster]')\n"
+    )

@@ -1,11 +1,9 @@
-"""Tests for rtpy.io.image: 8-bit conversion, file formats, atomic writes, path checks."""
+"""Tests for rtpy.io.image: the file formats and the checks of output paths."""
 
 from __future__ import annotations
 
-import errno
 import io
 import os
-import stat
 import sys
 from pathlib import Path
 
@@ -13,12 +11,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from rtpy.io import image
 from rtpy.io.image import (
     OutputError,
-    RenderedImage,
     WriteError,
-    atomic_write,
     check_image_path,
     check_linear_path,
     check_writable,
@@ -29,6 +24,7 @@ from rtpy.io.image import (
     write_pfm,
     write_png,
 )
+from rtpy.rendered_image import RenderedImage
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -177,64 +173,8 @@ def test_write_png_rejects_linear_extension(tmp_path: Path) -> None:
     assert listing(tmp_path) == []
 
 
-# --------------------------------------------------------------------------- atomic_write
-
-
 class Boom(Exception):
     pass
-
-
-def test_atomic_write_success_uses_temp_in_same_dir(tmp_path: Path) -> None:
-    target = tmp_path / "out.bin"
-    seen: list[Path] = []
-
-    def write(tmp: Path) -> None:
-        seen.append(tmp)
-        assert tmp.parent == tmp_path
-        assert tmp.name.startswith(".out.bin.") and tmp.name.endswith(".tmp")
-        assert not target.exists()  # the target only appears at the end
-        tmp.write_bytes(b"hello")
-
-    assert atomic_write(target, write) == target
-    assert target.read_bytes() == b"hello"
-    assert len(seen) == 1 and not seen[0].exists()
-    assert listing(tmp_path) == ["out.bin"]
-
-
-@pytest.mark.parametrize("exc", [Boom("disk full"), KeyboardInterrupt()])
-def test_atomic_write_failure_leaves_no_file(tmp_path: Path, exc: BaseException) -> None:
-    target = tmp_path / "out.png"
-
-    def write(tmp: Path) -> None:
-        tmp.write_bytes(b"half a PNG")
-        raise exc
-
-    with pytest.raises(type(exc)):
-        atomic_write(target, write)
-    assert not target.exists()
-    assert listing(tmp_path) == []
-
-
-def test_atomic_write_failure_keeps_old_content(tmp_path: Path) -> None:
-    target = tmp_path / "out.png"
-    target.write_bytes(b"old image")
-
-    def write(tmp: Path) -> None:
-        tmp.write_bytes(b"new, partial")
-        raise Boom("crash")
-
-    with pytest.raises(Boom):
-        atomic_write(target, write)
-    assert target.read_bytes() == b"old image"
-    assert listing(tmp_path) == ["out.png"]
-
-
-def test_atomic_write_replaces_existing(tmp_path: Path) -> None:
-    target = tmp_path / "out.txt"
-    target.write_bytes(b"old")
-    atomic_write(target, lambda tmp: tmp.write_bytes(b"new"))
-    assert target.read_bytes() == b"new"
-    assert listing(tmp_path) == ["out.txt"]
 
 
 def test_failed_write_png_leaves_no_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -245,80 +185,6 @@ def test_failed_write_png_leaves_no_file(tmp_path: Path, monkeypatch: pytest.Mon
     with pytest.raises(Boom):
         write_png(tmp_path / "img.png", rgb([0.5]), 2.0)
     assert listing(tmp_path) == []
-
-
-@pytest.mark.parametrize(
-    "code", [errno.ENOSPC, errno.EFBIG, errno.EIO, errno.EACCES, errno.EROFS, errno.ENAMETOOLONG]
-)
-def test_an_os_error_half_way_is_one_write_error_and_keeps_the_old_file(
-    tmp_path: Path, code: int
-) -> None:
-    """A disk that fills (or any OSError) after some bytes are written: WriteError,
-    one line naming the file and the reason, no temporary file, the old file as it was."""
-    target = tmp_path / "out.png"
-    target.write_bytes(b"old image")
-
-    def write(tmp: Path) -> None:
-        with open(tmp, "wb") as f:
-            f.write(b"new, partial")
-            f.flush()
-            raise OSError(code, os.strerror(code))
-
-    with pytest.raises(WriteError) as info:
-        atomic_write(target, write)
-    assert str(info.value) == f"cannot write '{target}': {os.strerror(code)}"
-    assert info.value.errno == code and isinstance(info.value, OutputError)
-    assert target.read_bytes() == b"old image"
-    assert listing(tmp_path) == ["out.png"]
-
-
-def test_a_temporary_file_that_cannot_be_made_is_a_write_error(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    def full(*args: object) -> int:
-        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-
-    monkeypatch.setattr(os, "open", full)
-    with pytest.raises(WriteError, match="No space left on device|ENOSPC"):
-        atomic_write(tmp_path / "out.npy", lambda tmp: None)
-    assert listing(tmp_path) == []
-
-
-def test_a_signal_as_the_temporary_file_appears_finds_it(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """A second Ctrl-C removes the temporary files of writes in progress and exits;
-    if it lands just after the temporary file is created, before atomic_write
-    returns to Python code, that file must already be listed."""
-    real_open = os.open
-
-    def open_then_signal(path, flags, *args):
-        fd = real_open(path, flags, *args)
-        os.close(fd)
-        image.remove_temporary_files()  # what the signal handler does before os._exit
-        raise Boom("exited")
-
-    monkeypatch.setattr(image.os, "open", open_then_signal)
-    with pytest.raises(Boom):
-        write_npy(tmp_path / "out.npy", rgb([0.5]))
-    assert listing(tmp_path) == []
-
-
-@pytest.mark.skipif(os.name != "posix", reason="POSIX permission bits")
-def test_atomic_write_file_mode(tmp_path: Path) -> None:
-    old_umask = os.umask(0o022)
-    try:
-        new = tmp_path / "new.bin"
-        atomic_write(new, lambda tmp: tmp.write_bytes(b"x"))
-        # Not tempfile's private 0o600: a normal file for the current umask.
-        assert stat.S_IMODE(new.stat().st_mode) == 0o644
-        existing = tmp_path / "existing.bin"
-        existing.write_bytes(b"old")
-        existing.chmod(0o640)
-        atomic_write(existing, lambda tmp: tmp.write_bytes(b"new"))
-        assert stat.S_IMODE(existing.stat().st_mode) == 0o640
-    finally:
-        os.umask(old_umask)
 
 
 # --------------------------------------------------------------------------- path checks
@@ -405,107 +271,6 @@ def test_check_writable_read_only_directory(tmp_path: Path) -> None:
         ro.chmod(0o700)
 
 
-# --------------------------------------------------------------------------- RenderedImage
-
-
-def make_result(h: int = 3, w: int = 5) -> RenderedImage:
-    return RenderedImage(random_image(h, w, seed=7) / 4.0, gamma=2.2, spp=16)
-
-
-def test_rendered_image_attributes() -> None:
-    img = RenderedImage(np.zeros((3, 5, 3), dtype=np.float32), spp=8)
-    assert img.linear.dtype == np.float64
-    assert (img.width, img.height) == (5, 3)
-    assert img.gamma == 2.0
-    assert img.spp == 8 and img.samples_min == 8 and img.samples_max == 8
-    assert img.interrupted is False
-    assert img.stats == {}
-    partial = RenderedImage(
-        np.zeros((2, 2, 3)),
-        spp=64,
-        samples_min=3,
-        samples_max=4,
-        interrupted=True,
-        stats={"seconds": 1.5},
-    )
-    assert (partial.samples_min, partial.samples_max) == (3, 4)
-    assert partial.interrupted is True
-    assert partial.stats["seconds"] == 1.5
-
-
-def test_rendered_image_rejects_bad_shape() -> None:
-    with pytest.raises(ValueError, match="shape"):
-        RenderedImage(np.zeros((3, 5)))
-
-
-def test_rendered_image_pil_size_and_origin() -> None:
-    linear = np.zeros((3, 5, 3))
-    linear[0, 4] = [1.0, 0.0, 0.0]  # top-right pixel red
-    linear[2, 0] = [0.0, 0.0, 1.0]  # bottom-left pixel blue
-    result = RenderedImage(linear)
-    pil = result.pil
-    assert isinstance(pil, Image.Image)
-    assert pil.mode == "RGB"
-    assert pil.size == (5, 3)  # (W, H)
-    assert pil.getpixel((4, 0)) == (255, 0, 0)
-    assert pil.getpixel((0, 2)) == (0, 0, 255)
-    assert pil.getpixel((0, 0)) == (0, 0, 0)
-    assert np.array_equal(np.asarray(result.to_pil()), np.asarray(pil))
-
-
-def test_rendered_image_pil_uses_gamma() -> None:
-    result = RenderedImage(np.full((1, 1, 3), 0.25), gamma=2.0)
-    assert result.pil.getpixel((0, 0)) == (128, 128, 128)
-    assert RenderedImage(np.full((1, 1, 3), 0.25), gamma=1.0).pil.getpixel((0, 0)) == (64,) * 3
-
-
-def test_rendered_image_repr_png() -> None:
-    result = make_result()
-    data = result._repr_png_()
-    assert isinstance(data, bytes)
-    assert data.startswith(PNG_SIGNATURE)
-    with Image.open(io.BytesIO(data)) as pil:
-        assert pil.size == (5, 3)
-        assert np.array_equal(np.asarray(pil), to_8bit(result.linear, result.gamma))
-
-
-def test_rendered_image_repr() -> None:
-    text = repr(make_result(h=3, w=5))
-    assert "5x3" in text and "spp=16" in text and "interrupted=False" in text
-    partial = RenderedImage(
-        np.zeros((2, 2, 3)), spp=64, samples_min=3, samples_max=4, interrupted=True
-    )
-    assert "interrupted=True" in repr(partial)
-
-
-def test_rendered_image_save_all_extensions(tmp_path: Path) -> None:
-    result = make_result()
-    expected_8bit = to_8bit(result.linear, result.gamma)
-    for name in ["a.png", "b.jpg", "c.jpeg", "d.npy", "e.pfm"]:
-        assert result.save(tmp_path / name) == tmp_path / name
-    assert listing(tmp_path) == ["a.png", "b.jpg", "c.jpeg", "d.npy", "e.pfm"]
-    with Image.open(tmp_path / "a.png") as pil:
-        assert np.array_equal(np.asarray(pil), expected_8bit)
-    for name in ["b.jpg", "c.jpeg"]:
-        with Image.open(tmp_path / name) as pil:
-            assert pil.format == "JPEG" and pil.size == (5, 3)
-    # Linear outputs hold the raw values: no clamping, no gamma.
-    assert np.array_equal(np.load(tmp_path / "d.npy"), result.linear)
-    assert np.array_equal(read_pfm(tmp_path / "e.pfm"), result.linear.astype(np.float32))
-
-
-def test_rendered_image_save_unsupported(tmp_path: Path) -> None:
-    path = tmp_path / "out.bmp"
-    with pytest.raises(OutputError, match="out.bmp"):
-        make_result().save(path)
-    assert listing(tmp_path) == []
-
-
-def test_rendered_image_save_missing_directory(tmp_path: Path) -> None:
-    with pytest.raises(OutputError, match="does not exist"):
-        make_result().save(tmp_path / "missing" / "out.png")
-
-
 # --------------------------------------------------------------------------- sRGB and PNG chunks
 
 
@@ -576,7 +341,7 @@ def test_exr_without_openexr_says_how_to_install(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setitem(sys.modules, "OpenEXR", None)  # import OpenEXR fails
-    for attempt in (check_linear_path, lambda p: make_result().save(p)):
+    for attempt in (check_linear_path, lambda p: RenderedImage(random_image(3, 5)).save(p)):
         with pytest.raises(OutputError) as info:
             attempt(tmp_path / "a.exr")
         message = str(info.value)

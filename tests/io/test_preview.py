@@ -10,8 +10,9 @@ import pytest
 from PIL import Image
 
 import rtpy
-from rtpy.io.image import OutputError, RenderedImage
+from rtpy.files import OutputError
 from rtpy.io.preview import notebook_preview, preview_target
+from rtpy.rendered_image import RenderedImage
 
 
 def image(value: float) -> RenderedImage:

@@ -1,6 +1,6 @@
-"""The numpy backend of the renderer loop: its work units, determinism across workers,
-Ctrl-C, a material without a kernel, the `backend=` of rtpy.render and `--backend` of
-the command line."""
+"""The numpy backend of the render loop: its units of work, determinism across
+workers, Ctrl-C, a material without a kernel, the `backend=` of rtpy.render and
+`--backend` of the command line."""
 
 from __future__ import annotations
 
@@ -12,13 +12,19 @@ from rtpy.io.cli import main
 from rtpy.materials.material import Material
 from rtpy.numpy_backend import renderer as numpy_renderer
 from rtpy.numpy_backend.materials.fallback import ScalarFallback
-from rtpy.numpy_backend.renderer import MAX_RAYS, plan_units
+from rtpy.numpy_backend.renderer import MAX_RAYS, NumpyBackend
 from rtpy.ray import spawn_ray
 from rtpy.scatter_info import ScatterInfo
 from rtpy.vec3 import Color
 
 from ..test_renderer import InterruptAfter, small_scene
 from .test_agreement import SEEDS, compare
+
+
+def plan_units(width: int, height: int, spp: int) -> list:
+    scene, camera = small_scene()
+    backend = NumpyBackend(scene, camera, rtpy.RenderSettings())
+    return list(backend.plan(width, height, spp).units())
 
 
 @pytest.mark.parametrize("width,height,spp", [(1, 1, 1), (40, 33, 7), (100, 3, 64), (64, 64, 100)])
@@ -33,10 +39,11 @@ def test_units_cover_every_pixel_with_spp_samples_and_bounded_size(width, height
     assert batches == sorted(batches)
 
 
-def test_same_seed_same_image_for_any_worker_count():
+def test_same_seed_same_image_for_any_worker_count(monkeypatch):
+    monkeypatch.setattr(numpy_renderer, "MAX_RAYS", 2048)  # passes of several units
     scene, camera = small_scene()
-    camera = camera.with_width(70)  # several tiles
-    kw = dict(camera=camera, spp=20, seed=9, backend="numpy")  # and batches
+    camera = camera.with_width(70)  # 70 x 39: 2, 2, 3, 6, 13 and 6 units a pass
+    kw = dict(camera=camera, spp=20, seed=9, backend="numpy")
     one = rtpy.render(scene, workers=1, **kw)
     two = rtpy.render(scene, workers=2, **kw)
     np.testing.assert_array_equal(one.linear, two.linear)
@@ -63,8 +70,8 @@ def test_render_reports_samples_speed_and_memory():
 
 
 def test_ctrl_c_keeps_finished_passes(monkeypatch):
-    """Batches are passes over the image: Ctrl-C during the second pass leaves the
-    whole first one, every pixel with a sample (noisier, not black in places)."""
+    """Ctrl-C during the second pass leaves the whole first one, every pixel with a
+    sample (noisier, not black in places)."""
     scene, camera = small_scene()
     camera = camera.with_width(64)  # 64 x 36
     monkeypatch.setattr(numpy_renderer, "MAX_RAYS", 64 * 36)  # a pass of 1 spp per unit
@@ -81,8 +88,8 @@ def test_ctrl_c_keeps_finished_passes(monkeypatch):
     [(256, 144, 32), (1920, 1080, 1), (3840, 2160, 1), (100000, 2, 3), (4, 2, 1)],
 )
 def test_units_hold_about_max_rays_paths_whatever_the_spp(width, height, spp):
-    """A unit is as big as MAX_RAYS allows: every unit but the smallest of a batch holds
-    more than half of MAX_RAYS paths (or the whole batch, when it holds fewer)."""
+    """A unit is as big as MAX_RAYS allows: every unit but the smallest of a pass holds
+    more than half of MAX_RAYS paths (or the whole pass, when it holds fewer)."""
     units = plan_units(width, height, spp)
     for batch in {u.batch for u in units}:
         sizes = sorted((u.x1 - u.x0) * (u.y1 - u.y0) * u.spp for u in units if u.batch == batch)

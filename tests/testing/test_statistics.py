@@ -1,12 +1,9 @@
 """Tests for rtpy.testing.statistics: tails, multiple-test corrections, the block
-z-test and peak memory."""
+z-test."""
 
 from __future__ import annotations
 
 import math
-import mmap
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -19,8 +16,6 @@ from rtpy.testing.statistics import (
     chi2_sf,
     gamma_q,
     normal_quantile,
-    peak_memory_mb,
-    reset_peak_memory,
     sidak_alpha,
 )
 
@@ -174,51 +169,3 @@ def test_block_z_test_of_noiseless_images_allows_rounding_only():
     assert not block_z_test(image, zero, image * (1 + 1e-6), zero, alpha=1e-3).passed
     with pytest.raises(ValueError, match="shapes differ"):
         block_z_test(image, zero, image[:4], zero[:4], alpha=1e-3)
-
-
-# --- peak memory -----------------------------------------------------------------------------
-
-
-def touched_pages(megabytes: int) -> mmap.mmap:
-    """Fresh anonymous memory, every page written (small pages: the resident size
-    grows by exactly this much, whatever the allocator or numpy would reuse)."""
-    memory = mmap.mmap(-1, megabytes << 20)
-    if hasattr(mmap, "MADV_NOHUGEPAGE"):
-        memory.madvise(mmap.MADV_NOHUGEPAGE)
-    np.frombuffer(memory, dtype=np.uint8)[::4096] = 1
-    return memory
-
-
-def test_peak_memory_sees_an_allocation_and_a_reset_forgets_it():
-    assert peak_memory_mb() > 0
-    if not reset_peak_memory():
-        pytest.skip("the peak can be reset on Linux only")
-    start = peak_memory_mb()
-    memory = touched_pages(64)
-    grown = peak_memory_mb()
-    memory.close()
-    reset_peak_memory()
-    after_reset = peak_memory_mb()
-    assert grown >= start + 60
-    assert after_reset < grown - 50
-    assert peak_memory_mb(children=True) >= after_reset
-
-
-def test_statistics_import_and_peak_memory_work_without_the_resource_module():
-    """Windows has no `resource`: importing the module must not need it, and peak
-    memory falls back to what the platform offers (NaN when nothing)."""
-    code = (
-        "import sys; sys.modules['resource'] = None\n"
-        "import builtins, math\n"
-        "real_open = builtins.open\n"
-        "def no_proc(path, *a, **k):\n"
-        "    if str(path).startswith('/proc/'): raise OSError('no /proc')\n"
-        "    return real_open(path, *a, **k)\n"
-        "from rtpy.testing.statistics import peak_memory_mb, reset_peak_memory\n"
-        "builtins.open = no_proc\n"
-        "print(reset_peak_memory(), math.isnan(peak_memory_mb()), "
-        "math.isnan(peak_memory_mb(children=True)))\n"
-    )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.split() == ["False", "True", "True"]

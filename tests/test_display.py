@@ -1,4 +1,4 @@
-"""Tests for rtpy.io.display: the display transform (gamma or sRGB) to 8-bit values."""
+"""Tests for rtpy.display: the display transform (gamma or sRGB) to 8-bit values."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rtpy.io.display import linear_to_srgb, to_8bit
+from rtpy.display import linear_to_srgb, to_8bit
 from rtpy.texture import srgb_to_linear
 
-from .test_image import rgb
+from .io.test_image import rgb
 
 # --------------------------------------------------------------------------- to_8bit
 
