@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, Phase, find, given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rtpy.io import obj_arrays
@@ -173,8 +173,6 @@ def test_a_large_file_is_read_here_with_the_same_floats(tmp_path):
 
 # --- the checks can fail -------------------------------------------------------------
 
-FIND = settings(max_examples=1000, phases=[Phase.generate], database=None, derandomize=True)
-
 
 def _single_precision(block, dtype):
     numbers = PARSE(block, dtype)
@@ -184,29 +182,33 @@ def _single_precision(block, dtype):
 PARSE = obj_arrays._numbers
 
 
-@pytest.mark.slow
+# Texts on which each planted mistake changes obj_arrays' answer: the agreement check
+# must see it. (A search for such texts depends on hypothesis's draws, which differ in
+# a student's repository, where other modules are imported.)
+TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+
+
 @pytest.mark.parametrize(
-    "plant, texts",
+    "plant, text",
     [
         # the normal read from the texture coordinate's column
         (
             lambda m: m.setattr(obj_arrays, "FORMS", {**obj_arrays.FORMS, b" d/d/d": (3, 2, 1)}),
-            obj_texts(clean=True),
+            TRIANGLE + "vt 0 0\nvt 1 0\nvn 0 0 1\nvn 0 1 0\nf 1/1/2 2/2/1 3/1/2\n",
         ),
         # an unknown statement taken for one to ignore
-        (lambda m: m.setattr(obj_arrays, "IGNORED", obj_arrays.IGNORED | {"bogus"}), obj_texts()),
+        (
+            lambda m: m.setattr(obj_arrays, "IGNORED", obj_arrays.IGNORED | {"bogus"}),
+            "bogus 1 2\n" + TRIANGLE + "f 1 2 3\n",
+        ),
         # numbers rounded to single precision
-        (lambda m: m.setattr(obj_arrays, "_numbers", _single_precision), obj_texts()),
+        (
+            lambda m: m.setattr(obj_arrays, "_numbers", _single_precision),
+            "v 0.1 0.2 0.3\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        ),
     ],
 )
-def test_the_agreement_check_catches_planted_mistakes(monkeypatch, plant, texts):
+def test_the_agreement_check_catches_planted_mistakes(monkeypatch, plant, text):
+    assert disagreement(text) is None
     plant(monkeypatch)
-
-    def wrong(text):
-        try:
-            return disagreement(text) is not None
-        except Exception:  # the planted mistake may crash too
-            return True
-
-    text = find(texts, wrong, settings=FIND)
-    assert wrong(text)
+    assert disagreement(text) is not None
