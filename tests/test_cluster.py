@@ -86,12 +86,13 @@ class DaskProcesses:
         )  # fmt: skip
 
     def stop(self) -> None:
-        for proc in self.processes:
+        """Workers first, then the scheduler: a worker whose scheduler is gone first
+        spends its timeout trying to reach it before it exits."""
+        for proc in reversed(self.processes):
             if proc.poll() is None:
                 proc.terminate()
-        for proc in self.processes:
             try:
-                proc.wait(timeout=30)
+                proc.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
