@@ -15,8 +15,6 @@ from __future__ import annotations
 
 import math
 
-_new = object.__new__
-
 
 class Vec3:
     __slots__ = ("e0", "e1", "e2")
@@ -49,42 +47,27 @@ class Vec3:
         return [self.e0, self.e1, self.e2]
 
     # --- arithmetic -------------------------------------------------------
-    # The operators make their result with object.__new__ and set the three slots
-    # themselves instead of calling the class: every ray makes dozens of vectors,
-    # and skipping __init__ makes each of them cheaper.
+    # Each result has the type of the left operand: a Color stays a Color.
     def __add__(self, o: Vec3) -> Vec3:
-        v = _new(type(self))
-        v.e0, v.e1, v.e2 = self.e0 + o.e0, self.e1 + o.e1, self.e2 + o.e2
-        return v
+        return type(self)(self.e0 + o.e0, self.e1 + o.e1, self.e2 + o.e2)
 
     def __sub__(self, o: Vec3) -> Vec3:
-        v = _new(type(self))
-        v.e0, v.e1, v.e2 = self.e0 - o.e0, self.e1 - o.e1, self.e2 - o.e2
-        return v
+        return type(self)(self.e0 - o.e0, self.e1 - o.e1, self.e2 - o.e2)
 
     def __neg__(self) -> Vec3:
-        v = _new(type(self))
-        v.e0, v.e1, v.e2 = -self.e0, -self.e1, -self.e2
-        return v
+        return type(self)(-self.e0, -self.e1, -self.e2)
 
     def __mul__(self, o: Vec3 | float) -> Vec3:
-        v = _new(type(self))
         if type(o) is float or not isinstance(o, Vec3):
-            v.e0, v.e1, v.e2 = self.e0 * o, self.e1 * o, self.e2 * o
-        else:  # component-wise, for colours
-            v.e0, v.e1, v.e2 = self.e0 * o.e0, self.e1 * o.e1, self.e2 * o.e2
-        return v
+            return type(self)(self.e0 * o, self.e1 * o, self.e2 * o)
+        return type(self)(self.e0 * o.e0, self.e1 * o.e1, self.e2 * o.e2)  # for colours
 
     def __rmul__(self, s: float) -> Vec3:
-        v = _new(type(self))
-        v.e0, v.e1, v.e2 = self.e0 * s, self.e1 * s, self.e2 * s
-        return v
+        return type(self)(self.e0 * s, self.e1 * s, self.e2 * s)
 
     def __truediv__(self, s: float) -> Vec3:
         k = 1.0 / s
-        v = _new(type(self))
-        v.e0, v.e1, v.e2 = self.e0 * k, self.e1 * k, self.e2 * k
-        return v
+        return type(self)(self.e0 * k, self.e1 * k, self.e2 * k)
 
     def __eq__(self, o: object) -> bool:
         if not isinstance(o, Vec3):
