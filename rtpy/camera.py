@@ -66,46 +66,16 @@ class Camera:
         defocus_angle: float = 0.0,
         focus_distance: float = 10.0,
     ) -> None:
-        look_from = checked_point("look_from", look_from)
-        look_at = checked_point("look_at", look_at)
-        vup = checked_edge("vup", vup)
-        self.look_from, self.look_at, self.vup = look_from, look_at, vup
-        self.vfov = checked_number("vfov", vfov, VFOV)
-        if isinstance(aspect_ratio, str):
-            try:
-                aspect_ratio = parse_aspect_ratio(aspect_ratio)
-            except ValueError:
-                raise ValueError(
-                    f'aspect_ratio: expected a number or "W:H", found {aspect_ratio!r}'
-                ) from None
-        self.aspect_ratio = checked_number("aspect_ratio", aspect_ratio, ASPECT_RATIO)
-        self.width = SETTINGS["width"].check(width)
-        self.defocus_angle = checked_number("defocus_angle", defocus_angle, DEFOCUS_ANGLE)
-        self.focus_distance = checked_number("focus_distance", focus_distance, LENGTH)
-        height = self.width / self.aspect_ratio
-        if not height < 1e9:
-            raise ValueError(f"aspect_ratio {aspect_ratio} makes the image {height} pixels high")
-        self.height = max(1, int(height))
-        if self.width * self.height > MAX_PIXELS:
-            raise ValueError(
-                f"width {self.width} x height {self.height} is {self.width * self.height:,} "
-                f"pixels; the most is {MAX_PIXELS:,} (about 3 GB of memory)"
-            )
+        # Checked first (the names of wrong parameters in the errors), then RTIOW's camera.
+        checked = checked_parameters(
+            look_from, look_at, vup, vfov, aspect_ratio, width, defocus_angle, focus_distance
+        )
+        self.look_from, self.look_at, self.vup, self.vfov = checked[:4]
+        self.aspect_ratio, self.width, self.defocus_angle, self.focus_distance = checked[4:]
+        self.height = max(1, int(self.width / self.aspect_ratio))
 
-        view = look_from - look_at
-        if view.length() not in LENGTH:
-            raise ValueError(
-                f"look_at: expected a distance from look_from {LENGTH.text()}, "
-                f"found {view.length():.3g}"
-            )
-        self.w = unit_vector(view)  # points backward, away from the scene
-        side = cross(vup, self.w)
-        if not side.length() >= MIN_SINE * vup.length():
-            raise ValueError(
-                "vup: expected an up vector across the view direction (look_at - look_from), "
-                f"the sine of the angle between them >= {MIN_SINE:g}; found it parallel"
-            )
-        self.u = unit_vector(side)  # camera right
+        self.w = unit_vector(self.look_from - self.look_at)  # backward, away from the scene
+        self.u = unit_vector(cross(self.vup, self.w))  # camera right
         self.v = cross(self.w, self.u)  # camera up
 
         # The viewport lies on the focus plane; its width follows the rounded
@@ -117,7 +87,8 @@ class Camera:
         viewport_v = self.v * -viewport_height  # top edge -> bottom edge
         self.pixel_delta_u = viewport_u / self.width
         self.pixel_delta_v = viewport_v / self.height
-        upper_left = look_from - self.w * self.focus_distance - viewport_u / 2.0 - viewport_v / 2.0
+        focus_center = self.look_from - self.w * self.focus_distance
+        upper_left = focus_center - viewport_u / 2.0 - viewport_v / 2.0
         self.pixel00 = upper_left + (self.pixel_delta_u + self.pixel_delta_v) * 0.5
         radius = self.focus_distance * math.tan(math.radians(self.defocus_angle / 2.0))
         self.defocus_disk_u = self.u * radius
@@ -159,3 +130,47 @@ class Camera:
         r = generator().random
         return self._ray_through(i + r() - 0.5, j + r() - 0.5)
         # END SOLUTION
+
+
+def checked_parameters(
+    look_from, look_at, vup, vfov, aspect_ratio, width, defocus_angle, focus_distance
+) -> tuple:
+    """Camera's parameters, checked and converted (aspect_ratio "16:9" -> 1.777...),
+    or ValueError/TypeError naming the parameter: finite points, a view of some
+    length, an up vector across it, an image of at most MAX_PIXELS pixels."""
+    look_from = checked_point("look_from", look_from)
+    look_at = checked_point("look_at", look_at)
+    vup = checked_edge("vup", vup)
+    vfov = checked_number("vfov", vfov, VFOV)
+    if isinstance(aspect_ratio, str):
+        try:
+            aspect_ratio = parse_aspect_ratio(aspect_ratio)
+        except ValueError:
+            raise ValueError(
+                f'aspect_ratio: expected a number or "W:H", found {aspect_ratio!r}'
+            ) from None
+    aspect_ratio = checked_number("aspect_ratio", aspect_ratio, ASPECT_RATIO)
+    width = SETTINGS["width"].check(width)
+    defocus_angle = checked_number("defocus_angle", defocus_angle, DEFOCUS_ANGLE)
+    focus_distance = checked_number("focus_distance", focus_distance, LENGTH)
+    height = width / aspect_ratio
+    if not height < 1e9:
+        raise ValueError(f"aspect_ratio {aspect_ratio} makes the image {height} pixels high")
+    height = max(1, int(height))
+    if width * height > MAX_PIXELS:
+        raise ValueError(
+            f"width {width} x height {height} is {width * height:,} "
+            f"pixels; the most is {MAX_PIXELS:,} (about 3 GB of memory)"
+        )
+    view = look_from - look_at
+    if view.length() not in LENGTH:
+        raise ValueError(
+            f"look_at: expected a distance from look_from {LENGTH.text()}, "
+            f"found {view.length():.3g}"
+        )
+    if not cross(vup, unit_vector(view)).length() >= MIN_SINE * vup.length():
+        raise ValueError(
+            "vup: expected an up vector across the view direction (look_at - look_from), "
+            f"the sine of the angle between them >= {MIN_SINE:g}; found it parallel"
+        )
+    return look_from, look_at, vup, vfov, aspect_ratio, width, defocus_angle, focus_distance
