@@ -19,8 +19,8 @@ Conventions:
 - Objects are hit strictly inside the ray interval (t_min < t < t_max), as in
   Scene. Box tests accept the closed interval (t_min <= t <= t_max): a box test
   may let through a ray that then misses every object, never the other way round.
-- The result is exactly that of testing every object in list order (the Scene
-  queries' brute_force=True): the smallest t, and among objects hit at the same t
+- The result is exactly that of testing every object in list order (a Scene below
+  its bvh_min_objects): the smallest t, and among objects hit at the same t
   the one earliest in the list. The floats are the objects' own, so they are
   bit-identical too.
 - Boxes are a little larger than the objects in them, because the box test and
@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING
 from .vec3 import Vec3
 
 if TYPE_CHECKING:
+    from .hit_info import HitInfo
     from .hittable import Hittable
     from .ray import Ray
 
@@ -242,6 +243,14 @@ class BVH:
         """(index, t) of the closest hit with t_min < t < t_max, ties going to the
         object earliest in the list; None when nothing is hit."""
         return self._search(ray, t_min, t_max, None, False)
+
+    def find_intersection(self, ray: Ray, interval) -> HitInfo | None:
+        """As Scene.find_intersection: the closest hit inside the interval, or None."""
+        found = self.closest_hit(ray, interval.min, interval.max)
+        if found is None:
+            return None
+        index, t = found
+        return self.objects[index].hit_info(ray, t)
 
     def any_hit(self, ray: Ray, t_min: float, t_max: float, ignore: Hittable | None = None) -> bool:
         """True if some object other than `ignore` is hit with t_min < t < t_max."""

@@ -32,7 +32,8 @@ class Scene:
     hierarchy (rtpy.bvh) instead of testing every object. It is built on the first
     query and rebuilt when `objects` no longer equals the list it was built from
     (Scene.add_object, or any change to the list). Its answers are exactly those of
-    testing every object in list order (the queries' brute_force=True).
+    testing every object in list order, what the scene does below
+    bvh_min_objects objects.
 
     background  radiance of rays that escape (a constant environment)
     sky         True: the RTIOW blue-white gradient instead of `background`
@@ -107,21 +108,11 @@ class Scene:
             self._bvh_objects = list(self.objects)
         return self._bvh
 
-    def find_intersection(
-        self, ray: Ray, interval: Interval, brute_force: bool = False
-    ) -> HitInfo | None:
+    def find_intersection(self, ray: Ray, interval: Interval) -> HitInfo | None:
         """The closest hit with t in (interval.min, interval.max), or None. Of
-        objects hit at the same t, the one earliest in `objects` wins.
-
-        brute_force=True tests every object even when the scene would use its BVH
-        (the tests compare the two).
-        """
-        if not brute_force and len(self.objects) >= self.bvh_min_objects:
-            found = self.bvh().closest_hit(ray, interval.min, interval.max)
-            if found is None:
-                return None
-            index, t = found
-            return self._bvh.objects[index].hit_info(ray, t)
+        objects hit at the same t, the one earliest in `objects` wins."""
+        if len(self.objects) >= self.bvh_min_objects:
+            return self.bvh().find_intersection(ray, interval)  # the same hit, sooner
         if not self.objects:
             return None  # the sky alone (week 3's scenes, before this method is written)
         # BEGIN SOLUTION week04: the closest hit over all objects (earliest object wins ties)
@@ -140,18 +131,12 @@ class Scene:
         return closest_obj.hit_info(ray, closest_t)
         # END SOLUTION
 
-    def find_occlusion(
-        self,
-        ray: Ray,
-        interval: Interval,
-        brute_force: bool = False,
-        ignore: Hittable | None = None,
-    ) -> bool:
+    def find_occlusion(self, ray: Ray, interval: Interval, ignore: Hittable | None = None) -> bool:
         """True if anything (glass included) lies on the ray with t in the interval.
         `ignore` is an object not to test (a light, for a shadow ray sent to a point
-        on it). brute_force as for find_intersection."""
+        on it)."""
         t_min, t_max = interval.min, interval.max
-        if not brute_force and len(self.objects) >= self.bvh_min_objects:
+        if len(self.objects) >= self.bvh_min_objects:
             return self.bvh().any_hit(ray, t_min, t_max, ignore)
         # BEGIN SOLUTION week05: is anything on the shadow ray inside the interval?
         for obj in self.objects:

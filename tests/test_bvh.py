@@ -26,6 +26,7 @@ from rtpy.sphere import Sphere
 from rtpy.triangle import Triangle
 from rtpy.vec3 import Vec3, cross
 
+from .in_list_order import in_list_order
 from .tiers import slow_except
 from .vectors import V
 
@@ -339,10 +340,11 @@ def same_hit(a, b) -> bool:
 def mismatch(scene: Scene, ray: Ray, interval: Interval) -> str | None:
     """How the scene's BVH queries differ from brute force on this ray, or None."""
     got = scene.find_intersection(ray, interval)
-    want = scene.find_intersection(ray, interval, brute_force=True)
+    listed = in_list_order(scene)
+    want = listed.find_intersection(ray, interval)
     if not same_hit(got, want):
         return f"find_intersection: BVH {got!r} on {got and got.obj!r}, brute force {want!r}"
-    if scene.find_occlusion(ray, interval) != scene.find_occlusion(ray, interval, brute_force=True):
+    if scene.find_occlusion(ray, interval) != listed.find_occlusion(ray, interval):
         return "find_occlusion differs"
     return None
 
@@ -507,7 +509,7 @@ def test_equal_t_found_later_in_the_tree_still_wins_by_list_order(monkeypatch):
     hit = scene.find_intersection(ray, FORWARD)
     assert order == [big, small]
     assert hit.obj is small and hit.t == 2.0
-    assert same_hit(hit, scene.find_intersection(ray, FORWARD, brute_force=True))
+    assert same_hit(hit, in_list_order(scene).find_intersection(ray, FORWARD))
 
 
 def test_ray_in_the_plane_of_coplanar_triangles():

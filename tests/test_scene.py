@@ -17,6 +17,7 @@ from rtpy.sphere import Sphere
 from rtpy.triangle import Triangle
 from rtpy.vec3 import Color, Vec3
 
+from .in_list_order import in_list_order
 from .vectors import V
 
 GREY = Lambertian()
@@ -160,17 +161,19 @@ def test_sky_known_values():
     assert scene.background_radiance(V(0, -1, 0)).tolist() == pytest.approx([1.0, 1.0, 1.0])
 
 
-@pytest.mark.parametrize("brute_force", [True, False])
-def test_find_occlusion_can_ignore_one_object(brute_force):
+@pytest.mark.parametrize("listed", [True, False])
+def test_find_occlusion_can_ignore_one_object(listed):
     """A shadow ray sent to a light is not blocked by the light itself, but still by
     everything else, with or without the BVH (twelve objects use it)."""
     light = Sphere(Vec3(0, 0, -5), 1.0, Lambertian())
     wall = Sphere(Vec3(0, 0, -10), 1.0, Lambertian())
     others = [Sphere(Vec3(10 + 3 * k, 5, 0), 1.0, Lambertian()) for k in range(10)]
     scene = Scene([light, wall, *others])
+    if listed:
+        scene = in_list_order(scene)
     ray = Ray(Vec3(0, 0, 0), Vec3(0, 0, -1))
     full = Interval(0.0, 20.0)
-    assert scene.find_occlusion(ray, full, brute_force=brute_force)
-    assert scene.find_occlusion(ray, full, brute_force=brute_force, ignore=light)
-    assert not scene.find_occlusion(ray, Interval(0.0, 8.0), brute_force=brute_force, ignore=light)
-    assert scene.find_occlusion(ray, Interval(0.0, 8.0), brute_force=brute_force)
+    assert scene.find_occlusion(ray, full)
+    assert scene.find_occlusion(ray, full, ignore=light)
+    assert not scene.find_occlusion(ray, Interval(0.0, 8.0), ignore=light)
+    assert scene.find_occlusion(ray, Interval(0.0, 8.0))

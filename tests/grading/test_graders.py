@@ -118,7 +118,7 @@ def unnormalised_light_vector(mp):
 
 
 def two_blockers_needed(mp):
-    def find_occlusion(self, ray, interval, brute_force=False, ignore=None):
+    def find_occlusion(self, ray, interval, ignore=None):
         hits = sum(
             o is not ignore and o.hit_t(ray, interval.min, interval.max) is not None
             for o in self.objects
@@ -246,7 +246,7 @@ def quad_no_interior_test(mp):
 
 
 def first_hit_not_closest(mp):
-    def find_intersection(self, ray, interval, brute_force=False):
+    def find_intersection(self, ray, interval):
         for obj in self.objects:
             t = obj.hit_t(ray, interval.min, interval.max)
             if t is not None:
