@@ -37,6 +37,7 @@ from .materials import (
     Mirror,
     OrenNayar,
     Phong,
+    RoughDielectric,
     Ward,
     register_material,
 )
@@ -114,6 +115,7 @@ __all__ = [
     "Mirror",
     "Metal",
     "Dielectric",
+    "RoughDielectric",
     "DiffuseLight",
     "Phong",
     "Blinn",

@@ -16,9 +16,8 @@ FORWARD = Interval(0.0, math.inf)
 
 
 class Integrator:
-    """Base class. `radiance(ray, scene)` estimates the radiance arriving at the
-    ray's origin along -ray.direction (a Monte Carlo estimate for the stochastic
-    integrators: its expectation is the pixel value)."""
+    """Base class: compute_scattering(ray, scene) is the radiance a camera ray
+    brings back."""
 
     name = "integrator"
     uses_center_ray = False  # True: one ray through each pixel's center, spp = 1
@@ -27,4 +26,11 @@ class Integrator:
         self.settings = settings or RenderSettings()
 
     def compute_scattering(self, ray: Ray, scene: Scene) -> Color:
+        """The radiance arriving at ray.origin along -ray.direction: for the
+        stochastic integrators a Monte Carlo estimate whose expectation is the pixel
+        value. The course's name; `radiance` is the same method."""
         raise NotImplementedError
+
+    def radiance(self, ray: Ray, scene: Scene) -> Color:
+        """compute_scattering, under the name of what it returns."""
+        return self.compute_scattering(ray, scene)

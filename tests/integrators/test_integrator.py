@@ -33,6 +33,17 @@ def test_the_base_class_has_default_settings_and_no_estimate():
         integrator.compute_scattering(Ray(Vec3(0, 0, 0), Vec3(0, 0, -1)), Scene([]))
 
 
+def test_radiance_is_compute_scattering_under_its_meaning():
+    """Overriding the course's name is enough: radiance() calls it."""
+
+    class Constant(Integrator):
+        def compute_scattering(self, ray, scene):
+            return Color(0.25, 0.5, 1.0)
+
+    ray = Ray(Vec3(0, 0, 0), Vec3(0, 0, -1))
+    assert Constant().radiance(ray, Scene([])) == Color(0.25, 0.5, 1.0)
+
+
 @pytest.mark.parametrize(
     "integrator,nee", [("direct", True), ("path", True), ("path", False), ("whitted", True)]
 )

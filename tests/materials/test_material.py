@@ -30,6 +30,15 @@ def test_registry_names():
     assert MATERIALS["diffuse_light"] is DiffuseLight
 
 
+def test_every_bundled_scene_file_type_is_exported_from_rtpy():
+    """A material a scene file can name can be made in Python as rtpy.<Class>."""
+    import rtpy
+
+    for name, cls in MATERIALS.items():
+        assert getattr(rtpy, cls.__name__, None) is cls, f"{name}: rtpy.{cls.__name__} missing"
+        assert cls.__name__ in rtpy.__all__
+
+
 def test_the_base_class_scatters_reflects_and_emits_nothing():
     m = Material()
     hit = make_hit(m, UP)
