@@ -13,9 +13,7 @@ import math
 from collections.abc import Sequence
 
 from .bvh import AABB, BOX_PADDING, BVH, ROUNDING_MARGIN, Tree
-from .hit_info import HitInfo
-from .hittable import Hittable
-from .io.values import (
+from .checks import (
     ANGLE,
     MAX_COORDINATE,
     MIN_AREA,
@@ -25,6 +23,8 @@ from .io.values import (
     checked_vector,
     point,
 )
+from .hit_info import HitInfo
+from .hittable import Hittable
 from .ray import Ray
 from .triangle import Triangle
 from .vec3 import Vec3, dot, unit_vector

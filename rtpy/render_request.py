@@ -86,7 +86,7 @@ def prepare_render(
 ) -> Renderer:
     """The Renderer of render(scene, ...), every value checked (render's parameters)."""
     from .backend import make_backend
-    from .io.values import Range, checked, integer
+    from .checks import Range, checked, integer
     from .renderer import Renderer
 
     if not isinstance(scene, Scene):
