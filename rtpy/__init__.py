@@ -9,6 +9,11 @@ The modules follow the course's structure: vec3 / interval / ray / hit_info /
 scatter_info (utilities), camera, sphere / quad / triangle / scene (hittables),
 materials, light, texture, integrators, renderer. docs/course-map.md says where
 each name of the course's code is; docs/scene-format.md is the scene-file format.
+
+This module is the package's front door, on the top floor with rtpy.io (see
+tests/test_layout.py's FLOORS): it exports the API of every floor, and imports
+rtpy.backends and rtpy.io.writers so that the core finds its backends and its
+image writers (rtpy.backend, rtpy.writer) by registration.
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ from .backends import BACKENDS
 from .camera import Camera
 from .hit_info import HitInfo
 from .interval import Interval
+from .io import writers as _writers  # noqa: F401 (registers RenderedImage.save's formats)
 from .light import PointLight
 from .materials import (
     Blinn,
@@ -60,7 +66,11 @@ if TYPE_CHECKING:
 
 # Imported on first use: `import rtpy` loads neither numpy, Pillow nor tqdm, which
 # only rendering and writing images need (a command starts sooner without them).
-_LAZY = {"RenderedImage": ".rendered_image", "Renderer": ".renderer"}
+_LAZY = {
+    "RenderedImage": ".rendered_image",
+    "Renderer": ".renderer",
+    "mesh_from_obj": ".io.obj",
+}
 
 
 def __getattr__(name: str):
@@ -108,6 +118,7 @@ __all__ = [
     "SmoothTriangle",
     "Mesh",
     "Transform",
+    "mesh_from_obj",
     "PointLight",
     # materials and textures
     "Material",

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import math
 
+from .checks import RADIANCE, checked_color, checked_point
 from .hit_info import HitInfo
 from .hittable import MIN_LIGHT_DISTANCE2, Hittable
-from .io.values import RADIANCE, checked_color, checked_point
 from .sampling import generator
 from .vec3 import Color, Vec3
 

@@ -13,9 +13,7 @@ import math
 from collections.abc import Sequence
 
 from .bvh import AABB, BOX_PADDING, BVH, ROUNDING_MARGIN, Tree
-from .hit_info import HitInfo
-from .hittable import Hittable
-from .io.values import (
+from .checks import (
     ANGLE,
     MAX_COORDINATE,
     MIN_AREA,
@@ -25,6 +23,8 @@ from .io.values import (
     checked_vector,
     point,
 )
+from .hit_info import HitInfo
+from .hittable import Hittable
 from .ray import Ray
 from .triangle import Triangle
 from .vec3 import Vec3, dot, unit_vector
@@ -152,7 +152,7 @@ class Mesh(Hittable):
     """A triangle mesh, placed by a transform: one object of a scene, its triangles
     kept as arrays and searched through a BVH of its own.
 
-        mesh = Mesh.from_obj("teapot.obj", Lambertian(), Transform(scale=Vec3(0.5, 0.5, 0.5)))
+        mesh = rtpy.mesh_from_obj("teapot.obj", Lambertian(), Transform(scale=Vec3(0.5, 0.5, 0.5)))
         scene = Scene([mesh, ...])
 
     positions  (P, 3) vertex positions; normals: (Q, 3) vertex normals (may be empty)
@@ -216,15 +216,6 @@ class Mesh(Hittable):
         mesh.faces, mesh.face_normals, mesh.tree, mesh.skipped = faces, face_normals, tree, skipped
         mesh.__setstate__(mesh.__dict__)
         return mesh
-
-    @classmethod
-    def from_obj(cls, path, material, transform: Transform | None = None) -> Mesh:
-        """The mesh of a Wavefront OBJ file (rtpy.io.obj.read_obj, whose ObjError
-        names the line it cannot read)."""
-        from .io.obj import read_obj
-
-        obj = read_obj(path)
-        return cls(obj.positions, obj.normals, obj.triangles, material, transform)
 
     def __len__(self) -> int:
         return len(self.faces)

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 from .camera import Camera
 from .render_settings import SETTINGS, RenderSettings, SettingValueError
 from .scene import Scene
+from .writer import writer
 
 if TYPE_CHECKING:
     from .rendered_image import RenderedImage
@@ -86,7 +87,7 @@ def prepare_render(
 ) -> Renderer:
     """The Renderer of render(scene, ...), every value checked (render's parameters)."""
     from .backend import make_backend
-    from .io.values import Range, checked, integer
+    from .checks import Range, checked, integer
     from .renderer import Renderer
 
     if not isinstance(scene, Scene):
@@ -159,12 +160,11 @@ def _scene_with(scene: Scene, background, sky) -> Scene:
 
 def _preview(preview, scene: Scene):
     """A function of the image so far, or None: a file name or True made into one by
-    rtpy.io.preview (a function or None is one already: the command line's)."""
+    the preview writer, rtpy.io.preview's (a function or None is one already: the
+    command line's)."""
     if preview is None or (callable(preview) and not isinstance(preview, bool)):
         return preview
-    from .io.preview import preview_target
-
-    return preview_target(preview, scene.files)
+    return writer("preview")(preview, scene.files)
 
 
 def _checkpoint(path, backend):

@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from .io.values import (
+from .checks import (
     GAMMA,
     NON_NEGATIVE,
     RADIANCE,

@@ -2,7 +2,8 @@
 
 The image is an ``(H, W, 3)`` float64 array of linear RGB radiance, row 0 at the
 top; the display transform (gamma) is applied only for 8-bit output and display
-(rtpy.display). ``save`` writes any of rtpy.io.image's formats.
+(rtpy.display). ``save`` writes any of rtpy.io.image's formats, through the writer
+rtpy.io registers (rtpy.writer).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from PIL import Image
 
 from .display import Gamma, as_rgb, check_gamma, png_info, to_8bit
 from .files import StrPath
+from .writer import writer
 
 __all__ = ["RenderedImage"]
 
@@ -79,10 +81,7 @@ class RenderedImage:
         raises :class:`~rtpy.files.OutputError`, a failing write
         :class:`~rtpy.files.WriteError` (the file that was there is untouched).
         """
-        # The file formats are rtpy.io's: the one import of a result from its writers.
-        from .io.image import write_image
-
-        return write_image(path, self.linear, self.gamma)
+        return writer("image")(path, self.linear, self.gamma)  # rtpy.io.image's formats
 
     def _repr_png_(self) -> bytes:
         """PNG bytes of the 8-bit image, so Jupyter displays a RenderedImage inline."""

@@ -8,11 +8,11 @@ from typing import Any
 
 from .bvh import BVH
 from .camera import Camera
+from .checks import checked, string
 from .environment import Environment
 from .hit_info import HitInfo
 from .hittable import Hittable
 from .interval import Interval
-from .io.values import checked, string
 from .light import AreaLight, Light, PointLight
 from .mesh import Mesh
 from .ray import Ray

@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 
 from .bvh import AABB
+from .checks import LENGTH, checked_number, checked_point
 from .hit_info import HitInfo
 from .hittable import Hittable
-from .io.values import LENGTH, checked_number, checked_point
 from .onb import local_to_world
 from .ray import Ray
 from .sampling import uniform_sphere

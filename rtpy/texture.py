@@ -6,8 +6,8 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .checks import LENGTH, UNIT, checked_color, checked_number
 from .hit_info import HitInfo
-from .io.values import LENGTH, UNIT, checked_color, checked_number
 from .vec3 import Color
 
 if TYPE_CHECKING:

@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 
 from .bvh import AABB
+from .checks import MIN_AREA, checked_point
 from .hit_info import HitInfo
 from .hittable import FlatShape
-from .io.values import MIN_AREA, checked_point
 from .ray import Ray
 from .vec3 import Vec3, cross, dot
 

@@ -8,7 +8,14 @@ the modules.
   except a package's __init__.py (its exports: what it defines is tested where it is
   used) and UNMIRRORED, each with where it is tested;
 - every test file has a test that is not marked slow, so that the everyday loop
-  `python -m pytest -m "not slow"` touches every module.
+  `python -m pytest -m "not slow"` touches every module;
+- every module of rtpy/ is on a floor (FLOORS): the core (the course's code with its
+  value contract, file helpers, exit statuses, RenderedImage, the render loop with
+  its Backend protocol and plans), the backends registered by name, and the tools
+  (io, grading, testing, bench, the command line and the package's front door). A
+  module imports from its own floor or below, anywhere in it except under
+  `if TYPE_CHECKING:`, but for UPWARD_IMPORTS, each with why; and no modules import
+  each other in a circle at import time (their module-level imports).
 
 Each check is a function of a source tree, run on this one and, to show that it can
 fail, on a small tree with planted violations. An exception that no longer applies
@@ -53,6 +60,27 @@ UNMIRRORED = {
         "tests/numpy_backend/materials/test_table.py, against the scalar model"
     ),
 }
+
+
+FLOOR_NAMES = ("the core", "the backends", "the tools")
+# Path under rtpy/ (a file, or a folder ending in "/") -> its floor, the longest that
+# matches; a module no entry matches is on floor 0, the core.
+FLOORS: dict[str, int] = {
+    "rtpy/scalar_backend.py": 1,
+    "rtpy/backends.py": 1,
+    "rtpy/numpy_backend/": 1,
+    "rtpy/io/": 2,
+    "rtpy/grading/": 2,
+    "rtpy/testing/": 2,
+    "rtpy/bench/": 2,
+    "rtpy/__main__.py": 2,
+    # The front door: `import rtpy` exports the API of every floor (render, load_scene,
+    # BACKENDS) and imports the registrations the core looks up (backends, writers).
+    "rtpy/__init__.py": 2,
+}
+
+# "importer -> imported" (paths) -> why the import goes up a floor.
+UPWARD_IMPORTS: dict[str, str] = {}
 
 
 def modules(root: Path) -> list[Path]:
@@ -192,3 +220,185 @@ def test_the_checks_catch_planted_violations(tmp_path):
         "rtpy/no.py: no such module, drop it",
     ]
     assert files_without_fast_tests(tmp_path) == ["tests/test_big.py: every test is marked slow"]
+
+
+# --- floors and cycles -------------------------------------------------------------------
+
+
+def floor_of(rel: str, floors: dict[str, int] = FLOORS) -> int:
+    """The floor of the module at rel (rtpy/...): the longest entry of floors that
+    matches it, else 0."""
+    hits = [p for p in floors if rel == p or (p.endswith("/") and rel.startswith(p))]
+    return floors[max(hits, key=len)] if hits else 0
+
+
+def module_names(root: Path) -> dict[str, str]:
+    """Dotted module name -> path, for every module of rtpy/ (a package: its __init__)."""
+    names = {}
+    for path in modules(root):
+        rel = path.relative_to(root)
+        parts = list(rel.with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts.pop()
+        names[".".join(parts)] = rel.as_posix()
+    return names
+
+
+def _under_type_checking(node: ast.AST) -> bool:
+    return isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+
+
+def imports_of(root: Path, rel: str, names: dict[str, str]) -> list[tuple[int, str, bool]]:
+    """(line, path of the rtpy module imported, at module level?) for each import of
+    the module at rel, but those under `if TYPE_CHECKING:`. `from a import b` imports
+    the module a.b when there is one, else a."""
+    name = next(n for n, r in names.items() if r == rel)
+    package = name.split(".") if rel.endswith("__init__.py") else name.split(".")[:-1]
+    found: list[tuple[int, str, bool]] = []
+
+    def resolve(node: ast.Import | ast.ImportFrom) -> list[str]:
+        if isinstance(node, ast.Import):
+            return [a.name for a in node.names]
+        base = node.module or ""
+        if node.level:
+            up = package[: len(package) - node.level + 1]
+            base = ".".join([*up, *([node.module] if node.module else [])])
+        return [f"{base}.{a.name}" if f"{base}.{a.name}" in names else base for a in node.names]
+
+    def visit(node: ast.AST, top: bool) -> None:
+        for child in ast.iter_child_nodes(node):
+            if _under_type_checking(child):
+                for other in child.orelse:
+                    visit(ast.Module(body=[other], type_ignores=[]), top)
+            elif isinstance(child, ast.Import | ast.ImportFrom):
+                for target in resolve(child):
+                    while target and target not in names:  # import a.b.c: the module a.b
+                        target = target.rpartition(".")[0]
+                    if target:
+                        found.append((child.lineno, names[target], top))
+            else:
+                inner = isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef | ast.Lambda)
+                visit(child, top and not inner)
+
+    visit(ast.parse((root / rel).read_text()), True)
+    return sorted(set(found))  # `from a import b, c`: one import of a
+
+
+def upward_imports(
+    root: Path, allowed: dict[str, str], floors: dict[str, int] = FLOORS
+) -> list[str]:
+    """Imports of rtpy/ from a higher floor that `allowed` does not name, and the
+    entries of `allowed` that are not such an import."""
+    names = module_names(root)
+    out, found = [], set()
+    for rel in names.values():
+        for line, target, _ in imports_of(root, rel, names):
+            low, high = floor_of(rel, floors), floor_of(target, floors)
+            if high > low:
+                found.add(key := f"{rel} -> {target}")
+                if key not in allowed:
+                    out.append(
+                        f"{rel}:{line}: imports {target}, a floor up "
+                        f"({FLOOR_NAMES[low]} -> {FLOOR_NAMES[high]})"
+                    )
+    stale = [key for key in allowed if key not in found]
+    return out + [f"{key}: not an import a floor up, drop it" for key in stale]
+
+
+def import_cycles(root: Path) -> list[str]:
+    """Each circle of modules of rtpy/ that import each other at module level (but
+    under TYPE_CHECKING): its shortest circle through its first module."""
+    names = module_names(root)
+    graph = {
+        rel: sorted({t for _, t, top in imports_of(root, rel, names) if top and t != rel})
+        for rel in names.values()
+    }
+    out = []
+    for group in _strongly_connected(graph):
+        if len(group) < 2:
+            continue
+        start = min(group)
+        paths = {start: [start]}
+        queue = [start]
+        while queue:  # breadth first, within the group, back to start
+            rel = queue.pop(0)
+            nxt = [t for t in graph[rel] if t in group]
+            if start in nxt:
+                out.append("import cycle: " + " -> ".join([*paths[rel], start]))
+                break
+            for t in nxt:
+                if t not in paths:
+                    paths[t] = [*paths[rel], t]
+                    queue.append(t)
+    return sorted(out)
+
+
+def _strongly_connected(graph: dict[str, list[str]]) -> list[set[str]]:
+    """Tarjan's strongly connected components of graph."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    groups: list[set[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = set()
+            while True:
+                w = stack.pop()
+                group.add(w)
+                if w == v:
+                    break
+            groups.append(group)
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return groups
+
+
+def test_every_module_is_on_a_floor_and_imports_only_down():
+    present = [p.relative_to(ROOT).as_posix() for p in modules(ROOT)]
+    assert {floor_of(rel) for rel in present} == {0, 1, 2}
+    assert [entry for entry in FLOORS if not any(rel.startswith(entry) for rel in present)] == []
+    assert upward_imports(ROOT, UPWARD_IMPORTS) == []
+
+
+def test_no_modules_import_each_other_in_a_circle():
+    assert import_cycles(ROOT) == []
+
+
+def test_the_floor_checks_catch_planted_violations(tmp_path):
+    """A tree with one import a floor up (and one under TYPE_CHECKING, allowed), one
+    circle at import time (and one through a function's import, which is none), and
+    an allowed upward import that no longer is one."""
+    (tmp_path / "rtpy" / "io").mkdir(parents=True)
+    (tmp_path / "rtpy" / "__init__.py").write_text("")
+    (tmp_path / "rtpy" / "io" / "__init__.py").write_text("")
+    (tmp_path / "rtpy" / "core.py").write_text(
+        "from typing import TYPE_CHECKING\n\nfrom . import low\n\n"
+        "if TYPE_CHECKING:\n    from .io import fmt\n\n\n"
+        "def save():\n    from .io.fmt import write\n"
+    )
+    (tmp_path / "rtpy" / "low.py").write_text("from .core import save\n")
+    (tmp_path / "rtpy" / "io" / "fmt.py").write_text(
+        "from .. import core\n\n\ndef write():\n    pass\n"
+    )
+
+    planted = ("rtpy/core.py", "rtpy/numpy_backend/a.py", "rtpy/io/x.py", "rtpy/__init__.py")
+    assert [floor_of(rel) for rel in planted] == [0, 1, 2, 2]
+    assert upward_imports(tmp_path, {}) == [
+        "rtpy/core.py:10: imports rtpy/io/fmt.py, a floor up (the core -> the tools)"
+    ]
+    allowed = {"rtpy/core.py -> rtpy/io/fmt.py": "a reason", "rtpy/low.py -> rtpy/io/fmt.py": "x"}
+    assert upward_imports(tmp_path, allowed) == [
+        "rtpy/low.py -> rtpy/io/fmt.py: not an import a floor up, drop it"
+    ]
+    assert import_cycles(tmp_path) == ["import cycle: rtpy/core.py -> rtpy/low.py -> rtpy/core.py"]

@@ -166,14 +166,6 @@ def test_hit_info_of_a_smooth_triangle_is_a_hit_info():
     assert isinstance(SMOOTH.intersect(down_at(0.5, 0.5), EVERYWHERE), HitInfo)
 
 
-def test_from_obj_reads_a_file(tmp_path):
-    path = tmp_path / "quad.obj"
-    path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n")
-    mesh = Mesh.from_obj(path, MAT, Transform(scale=V(2, 2, 2)))
-    assert [type(t) for t in mesh.triangles] == [SmoothTriangle, SmoothTriangle]
-    assert mesh.triangles[1].c == V(0, 2, 0)
-
-
 # --------------------------------------------------------------------------- Mesh as one object
 
 

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from rtpy.checks import MIN_AREA
 from rtpy.interval import Interval
-from rtpy.io.values import MIN_AREA
 from rtpy.materials import Lambertian
 from rtpy.quad import Quad
 from rtpy.ray import Ray

@@ -10,9 +10,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from rtpy.checks import MIN_AREA
 from rtpy.hit_info import HitInfo
 from rtpy.interval import Interval
-from rtpy.io.values import MIN_AREA
 from rtpy.materials import Lambertian
 from rtpy.ray import Ray
 from rtpy.testing import chi2_sf

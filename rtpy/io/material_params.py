@@ -3,7 +3,8 @@
 Material keys are not listed anywhere: a material class registered with
 rtpy.materials.register_material loads from scene files with its constructor's
 parameters as keys and its defaults as defaults, and the parameter's annotation
-(or default) says what type of value the key takes.
+(or default) says what type of value the key takes. Their ranges are
+rtpy.materials.ranges.MATERIAL_RANGES.
 """
 
 from __future__ import annotations
@@ -14,29 +15,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..vec3 import Vec3
-from .values import EXPONENT, FUZZ, IOR, RADIANCE, ROUGHNESS, SIGMA, UNIT, Range
 
-__all__ = ["MATERIAL_RANGES", "Param", "material_parameters"]
-
-# Ranges of material parameters by name, for numbers and for each colour component.
-# The scene loader and the materials' constructors (rtpy.materials.material's
-# material_number and material_color) check against these; a constructor's
-# ValueError becomes a SceneError too.
-MATERIAL_RANGES: dict[str, Range] = {
-    "albedo": UNIT,
-    "f0": UNIT,
-    "emit": RADIANCE,
-    "ior": IOR,
-    "fuzz": FUZZ,
-    "kd": UNIT,
-    "ks": UNIT,
-    "exponent": EXPONENT,
-    "roughness": ROUGHNESS,
-    "alpha_x": ROUGHNESS,
-    "alpha_y": ROUGHNESS,
-    "sigma": SIGMA,
-    "tint": UNIT,
-}
+__all__ = ["Param", "material_parameters"]
 
 
 @dataclass(frozen=True)

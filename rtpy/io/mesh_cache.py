@@ -25,7 +25,7 @@ import numpy as np
 
 from ..bvh import Tree
 from ..mesh import Mesh, Transform
-from .obj import read_obj
+from .obj import mesh_from_obj
 
 FORMAT = 1
 MIN_FACES = 50_000
@@ -46,7 +46,7 @@ def cache_folder() -> Path | None:
 
 def load_mesh(path: Path, material, transform: Transform) -> tuple[Mesh, int]:
     """(the mesh of the OBJ file at path, the number of faces the file has): from the
-    cache when it has it, else read (rtpy.io.obj.read_obj, its errors), built, and
+    cache when it has it, else read (rtpy.io.obj.mesh_from_obj, its errors), built, and
     kept when it is large."""
     folder = cache_folder()
     entry = None if folder is None else folder / _key(path, transform)
@@ -54,9 +54,8 @@ def load_mesh(path: Path, material, transform: Transform) -> tuple[Mesh, int]:
         found = _read(entry, material)
         if found is not None:
             return found
-    obj = read_obj(path)
-    mesh = Mesh(obj.positions, obj.normals, obj.triangles, material, transform)
-    faces = len(obj.triangles)
+    mesh = mesh_from_obj(path, material, transform)
+    faces = len(mesh) + mesh.skipped  # the file's, the degenerate ones too
     if entry is not None and len(mesh) >= MIN_FACES:
         _write(entry, mesh, faces)
     return mesh, faces

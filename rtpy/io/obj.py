@@ -25,7 +25,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["ObjError", "ObjMesh", "parse_obj", "read_obj"]
+from ..mesh import Mesh, Transform
+
+__all__ = ["ObjError", "ObjMesh", "mesh_from_obj", "parse_obj", "read_obj"]
 
 # Statements that define nothing this reader uses; they are skipped.
 IGNORED = frozenset(
@@ -170,3 +172,13 @@ def read_obj(path: str | Path) -> ObjMesh:
 
     obj = parse_obj_bytes(raw)
     return obj if obj is not None else parse_obj(raw.decode("utf-8"))
+
+
+def mesh_from_obj(path: str | Path, material, transform: Transform | None = None) -> Mesh:
+    """The rtpy.Mesh of an OBJ file, placed by transform (read_obj, whose ObjError
+    names the line it cannot read).
+
+        mesh = rtpy.mesh_from_obj("teapot.obj", Lambertian(), Transform(scale=Vec3(0.5, 0.5, 0.5)))
+    """
+    obj = read_obj(path)
+    return Mesh(obj.positions, obj.normals, obj.triangles, material, transform)

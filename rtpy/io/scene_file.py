@@ -30,9 +30,23 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
+from .. import checks
 from ..camera import Camera
+from ..checks import (
+    ANY,
+    ASPECT_RATIO,
+    DEFOCUS_ANGLE,
+    LENGTH,
+    MAX_RADIANCE,
+    RADIANCE,
+    UNIT,
+    VFOV,
+    describe,
+    suggest,
+)
 from ..light import PointLight
 from ..materials import MATERIALS
+from ..materials.ranges import MATERIAL_RANGES
 from ..mesh import Transform
 from ..quad import Quad
 from ..render_settings import (
@@ -48,24 +62,11 @@ from ..sphere import Sphere
 from ..texture import CheckerTexture, ImageTexture, SolidColor, Texture
 from ..triangle import Triangle
 from ..vec3 import Color, Vec3
-from . import values
-from .material_params import MATERIAL_RANGES, Param, material_parameters
+from .material_params import Param, material_parameters
 from .mesh_cache import load_mesh
 from .obj import ObjError
 from .scene_tables import SceneError, SceneWarning, TableReader
 from .toml_lines import TomlLines, Where, quote_key
-from .values import (
-    ANY,
-    ASPECT_RATIO,
-    DEFOCUS_ANGLE,
-    LENGTH,
-    MAX_RADIANCE,
-    RADIANCE,
-    UNIT,
-    VFOV,
-    describe,
-    suggest,
-)
 
 __all__ = [
     "MAX_HEIGHT",
@@ -161,7 +162,7 @@ class _Loader(TableReader):
         self.check_keys(w, t, CAMERA_KEYS)
         look_from = self.vec3(w, "look_from", t.get("look_from", [0, 0, 0]))
         look_at = self.vec3(w, "look_at", t.get("look_at", [0, 0, -1]))
-        vup = self.vec3(w, "vup", t.get("vup", [0, 1, 0]), values.edge)
+        vup = self.vec3(w, "vup", t.get("vup", [0, 1, 0]), checks.edge)
         vfov = self.number(w, "vfov", t.get("vfov", 90), VFOV)
         aspect = self.aspect_ratio(w, t.get("aspect_ratio", 16.0 / 9.0))
         width = self.setting(w, "width", t.get("width", SETTINGS["width"].default))
@@ -173,8 +174,8 @@ class _Loader(TableReader):
             raise self.fail(
                 w,
                 "aspect_ratio",
-                f"width {width} / aspect_ratio {values.num_text(aspect)} gives an image height of "
-                f"{values.num_text(int(height)) if math.isfinite(height) else 'inf'} pixels; "
+                f"width {width} / aspect_ratio {checks.num_text(aspect)} gives an image height of "
+                f"{checks.num_text(int(height)) if math.isfinite(height) else 'inf'} pixels; "
                 f"the most is {MAX_HEIGHT}",
             )
         try:
@@ -195,7 +196,7 @@ class _Loader(TableReader):
             if not (math.isfinite(a) and math.isfinite(b) and a > 0 and b > 0):
                 raise self.expected(w, "aspect_ratio", what, v)
             v = a / b
-        elif not values.is_number(v):
+        elif not checks.is_number(v):
             raise self.expected(w, "aspect_ratio", what, v)
         return self.number(w, "aspect_ratio", v, ASPECT_RATIO)
 
@@ -296,7 +297,7 @@ class _Loader(TableReader):
             return self.number(w, p.name, v, rng)
         if p.kind == "str":
             return self.string(w, p.name, v, p.choices)
-        if values.is_number(v) and isinstance(v, float) and not math.isfinite(v):
+        if checks.is_number(v) and isinstance(v, float) and not math.isfinite(v):
             raise self.expected(w, p.name, "a finite number", v)
         return v
 
@@ -321,7 +322,7 @@ class _Loader(TableReader):
         self.check_keys(w, t, OBJECT_KEYS[kind], f'type "{kind}"')
 
         def point(key: str) -> Vec3:
-            check = values.edge if key in ("u", "v") else values.point
+            check = checks.edge if key in ("u", "v") else checks.point
             return self.vec3(w, key, self.require(w, t, key, "an array of 3 numbers"), check)
 
         if kind == "sphere":
@@ -348,13 +349,13 @@ class _Loader(TableReader):
         if not isinstance(rel, str) or not rel:
             raise self.expected(w, "path", what, rel)
         translate = self.vec3(w, "translate", t.get("translate", [0, 0, 0]))
-        rotate = self.vec3(w, "rotate", t.get("rotate", [0, 0, 0]), values.angles)
+        rotate = self.vec3(w, "rotate", t.get("rotate", [0, 0, 0]), checks.angles)
         scale = t.get("scale", 1)
-        if values.is_number(scale):
+        if checks.is_number(scale):
             scale = [scale] * 3
         elif not isinstance(scale, list):
             raise self.expected(w, "scale", "a number or an array of 3 numbers", scale)
-        scale = self.vec3(w, "scale", scale, values.scales)
+        scale = self.vec3(w, "scale", scale, checks.scales)
         material = self.reference(w, t)
         resolved = self.path.parent / rel
         self.files.append(resolved)

@@ -14,11 +14,11 @@ from dataclasses import KW_ONLY, dataclass
 from pathlib import Path
 from typing import Any
 
+from .. import checks
+from ..checks import ANY, Invalid, Range, describe, suggest
 from ..render_settings import SETTINGS, SettingError
 from ..vec3 import Color, Vec3
-from . import values
 from .toml_lines import TomlLines, Where, quote_key
-from .values import ANY, Invalid, Range, describe, suggest
 
 __all__ = ["SceneError", "SceneWarning", "TableReader"]
 
@@ -123,7 +123,7 @@ class TableReader:
 
     # --- values -------------------------------------------------------------------
     def checked(self, where: Where, key: str, check: Callable, v: Any, *args) -> Any:
-        """check(v, *args) (one of rtpy.io.values' checks), its Invalid as a SceneError."""
+        """check(v, *args) (one of rtpy.checks' checks), its Invalid as a SceneError."""
         try:
             return check(v, *args)
         except Invalid as e:
@@ -137,23 +137,23 @@ class TableReader:
             raise self.fail(where, key, e.detail, e.suggestion) from None
 
     def number(self, where: Where, key: str, v: Any, rng: Range = ANY) -> float:
-        return self.checked(where, key, values.number, v, rng)
+        return self.checked(where, key, checks.number, v, rng)
 
     def integer(self, where: Where, key: str, v: Any, rng: Range = ANY) -> int:
-        return self.checked(where, key, values.integer, v, rng)
+        return self.checked(where, key, checks.integer, v, rng)
 
     def boolean(self, where: Where, key: str, v: Any) -> bool:
-        return self.checked(where, key, values.boolean, v)
+        return self.checked(where, key, checks.boolean, v)
 
     def string(self, where: Where, key: str, v: Any, choices: tuple[str, ...] = ()) -> str:
-        return self.checked(where, key, values.string, v, choices)
+        return self.checked(where, key, checks.string, v, choices)
 
-    def vec3(self, where: Where, key: str, v: Any, check: Callable = values.point) -> Vec3:
+    def vec3(self, where: Where, key: str, v: Any, check: Callable = checks.point) -> Vec3:
         """A vector checked by check (a point, an edge, scales, ...)."""
         return Vec3(*self.checked(where, key, check, v))
 
     def color(self, where: Where, key: str, v: Any, rng: Range = ANY) -> Color:
-        return Color(*self.checked(where, key, values.triple, v, rng))
+        return Color(*self.checked(where, key, checks.triple, v, rng))
 
     # --- tables -------------------------------------------------------------------
     def table(self, data: dict, name: str) -> dict:

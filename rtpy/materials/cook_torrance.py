@@ -49,8 +49,8 @@ from __future__ import annotations
 import math
 from typing import Literal
 
+from ..checks import checked, string
 from ..hit_info import HitInfo
-from ..io.values import checked, string
 from ..onb import ONB
 from ..ray import Ray
 from ..sampling import generator, random_cosine_direction

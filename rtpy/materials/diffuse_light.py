@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from ..checks import boolean, checked
 from ..hit_info import HitInfo
-from ..io.values import boolean, checked
 from ..vec3 import BLACK, Color
 from .material import Material, material_color
 

@@ -22,13 +22,13 @@ scattering() returns and never sample lights at them.
 
 from __future__ import annotations
 
+from ..checks import checked_color, checked_number
 from ..hit_info import HitInfo
-from ..io.material_params import MATERIAL_RANGES
-from ..io.values import checked_color, checked_number
 from ..ray import Ray
 from ..scatter_info import ScatterInfo
 from ..texture import SolidColor, Texture
 from ..vec3 import BLACK, WHITE, Color
+from .ranges import MATERIAL_RANGES
 
 
 def material_number(name: str, value: float) -> float:

@@ -40,7 +40,6 @@ from rtpy import (
     Dielectric,
     DiffuseLight,
     Lambertian,
-    Mesh,
     Metal,
     PointLight,
     Quad,
@@ -284,7 +283,7 @@ def shape(table: dict, material, folder: Path) -> list:
     if table["type"] == "triangle":
         return [Triangle(V(*table["a"]), V(*table["b"]), V(*table["c"]), material)]
     place = Transform(*(V(*table[k]) for k in ("translate", "rotate", "scale")))
-    return Mesh.from_obj(folder / table["path"], material, place).triangles
+    return rtpy.mesh_from_obj(folder / table["path"], material, place).triangles
 
 
 def build(data: dict, folder: Path) -> Scene:

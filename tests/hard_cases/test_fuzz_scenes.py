@@ -22,8 +22,8 @@ from hypothesis import given
 from PIL import Image
 
 import rtpy
+from rtpy.checks import MAX_RADIANCE
 from rtpy.io.scene_file import SceneError, load_scene_text
-from rtpy.io.values import MAX_RADIANCE
 from tests.io.scene_text import to_toml
 
 from .scene_strategies import fuzz_settings, random_scene, seeds

@@ -56,10 +56,10 @@ def test_a_large_mesh_is_built_once_and_read_back(tmp_path, cache, monkeypatch):
     built, faces = load_mesh(path, MAT, Transform())
     assert len(entries(cache)) == 1 and faces == len(built)
 
-    def no_reading(path):
+    def no_reading(path, material, transform):
         raise AssertionError("read again")
 
-    monkeypatch.setattr(mesh_cache, "read_obj", no_reading)
+    monkeypatch.setattr(mesh_cache, "mesh_from_obj", no_reading)
     again, faces_again = load_mesh(path, MAT, Transform())
     same_mesh(again, built)
     assert faces_again == faces and again.material is MAT

@@ -5,7 +5,11 @@ from __future__ import annotations
 
 import pytest
 
-from rtpy.io.obj import ObjError, parse_obj, read_obj
+import rtpy
+from rtpy.io.obj import ObjError, mesh_from_obj, parse_obj, read_obj
+from rtpy.materials import Lambertian
+from rtpy.mesh import SmoothTriangle, Transform
+from rtpy.vec3 import Vec3
 
 SQUARE = """\
 # a unit square in z = 0, as one quad face
@@ -108,3 +112,13 @@ def test_read_obj_reads_a_file_and_refuses_non_utf8(tmp_path):
 def test_a_file_with_no_faces_is_read_as_empty():
     assert parse_obj("v 0 0 0\n").triangles.shape == (0, 3, 2)
     assert parse_obj("").positions.shape == (0, 3)
+
+
+def test_mesh_from_obj_reads_a_file_into_a_mesh(tmp_path):
+    """What Mesh.from_obj was: the core's Mesh no longer reads a file format."""
+    path = tmp_path / "quad.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n")
+    mesh = mesh_from_obj(path, Lambertian(), Transform(scale=Vec3(2, 2, 2)))
+    assert [type(t) for t in mesh.triangles] == [SmoothTriangle, SmoothTriangle]
+    assert mesh.triangles[1].c == Vec3(0, 2, 0)
+    assert rtpy.mesh_from_obj is mesh_from_obj and len(mesh_from_obj(path, Lambertian())) == 2

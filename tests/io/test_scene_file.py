@@ -10,9 +10,10 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
+from rtpy import checks
 from rtpy.camera import MAX_PIXELS, Camera
-from rtpy.io import values
-from rtpy.io.material_params import MATERIAL_RANGES, material_parameters
+from rtpy.checks import COORDINATE, LENGTH, RADIANCE, UNIT, Range
+from rtpy.io.material_params import material_parameters
 from rtpy.io.scene_file import (
     MAX_HEIGHT,
     MAX_SPP,
@@ -20,9 +21,9 @@ from rtpy.io.scene_file import (
     SceneError,
     load_scene,
 )
-from rtpy.io.values import COORDINATE, LENGTH, RADIANCE, UNIT, Range
 from rtpy.light import PointLight
 from rtpy.materials import MATERIALS, Dielectric, DiffuseLight, Lambertian
+from rtpy.materials.ranges import MATERIAL_RANGES
 from rtpy.quad import Quad
 from rtpy.render_settings import RenderSettings
 from rtpy.scene import Scene
@@ -677,17 +678,17 @@ def _key_cases() -> list[tuple]:
         (cam, "look_from", 0, _offset_ok, ("look_from", "look_at")),
         (cam, "look_at", 0, _offset_ok, ("look_at",)),
         (cam, "vup", 0, _offset_ok, ("vup",)),
-        (cam, "vfov", None, _inside(values.VFOV), ()),
+        (cam, "vfov", None, _inside(checks.VFOV), ()),
         (
             cam,
             "aspect_ratio",
             None,
-            lambda x: _inside(values.ASPECT_RATIO)(x) and 4 / x < MAX_HEIGHT + 1,
+            lambda x: _inside(checks.ASPECT_RATIO)(x) and 4 / x < MAX_HEIGHT + 1,
             (),
         ),
-        (cam, "defocus_angle", None, _inside(values.DEFOCUS_ANGLE), ()),
+        (cam, "defocus_angle", None, _inside(checks.DEFOCUS_ANGLE), ()),
         (cam, "focus_distance", None, _inside(LENGTH), ()),
-        (("render",), "gamma", None, _inside(values.GAMMA), ()),
+        (("render",), "gamma", None, _inside(checks.GAMMA), ()),
         (("render",), "background", 1, _inside(RADIANCE), ()),
         (("textures", "t"), "scale", None, _inside(LENGTH), ()),
         (("textures", "t"), "odd", 2, _inside(UNIT), ()),
@@ -698,7 +699,7 @@ def _key_cases() -> list[tuple]:
         ((*obj, 1), "v", 2, _offset_ok, ()),
         ((*obj, 2), "a", 2, _inside(COORDINATE), ()),
         ((*obj, 3), "translate", 1, lambda x: _inside(COORDINATE)(x) and x + 1 in COORDINATE, ()),
-        ((*obj, 3), "rotate", 2, _inside(values.ANGLE), ()),
+        ((*obj, 3), "rotate", 2, _inside(checks.ANGLE), ()),
         ((*obj, 3), "scale", None, _size_inside(LENGTH), ()),
         (("lights", 0), "position", 2, _inside(COORDINATE), ()),
         (("lights", 0), "intensity", 0, _inside(RADIANCE), ()),

@@ -1,4 +1,4 @@
-"""Tests for rtpy.io.values: the typed values of scene files. Through the loader,
+"""Tests for rtpy.checks: the typed values of scene files. Through the loader,
 each wrong type or range is a SceneError naming the file, table and key; the
 checks themselves say what was expected and found."""
 
@@ -11,13 +11,14 @@ import pytest
 from hypothesis import given, settings
 
 import rtpy
+from rtpy import checks
 from rtpy.camera import Camera
+from rtpy.checks import COORDINATE, LENGTH, RADIANCE, UNIT, Invalid, Range
 from rtpy.environment import SkyBand
-from rtpy.io import values
-from rtpy.io.material_params import MATERIAL_RANGES, material_parameters
-from rtpy.io.values import COORDINATE, LENGTH, RADIANCE, UNIT, Invalid, Range
+from rtpy.io.material_params import material_parameters
 from rtpy.light import PointLight
 from rtpy.materials import MATERIALS, Lambertian
+from rtpy.materials.ranges import MATERIAL_RANGES
 from rtpy.mesh import Transform
 from rtpy.quad import Quad
 from rtpy.render_settings import RenderSettings
@@ -27,8 +28,8 @@ from rtpy.texture import CheckerTexture, SolidColor
 from rtpy.triangle import Triangle
 from rtpy.vec3 import Vec3
 
-from ..strategies import SPECIAL_FLOATS, extreme_floats
-from .scene_text import MINIMAL, assert_names, error_of
+from .io.scene_text import MINIMAL, assert_names, error_of
+from .strategies import SPECIAL_FLOATS, extreme_floats
 
 LIGHT = '[[lights]]\ntype = "point"\nposition = [0, true, 0]\nintensity = [1, 1, 1]\n'
 
@@ -121,69 +122,69 @@ def invalid(check, *args) -> Invalid:
 
 
 def test_number_takes_integers_refuses_booleans_nan_and_values_out_of_range():
-    assert values.number(3, values.POSITIVE) == 3.0 and isinstance(values.number(3), float)
-    assert values.number(np.float32(0.5)) == 0.5
-    e = invalid(values.number, True)
+    assert checks.number(3, checks.POSITIVE) == 3.0 and isinstance(checks.number(3), float)
+    assert checks.number(np.float32(0.5)) == 0.5
+    e = invalid(checks.number, True)
     assert e.wrong_type and e.detail == "expected a number, found true"
-    e = invalid(values.number, math.nan, values.POSITIVE)
+    e = invalid(checks.number, math.nan, checks.POSITIVE)
     assert not e.wrong_type and e.detail == "expected a finite number > 0, found nan"
     assert (
-        invalid(values.number, 10**400).detail
+        invalid(checks.number, 10**400).detail
         == "expected a finite number, found a very large integer"
     )
-    e = invalid(values.number, -1.5, Range(0, 180, True, True))
+    e = invalid(checks.number, -1.5, Range(0, 180, True, True))
     assert e.detail == "expected a number in (0, 180), found -1.5" and not e.wrong_type
 
 
 def test_integer_refuses_floats_with_a_hint_and_takes_numpy_integers():
-    assert values.integer(np.int64(7), values.NON_NEGATIVE) == 7
-    assert type(values.integer(np.int64(7))) is int
-    e = invalid(values.integer, 16.0, Range(1, 100), " (larger counts are refused)")
+    assert checks.integer(np.int64(7), checks.NON_NEGATIVE) == 7
+    assert type(checks.integer(np.int64(7))) is int
+    e = invalid(checks.integer, 16.0, Range(1, 100), " (larger counts are refused)")
     assert e.wrong_type
     assert e.detail == (
         "expected an integer in [1, 100] (larger counts are refused), found 16.0 "
         "(write 16 without the decimal point)"
     )
-    assert invalid(values.integer, 2.5).detail == "expected an integer, found 2.5"
-    assert invalid(values.integer, np.bool_(True)).wrong_type
-    assert invalid(values.integer, False).detail == "expected an integer, found false"
-    assert invalid(values.integer, 0, Range(1)).detail == "expected an integer >= 1, found 0"
+    assert invalid(checks.integer, 2.5).detail == "expected an integer, found 2.5"
+    assert invalid(checks.integer, np.bool_(True)).wrong_type
+    assert invalid(checks.integer, False).detail == "expected an integer, found false"
+    assert invalid(checks.integer, 0, Range(1)).detail == "expected an integer >= 1, found 0"
 
 
 def test_string_suggests_the_nearest_choice():
-    assert values.string("path", ("center", "path")) == "path"
-    e = invalid(values.string, "pth", ("center", "path"))
+    assert checks.string("path", ("center", "path")) == "path"
+    e = invalid(checks.string, "pth", ("center", "path"))
     assert e.detail == 'expected one of "center", "path", found the string "pth"'
     assert e.suggestion == "path" and not e.wrong_type
-    assert invalid(values.string, 3).detail == "expected a string, found 3"
-    assert invalid(values.string, "zzz", ("center", "path")).suggestion is None
+    assert invalid(checks.string, 3).detail == "expected a string, found 3"
+    assert invalid(checks.string, "zzz", ("center", "path")).suggestion is None
 
 
 def test_triple_names_the_bad_component():
-    assert values.triple([1, 2.5, 3]) == (1.0, 2.5, 3.0)
+    assert checks.triple([1, 2.5, 3]) == (1.0, 2.5, 3.0)
     each = "expected an array of 3 finite numbers, each in [0, 1]"
-    assert invalid(values.triple, [0, 2, 0], values.UNIT).detail == (
+    assert invalid(checks.triple, [0, 2, 0], checks.UNIT).detail == (
         f"{each}, found [0, 2, 0] (component 2 is 2)"
     )
-    e = invalid(values.triple, [0, True, 0], values.UNIT)
+    e = invalid(checks.triple, [0, True, 0], checks.UNIT)
     assert e.wrong_type and e.detail.endswith(
         "found true as component 2 (booleans are not numbers)"
     )
-    assert invalid(values.triple, [1, 2]).detail.endswith("found [1, 2]")
-    assert invalid(values.triple, "red").detail.endswith('found the string "red"')
+    assert invalid(checks.triple, [1, 2]).detail.endswith("found [1, 2]")
+    assert invalid(checks.triple, "red").detail.endswith('found the string "red"')
 
 
 def test_describe_and_ranges():
-    assert values.describe([1, 2.5, True]) == "[1, 2.5, true]"
-    assert values.describe(list(range(9))) == "an array of 9 items"
-    assert values.describe({"a": 1}) == "a table"
-    assert values.describe("x" * 100) == "the string " + '"' + "x" * 56 + "..."
-    assert values.describe(2.0) == "2.0" and values.describe(2**70) == "a very large integer"
+    assert checks.describe([1, 2.5, True]) == "[1, 2.5, true]"
+    assert checks.describe(list(range(9))) == "an array of 9 items"
+    assert checks.describe({"a": 1}) == "a table"
+    assert checks.describe("x" * 100) == "the string " + '"' + "x" * 56 + "..."
+    assert checks.describe(2.0) == "2.0" and checks.describe(2**70) == "a very large integer"
     assert Range(0, 1).text() == "in [0, 1]" and Range(0, None, True).text() == "> 0"
-    assert Range(None, 5, hi_open=True).text() == "< 5" and values.ANY.text() == ""
-    assert 0 not in Range(0, None, True) and 0 in Range(0) and 1e31 not in values.RADIANCE
-    assert math.nan not in values.ANY and math.inf in values.ANY
-    assert values.suggest("lookat", ["look_at", "look_from"]) == "look_at"
+    assert Range(None, 5, hi_open=True).text() == "< 5" and checks.ANY.text() == ""
+    assert 0 not in Range(0, None, True) and 0 in Range(0) and 1e31 not in checks.RADIANCE
+    assert math.nan not in checks.ANY and math.inf in checks.ANY
+    assert checks.suggest("lookat", ["look_at", "look_from"]) == "look_at"
 
 
 # --- the Python API: every constructor parameter over every magnitude ------------------------
@@ -261,18 +262,18 @@ API_CASES = [
         _vector_length_ok,
     ),
     ("Camera vup", lambda x: Camera(vup=(x, 1, 0)), ("vup",), _vector_length_ok),
-    ("Camera vfov", lambda x: Camera(vfov=x), ("vfov",), _inside(values.VFOV)),
+    ("Camera vfov", lambda x: Camera(vfov=x), ("vfov",), _inside(checks.VFOV)),
     (
         "Camera aspect_ratio",
         lambda x: Camera(aspect_ratio=x, width=1),
         ("aspect_ratio",),
-        _inside(values.ASPECT_RATIO),
+        _inside(checks.ASPECT_RATIO),
     ),
     (
         "Camera defocus_angle",
         lambda x: Camera(defocus_angle=x),
         ("defocus_angle",),
-        _inside(values.DEFOCUS_ANGLE),
+        _inside(checks.DEFOCUS_ANGLE),
     ),
     (
         "Camera focus_distance",
@@ -308,14 +309,14 @@ API_CASES = [
         ("translate",),
         _inside(COORDINATE),
     ),
-    ("Transform rotate", lambda x: Transform(rotate=(0, 0, x)), ("rotate",), _inside(values.ANGLE)),
+    ("Transform rotate", lambda x: Transform(rotate=(0, 0, x)), ("rotate",), _inside(checks.ANGLE)),
     (
         "Transform scale",
         lambda x: Transform(scale=(x, 1, 1)),
         ("scale",),
         lambda x: math.isfinite(x) and abs(x) in LENGTH,
     ),
-    ("RenderSettings gamma", lambda x: RenderSettings(gamma=x), ("gamma",), _inside(values.GAMMA)),
+    ("RenderSettings gamma", lambda x: RenderSettings(gamma=x), ("gamma",), _inside(checks.GAMMA)),
     *_material_cases(),
 ]
 

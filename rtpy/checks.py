@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from numbers import Integral, Real
 from typing import Any
 
-from ..vec3 import Color, Vec3
+from .vec3 import Color, Vec3
 
 __all__ = [
     "ANGLE",
