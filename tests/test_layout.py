@@ -402,3 +402,74 @@ def test_the_floor_checks_catch_planted_violations(tmp_path):
         "rtpy/low.py -> rtpy/io/fmt.py: not an import a floor up, drop it"
     ]
     assert import_cycles(tmp_path) == ["import cycle: rtpy/core.py -> rtpy/low.py -> rtpy/core.py"]
+
+
+# --- a render from the command line ------------------------------------------------------
+
+
+def calls_up_into_io(run) -> list[str]:
+    """The calls from a lower floor up into rtpy/io while run() runs, each as
+    "caller -> callee" (file:function): the times the core hands control back to the
+    tools. With the command line's own call down into the core, 1 + len(result) is
+    how often the render crosses io/."""
+    package = ROOT / "rtpy"
+    found: set[str] = set()
+
+    def rel(code) -> str | None:
+        path = Path(code.co_filename)
+        return (
+            f"rtpy/{path.relative_to(package).as_posix()}" if path.is_relative_to(package) else None
+        )
+
+    def hook(frame, event, arg) -> None:
+        callee = rel(frame.f_code) if event == "call" else None
+        if callee is None or not callee.startswith("rtpy/io/"):
+            return
+        caller = frame.f_back
+        while caller is not None and rel(caller.f_code) is None:
+            caller = caller.f_back  # through numpy, the standard library, ...
+        if caller is not None and floor_of(rel(caller.f_code)) < floor_of(callee):
+            name = f"{rel(caller.f_code)}:{caller.f_code.co_name}"
+            found.add(f"{name} -> {callee}:{frame.f_code.co_name}")
+
+    sys.setprofile(hook)
+    try:
+        run()
+    finally:
+        sys.setprofile(None)
+    return sorted(found)
+
+
+def render_from_the_command_line(out: Path) -> None:
+    from rtpy.io.cli import main
+
+    main(["render", "cornell", "--width", "8", "--spp", "1", "-j", "1", "-q", "-o", str(out)])
+
+
+def test_a_render_from_the_command_line_crosses_io_at_most_twice(tmp_path):
+    """Down from the command line once, and back up once: the image writer that the
+    command gave the core's atomic write."""
+    out = tmp_path / "out.png"
+    assert calls_up_into_io(lambda: render_from_the_command_line(out)) == [
+        "rtpy/files.py:atomic_write -> rtpy/io/image.py:write"
+    ]
+    assert out.exists()
+
+
+def test_the_trace_sees_a_core_function_that_calls_io(tmp_path, monkeypatch):
+    """A planted Renderer.render, compiled as rtpy/renderer.py's code, that checks the
+    output path through rtpy/io itself."""
+    import rtpy.renderer
+
+    source = (
+        "def render(self, *args, **kwargs):\n"
+        "    from rtpy.io.image import check_image_path\n"
+        "    check_image_path(OUT)\n"
+        "    return ORIGINAL(self, *args, **kwargs)\n"
+    )
+    namespace = {"ORIGINAL": rtpy.renderer.Renderer.render, "OUT": tmp_path / "out.png"}
+    exec(compile(source, str(ROOT / "rtpy" / "renderer.py"), "exec"), namespace)
+    monkeypatch.setattr(rtpy.renderer.Renderer, "render", namespace["render"])
+    found = calls_up_into_io(lambda: render_from_the_command_line(tmp_path / "out.png"))
+    assert "rtpy/renderer.py:render -> rtpy/io/image.py:check_image_path" in found
+    assert len(found) == 2
