@@ -1,4 +1,4 @@
-"""The meshes of the scene-size bench (scripts/bench_scene_size.py, docs/bench.md):
+"""The meshes of the scene-size bench (scripts/bench_scene_size.py, docs/performance.md):
 a UV sphere of about n triangles with its vertex normals, written as an OBJ file,
 on a ground sphere under the sky. Made on the fly, never committed.
 """

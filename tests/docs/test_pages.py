@@ -20,6 +20,7 @@ PAGES = (
     "instructors.md",
     "numpy-backend.md",
     "bench.md",
+    "performance.md",
 )
 README_LIMIT = 12 * 1024  # bytes
 
