@@ -6,7 +6,6 @@ from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
 
-from ... import materials as scalar
 from ...materials.material import Material
 from ...texture import Texture
 from ..arrays import put_rows
@@ -28,34 +27,34 @@ from .ward import WardKernel
 
 KernelChoice = type[Kernel] | Callable[[Material], type[Kernel]]
 
-# Material class -> its kernel class, or a function choosing one from the instance
-# (Cook-Torrance and the rough dielectric have one kernel per distribution, so no
-# kernel branches per hit).
-# A class the backend must not import is keyed by its full name, module and
-# qualified name, which identifies it as exactly as the class itself: the closed-form
-# scenes' GlowingLambertian lives in rtpy.testing, which the backend does not import
-# (and rtpy.testing, shipped to students, cannot import the withheld backend).
-KERNELS: dict[type | str, KernelChoice] = {
-    scalar.Lambertian: LambertianKernel,
-    scalar.Mirror: MirrorKernel,
-    scalar.Metal: MetalKernel,
-    scalar.Dielectric: DielectricKernel,
-    scalar.RoughDielectric: rough_dielectric_kernel,
-    scalar.DiffuseLight: DiffuseLightKernel,
-    scalar.Phong: PhongKernel,
-    scalar.BlinnPhong: BlinnPhongKernel,
-    scalar.CookTorrance: cook_torrance_kernel,
-    scalar.Ward: WardKernel,
-    scalar.OrenNayar: OrenNayarKernel,
-    "rtpy.testing.analytic_scenes.GlowingLambertian": GlowingLambertianKernel,
+# The kernels by the name a material class declares as its `kernel`: its kernel class,
+# or a function choosing one from the instance (Cook-Torrance and the rough dielectric
+# have one kernel per distribution, so no kernel branches per hit). A name, not the
+# class, so that a class this backend does not import has a twin: the closed-form
+# scenes' GlowingLambertian lives in rtpy.testing, which students get without this
+# backend.
+KERNELS: dict[str, KernelChoice] = {
+    "lambertian": LambertianKernel,
+    "glowing_lambertian": GlowingLambertianKernel,
+    "mirror": MirrorKernel,
+    "metal": MetalKernel,
+    "dielectric": DielectricKernel,
+    "rough_dielectric": rough_dielectric_kernel,
+    "diffuse_light": DiffuseLightKernel,
+    "phong": PhongKernel,
+    "blinn_phong": BlinnPhongKernel,
+    "cook_torrance": cook_torrance_kernel,
+    "ward": WardKernel,
+    "oren_nayar": OrenNayarKernel,
 }
 
 
 def kernel_class(material: Material) -> type[Kernel]:
-    """The kernel for `material`: by its exact class (a subclass may override anything,
-    so it gets the scalar fallback), and the fallback for anything unusual."""
-    cls = type(material)
-    choose = KERNELS.get(cls) or KERNELS.get(f"{cls.__module__}.{cls.__qualname__}")
+    """The kernel for `material`: the one registered under the `kernel` name its own
+    class sets (a subclass may override anything, so it gets the scalar fallback), and
+    the fallback for anything unusual."""
+    name = type(material).__dict__.get("kernel")
+    choose = KERNELS.get(name) if isinstance(name, str) else None
     if choose is None:
         return ScalarFallback
     kernel = choose if isinstance(choose, type) else choose(material)

@@ -12,7 +12,9 @@
   direction; the directions follow that pdf (rtpy.testing's chi2 test); and the
   absorbed fraction and the mean weight (the directional albedo) agree with the scalar
   sampler's by z-tests with fixed seeds.
-- kernels are chosen by exact class, and the number of kernel and numpy calls does
+- kernels are chosen by the name a material's own class declares (every scene
+  material and GlowingLambertian has one; a subclass, an unknown or odd name, gets the
+  fallback), and the number of kernel and numpy calls does
   not grow with the number of materials.
 """
 
@@ -25,8 +27,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from rtpy.materials import MATERIALS as SCENE_MATERIALS
 from rtpy.materials import CookTorrance, Dielectric, Lambertian, Material, Metal, Phong
-from rtpy.numpy_backend.materials import MaterialTable, kernel_class
+from rtpy.numpy_backend.materials import KERNELS, MaterialTable, kernel_class
 from rtpy.numpy_backend.materials.fallback import ScalarFallback
 from rtpy.testing import chi2_test
 from rtpy.vec3 import Color
@@ -170,6 +173,40 @@ class Glow(Material):
     """A material of its own class: no kernel."""
 
     is_emitter = True
+
+
+def test_every_scene_material_and_the_glowing_lambertian_declare_a_registered_kernel():
+    from rtpy.testing.analytic_scenes import GlowingLambertian
+
+    classes = [*SCENE_MATERIALS.values(), GlowingLambertian]
+    declared = {cls.__dict__.get("kernel") for cls in classes}
+    assert declared == set(KERNELS), "every class names a kernel, every kernel is named"
+    assert len(declared) == len(classes), "no two classes share a kernel"
+    glowing = GlowingLambertian(Color(0.5, 0.5, 0.5), Color(1.0, 1.0, 1.0))
+    assert kernel_class(glowing) is KERNELS["glowing_lambertian"]
+
+
+class Unregistered(Lambertian):
+    kernel = "lambertain"  # misspelt: no kernel by that name
+
+
+class Unhashable(Lambertian):
+    kernel = ["lambertian"]
+
+
+class Borrowing(Material):
+    """A class of its own asking for the Lambertian twin by name gets it."""
+
+    kernel = "lambertian"
+
+    def __init__(self):
+        self.albedo = Lambertian().albedo
+
+
+def test_a_name_without_a_kernel_uses_the_scalar_fallback():
+    assert kernel_class(Unregistered()) is ScalarFallback
+    assert kernel_class(Unhashable()) is ScalarFallback
+    assert kernel_class(Borrowing()) is KERNELS["lambertian"]
 
 
 def test_unknown_classes_use_the_scalar_fallback():
