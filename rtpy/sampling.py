@@ -57,6 +57,20 @@ def uniform_sphere(r1: float, r2: float) -> tuple[float, float, float]:
     return s * math.cos(phi), s * math.sin(phi), z
 
 
+def cone_angle(r1, cone_size, maximum=max):
+    """(cos theta, sin^2 theta) of a direction uniform by solid angle in a cone whose
+    half-angle has 1 - cos = cone_size: cos theta uniform in [1 - cone_size, 1] (pbrt-v4's
+    SampleUniformCone). Floats or numpy arrays (with numpy's maximum)."""
+    cos_t = 1.0 - r1 * cone_size
+    return cos_t, maximum(0.0, 1.0 - cos_t * cos_t)
+
+
+def cone_pdf(cone_size):
+    """The solid-angle density of directions uniform in a cone of 1 - cos = cone_size:
+    1 / (2 pi cone_size). Floats or numpy arrays."""
+    return 1.0 / (2.0 * math.pi * cone_size)
+
+
 def random_unit_vector() -> Vec3:
     """Uniform on the unit sphere (pdf 1 / (4 pi) per steradian)."""
     r = _generator.random

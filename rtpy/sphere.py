@@ -10,7 +10,7 @@ from .hit_info import HitInfo
 from .hittable import Hittable
 from .onb import local_to_world
 from .ray import Ray
-from .sampling import uniform_sphere
+from .sampling import cone_angle, cone_pdf, uniform_sphere
 from .vec3 import Vec3, dot, unit_vector
 
 
@@ -103,15 +103,15 @@ class Sphere(Hittable):
     # Sphere lights seen from outside are sampled uniformly in the cone of
     # directions they subtend (pbrt-v4's Sphere::Sample), which has far less
     # variance than sampling the area; from inside, uniformly by area.
-    def _cone(self, p: Vec3) -> tuple[float, float] | None:
-        """(squared distance from p to the center, 1 - cos_theta_max of the cone the
-        sphere subtends at p), or None when p is inside the sphere."""
-        d2 = (self.center - p).length_squared()
+    def _cone(self, p: Vec3) -> tuple[Vec3, float, float] | None:
+        """(the vector from p to the center, its squared length, 1 - cos_theta_max of
+        the cone the sphere subtends at p), or None when p is inside the sphere."""
+        to_center = self.center - p
+        d2 = to_center.length_squared()
         r2 = self.radius * self.radius
         if d2 <= r2 * 1.0000001:
             return None
-        sin2 = r2 / d2
-        return d2, sin2 / (1.0 + math.sqrt(1.0 - sin2))  # 1 - cos_max without cancellation
+        return to_center, d2, one_minus_cos_max(r2, d2)
 
     def sample_direction(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float] | None:
         if self._cone(p) is None:
@@ -123,41 +123,63 @@ class Sphere(Hittable):
         """As Hittable.sample_hit. From outside, the direction is drawn uniformly in
         the cone the sphere subtends at p, and the distance to the sphere follows from
         the sampled angle, so the ray is not traced."""
-        # Written per component: every light sample of every bounce comes here.
-        c, r = self.center, self.radius
-        ax, ay, az = c.e0 - p.e0, c.e1 - p.e1, c.e2 - p.e2  # from p to the center
-        d2 = ax * ax + ay * ay + az * az
-        rr = r * r
-        if d2 <= rr * 1.0000001:
+        cone = self._cone(p)
+        if cone is None:
             return super().sample_hit(p, r1, r2)  # inside: by area
-        sin2_max = rr / d2
-        one_minus_cos_max = sin2_max / (1.0 + math.sqrt(1.0 - sin2_max))  # no cancellation
-        cos_t = 1.0 - r1 * one_minus_cos_max
-        sin2_t = 1.0 - cos_t * cos_t
-        sin2_t = sin2_t if sin2_t > 0.0 else 0.0  # max(0, .), cheaper than the builtin
-        sin_t = math.sqrt(sin2_t)
-        phi = 2.0 * math.pi * r2
+        to_center, d2, cone_size = cone
         distance = math.sqrt(d2)
-        k = 1.0 / distance
-        axis = (ax * k, ay * k, az * k)  # unit, toward the center
-        direction = local_to_world(axis, sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
-        # The nearer root of t^2 - 2 t D cos_t + D^2 - r^2 = 0 (D = distance), written
-        # without cancellation; inside the cone r^2 - D^2 sin_t^2 >= 0 but for rounding.
-        room = rr - d2 * sin2_t
-        t = (d2 - rr) / (distance * cos_t + math.sqrt(room if room > 0.0 else 0.0))
-        # The point and the outward normal there, as hit_info makes them (seen from
-        # outside, the front face).
+        cos_t, sin2_t = cone_angle(r1, cone_size)  # theta, from the axis to the center
+        phi = 2.0 * math.pi * r2  # around the axis
+        direction = direction_around(to_center, distance, cos_t, math.sqrt(sin2_t), phi)
+        t = nearer_root(d2, self.radius * self.radius, distance, cos_t, sin2_t)
+        normal, point = self.surface_along(p, direction, t)
+        return direction, cone_pdf(cone_size), HitInfo(point, normal, t, True, self.material, self)
+
+    def surface_along(self, p: Vec3, direction: Vec3, t: float) -> tuple[Vec3, Vec3]:
+        """(outward normal, point) where the ray from p along direction meets the
+        sphere at t: the point put back onto the surface, as hit_info puts it."""
+        # Written per component: every light sample of a sphere lamp comes here.
+        c, r = self.center, self.radius
         nx = p.e0 + t * direction.e0 - c.e0
         ny = p.e1 + t * direction.e1 - c.e1
         nz = p.e2 + t * direction.e2 - c.e2
         k = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
-        normal = Vec3(nx * k, ny * k, nz * k)
-        point = Vec3(c.e0 + normal.e0 * r, c.e1 + normal.e1 * r, c.e2 + normal.e2 * r)
-        pdf = 1.0 / (2.0 * math.pi * one_minus_cos_max)
-        return direction, pdf, HitInfo(point, normal, t, True, self.material, self)
+        nx, ny, nz = nx * k, ny * k, nz * k
+        return Vec3(nx, ny, nz), Vec3(c.e0 + nx * r, c.e1 + ny * r, c.e2 + nz * r)
 
     def direction_pdf(self, p: Vec3, hit: HitInfo) -> float:
         cone = self._cone(p)
         if cone is None:
             return super().direction_pdf(p, hit)
-        return 1.0 / (2.0 * math.pi * cone[1])
+        return cone_pdf(cone[2])
+
+
+# --- the cone a sphere subtends ------------------------------------------------------
+# Plain arithmetic on floats or numpy arrays alike (the numpy backend passes its sqrt
+# and maximum): one formula for both backends.
+
+
+def one_minus_cos_max(r2, d2, sqrt=math.sqrt):
+    """1 - cos_theta_max of the cone a sphere of squared radius r2 subtends at squared
+    distance d2 from its center: sin^2 / (1 + cos) with sin^2 = r2 / d2, which does not
+    cancel for small cones as 1 - sqrt(1 - sin^2) would."""
+    sin2 = r2 / d2
+    return sin2 / (1.0 + sqrt(1.0 - sin2))
+
+
+def direction_around(axis: Vec3, length: float, cos_t: float, sin_t: float, phi: float) -> Vec3:
+    """The unit direction at angle theta (cos_t, sin_t) from axis / length (axis a
+    vector of that length) and at azimuth phi around it, in the frame ONB builds."""
+    k = 1.0 / length
+    w = (axis.e0 * k, axis.e1 * k, axis.e2 * k)  # unit: axis / length, as Vec3's / does
+    return local_to_world(w, sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
+
+
+def nearer_root(d2, r2, distance, cos_t, sin2_t, sqrt=math.sqrt, maximum=max):
+    """How far a ray from a point at `distance` from a sphere's center (d2 = distance^2,
+    r2 = radius^2) goes to the sphere, sent at angle theta (cos_t, sin2_t = sin^2) from
+    the direction to the center, inside the cone: the nearer root of
+    t^2 - 2 t D cos_t + D^2 - r^2 = 0, as (D^2 - r^2) / (D cos_t + sqrt(r^2 - D^2 sin^2_t))
+    without cancellation (inside the cone the square root's argument is >= 0 but for
+    rounding)."""
+    return (d2 - r2) / (distance * cos_t + sqrt(maximum(0.0, r2 - d2 * sin2_t)))

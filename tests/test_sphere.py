@@ -7,6 +7,7 @@ import math
 import random
 from decimal import Decimal, getcontext
 
+import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
@@ -15,7 +16,7 @@ from rtpy.hit_info import HitInfo
 from rtpy.interval import Interval
 from rtpy.materials import Lambertian
 from rtpy.ray import Ray
-from rtpy.sphere import Sphere
+from rtpy.sphere import Sphere, nearer_root, one_minus_cos_max
 from rtpy.testing import chi2_sf
 
 from .vectors import V, dot3, norm3, sub3
@@ -470,3 +471,49 @@ def test_sample_point_uniform_on_sphere():
         zsum += nrm.e2
     # Archimedes: z of a uniform point on the sphere is uniform on [-1, 1].
     assert abs(zsum / n) < 4 * math.sqrt(1.0 / 3.0 / n)
+
+
+# --- the cone's formulas, shared with the numpy backend --------------------------------
+
+
+@pytest.mark.parametrize("r_over_d", [0.5, 1e-3, 1e-9, 1e-150])
+def test_one_minus_cos_max_keeps_its_precision_for_tiny_cones(r_over_d):
+    """1 - cos_max against exact decimals; the naive 1 - sqrt(1 - s^2) is 0 below 1e-8."""
+    getcontext().prec = 60
+    s2 = Decimal(r_over_d * r_over_d)
+    exact = s2 / (1 + (1 - s2).sqrt())  # = 1 - sqrt(1 - s^2), in 60 digits
+    got = one_minus_cos_max(r_over_d * r_over_d, 1.0)
+    assert float(abs(Decimal(got) - exact) / exact) < 4e-16
+
+
+@given(
+    st.floats(1.5, 1e6),
+    st.floats(0.0, 1.0, exclude_max=True),
+)
+def test_nearer_root_meets_the_sphere_first(distance, r1):
+    """The point at the root lies on the sphere, and it is the nearer of its two points."""
+    radius = 1.0
+    d2, r2 = distance * distance, radius * radius
+    cos_t = 1.0 - r1 * one_minus_cos_max(r2, d2)
+    sin2_t = max(0.0, 1.0 - cos_t * cos_t)
+    t = nearer_root(d2, r2, distance, cos_t, sin2_t)
+    # The point p + t w, with the center at distance D along the axis: its distance to
+    # the center by the law of cosines.
+    to_center2 = t * t - 2.0 * t * distance * cos_t + d2
+    assert to_center2 == pytest.approx(r2, rel=1e-6, abs=1e-9 * d2)
+    assert t <= distance * cos_t + 1e-9 * distance  # before the chord's midpoint
+
+
+def test_the_cone_formulas_give_the_same_bits_on_arrays():
+    """The numpy backend passes arrays (and np.sqrt, np.maximum): the same numbers."""
+    rng = np.random.default_rng(3)
+    d2 = rng.uniform(1.1, 1e4, 200)
+    r2 = np.ones(200)
+    cos_t = 1.0 - rng.random(200) * one_minus_cos_max(r2, d2, sqrt=np.sqrt)
+    sin2_t = np.maximum(0.0, 1.0 - cos_t * cos_t)
+    dist = np.sqrt(d2)
+    batched = nearer_root(d2, r2, dist, cos_t, sin2_t, sqrt=np.sqrt, maximum=np.maximum)
+    for i in range(200):
+        a, b = float(d2[i]), float(cos_t[i])
+        assert one_minus_cos_max(1.0, a) == one_minus_cos_max(r2, d2, sqrt=np.sqrt)[i]
+        assert nearer_root(a, 1.0, math.sqrt(a), b, float(sin2_t[i])) == batched[i]

@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from ..sampling import cone_angle
 from .onb import local_to_world
 from .vec3 import Columns
 
@@ -109,8 +110,7 @@ def cone_direction(
     from outside): (world direction, cos_t, sin_t^2) at angle cos_t = 1 - r1 omc from
     the unit axis, azimuth 2 pi r2 in the frame ONB(axis); omc is 1 - cos of the
     cone's half-angle, and the density 1 / (2 pi omc)."""
-    cos_t = 1.0 - r1 * omc
-    sin2_t = np.maximum(0.0, 1.0 - cos_t * cos_t)
+    cos_t, sin2_t = cone_angle(r1, omc, maximum=np.maximum)
     sin_t = np.sqrt(sin2_t)
     cos_phi, sin_phi = cos_sin_2pi(r2)
     return local_to_world(axis, sin_t * cos_phi, sin_t * sin_phi, cos_t), cos_t, sin2_t

@@ -13,7 +13,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..sphere import Sphere
+from ..sampling import cone_pdf
+from ..sphere import Sphere, nearer_root, one_minus_cos_max
 from .arrays import at, axpy, dot, put_rows, scale
 from .hittable import INF, PrimitiveSet, area_direction, area_direction_pdf
 from .sampling import cone_direction, uniform_sphere
@@ -39,13 +40,6 @@ def _sphere_roots(h, c_term, a, r, f2, t_min, t_max):
     hi = np.maximum(t0, t1)
     t = np.where(t_min < lo, lo, hi)  # the nearer root past t_min (hi >= lo)
     return np.where((t_min < t) & (t < t_max), t, INF), q
-
-
-def _cone_omc(d2, r2):
-    """1 - cos_max of the cone that a sphere of squared radius r2 subtends at squared
-    distance d2 from its centre (Sphere._cone), written without cancellation."""
-    sin2 = r2 / d2
-    return sin2 / (1.0 + np.sqrt(1.0 - sin2))
 
 
 class SphereSet(PrimitiveSet):
@@ -211,7 +205,7 @@ class SphereSet(PrimitiveSet):
         r2 = at(self.r2, k)
         outside = ~(d2 <= r2 * 1.0000001)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inside: unused
-            return outside, _cone_omc(d2, r2)
+            return outside, one_minus_cos_max(r2, d2, sqrt=np.sqrt)
 
     def sample_direction(self, k, p, r1, r2):
         """Sphere.sample_direction: by solid angle inside the cone seen from outside,
@@ -236,11 +230,11 @@ class SphereSet(PrimitiveSet):
             )
             if every:
                 direction = np.stack(dirs, axis=1)
-                pdf = 1.0 / (2.0 * math.pi * om)
+                pdf = cone_pdf(om)
                 valid[:] = True
                 return direction, pdf, valid
             put_rows(direction, o, np.stack(dirs, axis=1))
-            pdf[o] = 1.0 / (2.0 * math.pi * om)
+            pdf[o] = cone_pdf(om)
             valid[o] = True
         i = np.flatnonzero(~outside)
         if i.size:
@@ -270,14 +264,14 @@ class SphereSet(PrimitiveSet):
         if not (d2 > rr * 1.0000001).all():  # some point inside: the general path
             return super().sample_light(k, p, r1, r2)
         # The cone and a direction in it, as cone() and sample_direction().
-        omc = _cone_omc(d2, rr)
+        omc = one_minus_cos_max(rr, d2, sqrt=np.sqrt)
         dist = np.sqrt(d2)
         inv = 1.0 / dist
         (dx, dy, dz), cos_t, sin2_t = cone_direction((ocx * inv, ocy * inv, ocz * inv), omc, r1, r2)
-        pdf = 1.0 / (2.0 * math.pi * omc)
+        pdf = cone_pdf(omc)
         # The distance to the sphere along the sampled direction (see above); inside
         # the cone, r^2 - D^2 sin^2 >= 0 but for rounding.
-        t = (d2 - rr) / (dist * cos_t + np.sqrt(np.maximum(0.0, rr - d2 * sin2_t)))
+        t = nearer_root(d2, rr, dist, cos_t, sin2_t, sqrt=np.sqrt, maximum=np.maximum)
         valid = np.ones(len(t), dtype=bool)
         # The point and its normal, as geometric().
         qx, qy, qz = px + t * dx, py + t * dy, pz + t * dz
@@ -292,7 +286,7 @@ class SphereSet(PrimitiveSet):
     def direction_pdf(self, k, p, q, n):
         outside, omc = self.cone(k, p)
         with np.errstate(divide="ignore"):
-            cone_pdf = 1.0 / (2.0 * math.pi * omc)
+            pdf = cone_pdf(omc)
         if outside.all():
-            return cone_pdf
-        return np.where(outside, cone_pdf, area_direction_pdf(p, q, n, self.area(k)))
+            return pdf
+        return np.where(outside, pdf, area_direction_pdf(p, q, n, self.area(k)))
