@@ -59,8 +59,17 @@ from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, Vec3, cross, dot, halfvector, reflect
 from .glossy import INV_PI, diffuse_probability, mixture_pdf, reflected_density, weighted_sample
 from .material import Material, as_texture, check_strengths, material_color, material_number
-
-INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
+from .microfacet import (
+    beckmann_a,
+    beckmann_d,
+    beckmann_exponent,
+    beckmann_lambda,
+    beckmann_tan2,
+    cos_sin_of_tan2,
+    ggx_d,
+    ggx_g1,
+    ggx_tan2,
+)
 
 DISTRIBUTIONS = ("ggx", "beckmann")
 # Widths below this are computed as this (a mirror to every practical purpose):
@@ -69,11 +78,16 @@ DISTRIBUTIONS = ("ggx", "beckmann")
 MIN_ALPHA = 1e-4
 
 
+def schlick_weight(cosine, minimum=min, maximum=max):
+    """(1 - cos)^5, cos clamped to [0, 1]: the weight of 1 - F0 in Schlick's Fresnel
+    reflectance (floats, or arrays with numpy's minimum and maximum)."""
+    return (1.0 - minimum(1.0, maximum(0.0, cosine))) ** 5
+
+
 def schlick_fresnel(f0: Color, cosine: float) -> Color:
     """Schlick's Fresnel reflectance F0 + (1 - F0) (1 - cos)^5, per colour channel
     (Schlick 1994, "An Inexpensive BRDF Model for Physically-based Rendering")."""
-    m = (1.0 - min(1.0, max(0.0, cosine))) ** 5
-    return f0 + (WHITE - f0) * m
+    return f0 + (WHITE - f0) * schlick_weight(cosine)
 
 
 def f0_from_ior(ior: float) -> float:
@@ -136,8 +150,7 @@ class CookTorrance(Material):
 
     def D(self, normal: Vec3, h: Vec3) -> float:
         """Microfacet density along the unit half vector h (0 below the surface): the
-        GGX or Beckmann D of the module docstring (Walter et al. 2007, "Microfacet
-        Models for Refraction through Rough Surfaces", section 5)."""
+        GGX or Beckmann D of the module docstring (rtpy/materials/microfacet.py)."""
         cos = dot(normal, h)
         cos2 = cos * cos
         if cos <= 0.0 or cos2 == 0.0:
@@ -145,37 +158,29 @@ class CookTorrance(Material):
         sin2 = cross(normal, h).length_squared()
         a2 = self.alpha * self.alpha
         if self.distribution == "ggx":
-            # alpha^2 / (pi cos^4 (alpha^2 + tan^2)^2), multiplied out by cos^4:
-            k = a2 * cos2 + sin2
-            return a2 / (math.pi * k * k)
-        denominator = a2 * cos2
-        if denominator == 0.0:  # underflow for tiny widths at the horizon: exp(-inf)
+            return ggx_d(a2, cos2, sin2)
+        if a2 * cos2 == 0.0:  # underflow for tiny widths at the horizon: exp(-inf)
             return 0.0
-        exponent = sin2 / denominator  # tan^2 / alpha^2
+        exponent = beckmann_exponent(a2, cos2, sin2)
         if exponent > 700.0:  # exp underflows; the cos^4 below would lose to it anyway
             return 0.0
-        return math.exp(-exponent) / (math.pi * a2 * cos2 * cos2)
+        return beckmann_d(a2, cos2, exponent)
 
     def G1(self, normal: Vec3, v: Vec3) -> float:
         """Smith's masking of the unit direction v (1 at the normal, 0 at grazing), the
-        G1 that matches D (Walter et al. 2007, section 5; the module docstring has
-        both forms)."""
+        G1 that matches D (rtpy/materials/microfacet.py)."""
         cos = dot(normal, v)
         if cos <= 0.0:
             return 0.0
         sin2 = cross(normal, v).length_squared()
         if sin2 == 0.0:
             return 1.0
-        a2 = self.alpha * self.alpha
         if self.distribution == "ggx":
-            # 2 / (1 + sqrt(1 + alpha^2 tan^2)), multiplied through by cos:
-            return 2.0 * cos / (cos + math.sqrt(cos * cos + a2 * sin2))
-        a = cos / (self.alpha * math.sqrt(sin2))  # 1 / (alpha tan(theta))
+            return ggx_g1(self.alpha * self.alpha, cos, sin2)
+        a = beckmann_a(self.alpha, cos, sin2)
         if a == 0.0:
             return 0.0
-        # erf(a) - 1 = -erfc(a), without the cancellation for large a.
-        lam = 0.5 * (INV_SQRT_PI * math.exp(-a * a) / a - math.erfc(a))
-        return 1.0 / (1.0 + max(0.0, lam))
+        return 1.0 / (1.0 + max(0.0, beckmann_lambda(a)))
 
     def F(self, cosine: float) -> Color:
         """Fresnel reflectance of a facet seen at incidence cosine wo . h."""
@@ -192,12 +197,8 @@ class CookTorrance(Material):
         the sampling formulas of Walter et al. 2007, section 5.
         """
         a2 = self.alpha * self.alpha
-        if self.distribution == "ggx":
-            tan2 = a2 * r1 / (1.0 - r1)
-        else:
-            tan2 = -a2 * math.log1p(-r1)
-        cos = 1.0 / math.sqrt(1.0 + tan2)
-        sin = math.sqrt(tan2) * cos
+        tan2 = ggx_tan2(a2, r1) if self.distribution == "ggx" else beckmann_tan2(a2, r1)
+        cos, sin = cos_sin_of_tan2(tan2)
         phi = 2.0 * math.pi * r2
         return Vec3(sin * math.cos(phi), sin * math.sin(phi), cos)
 

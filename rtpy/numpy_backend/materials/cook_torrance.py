@@ -9,7 +9,18 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...materials import CookTorrance
-from ...materials.cook_torrance import INV_SQRT_PI
+from ...materials.cook_torrance import schlick_weight
+from ...materials.microfacet import (
+    beckmann_a,
+    beckmann_d,
+    beckmann_exponent,
+    beckmann_lambda,
+    beckmann_tan2,
+    cos_sin_of_tan2,
+    ggx_d,
+    ggx_g1,
+    ggx_tan2,
+)
 from ..onb import ONB
 from ..sampling import cos_sin_2pi
 from ..vec3 import Columns, cross, dot, halfvector, reflect
@@ -18,14 +29,15 @@ from .material import Bounce, color_param, param
 
 
 def schlick_fresnel(f0: np.ndarray, cosine: np.ndarray) -> np.ndarray:
-    """cook_torrance.schlick_fresnel for colours f0 (n, 3)."""
-    m = ((1.0 - np.minimum(1.0, np.maximum(0.0, cosine))) ** 5)[:, None]
+    """cook_torrance.schlick_fresnel for colours f0 (n, 3) (its F0 + (1 - F0) m on rows
+    of colours, where the scalar model has Color arithmetic)."""
+    m = schlick_weight(cosine, minimum=np.minimum, maximum=np.maximum)[:, None]
     return f0 + (1.0 - f0) * m
 
 
 def erfc(x: np.ndarray) -> np.ndarray:
-    """math.erfc elementwise: numpy has no erfc, and the scalar twin's own function
-    keeps the two backends identical (the callers use it only where it matters)."""
+    """math.erfc elementwise (numpy has no erfc): the scalar model's own function keeps
+    the two backends identical (the callers use it only where it matters)."""
     return np.array([math.erfc(v) for v in x.tolist()], dtype=np.float64)
 
 
@@ -70,9 +82,7 @@ class CookTorranceKernel(GlossyKernel):
 
     def sample_half_vector(self, alpha: np.ndarray, r1: np.ndarray, r2: np.ndarray) -> Columns:
         """CookTorrance.sample_half_vector: local (x, y, z) around the normal (z)."""
-        tan2 = self.tan2_half_vector(alpha, r1)
-        cos = 1.0 / np.sqrt(1.0 + tan2)
-        sin = np.sqrt(tan2) * cos
+        cos, sin = cos_sin_of_tan2(self.tan2_half_vector(alpha, r1), sqrt=np.sqrt)
         cos_phi, sin_phi = cos_sin_2pi(r2)
         return sin * cos_phi, sin * sin_phi, cos
 
@@ -101,29 +111,26 @@ class CookTorranceKernel(GlossyKernel):
 
 class GGXKernel(CookTorranceKernel):
     def distribution(self, a2, cos2, sin2, ok):
-        k = np.where(ok, a2 * cos2 + sin2, 1.0)
-        return np.where(ok, a2 / (math.pi * k * k), 0.0)
+        return np.where(ok, ggx_d(a2, cos2, sin2), 0.0)  # cos2 is 1 where not ok: k > 0
 
     def G1(self, alpha, normal, v):
         cos = dot(normal, v)
         up = cos > 0.0
         c = cross(normal, v)
         sin2 = dot(c, c)
-        cos = np.where(up, cos, 1.0)
-        g = 2.0 * cos / (cos + np.sqrt(cos * cos + alpha * alpha * sin2))
+        g = ggx_g1(alpha * alpha, np.where(up, cos, 1.0), sin2, sqrt=np.sqrt)
         return np.where(up, np.where(sin2 == 0.0, 1.0, g), 0.0)
 
     def tan2_half_vector(self, alpha, r1):
-        return alpha * alpha * r1 / (1.0 - r1)
+        return ggx_tan2(alpha * alpha, r1)
 
 
 class BeckmannKernel(CookTorranceKernel):
     def distribution(self, a2, cos2, sin2, ok):
-        denominator = a2 * cos2
-        ok = ok & (denominator != 0.0)  # underflow for tiny widths at the horizon
-        exponent = sin2 / np.where(ok, denominator, 1.0)  # tan^2 / alpha^2
+        ok = ok & (a2 * cos2 != 0.0)  # underflow for tiny widths at the horizon
+        exponent = beckmann_exponent(a2, np.where(ok, cos2, 1.0), sin2)
         ok &= ~(exponent > 700.0)  # exp underflows
-        d = np.exp(-np.where(ok, exponent, 0.0)) / (math.pi * a2 * cos2 * cos2)
+        d = beckmann_d(a2, cos2, np.where(ok, exponent, 0.0), exp=np.exp)
         return np.where(ok, d, 0.0)
 
     def G1(self, alpha, normal, v):
@@ -132,17 +139,17 @@ class BeckmannKernel(CookTorranceKernel):
         sin2 = dot(c, c)
         g = np.where(cos > 0.0, 1.0, 0.0)  # 1 also where sin2 = 0 and where a >= 6
         slanted = np.flatnonzero((cos > 0.0) & (sin2 != 0.0))
-        a = cos[slanted] / (alpha[slanted] * np.sqrt(sin2[slanted]))  # 1 / (alpha tan)
+        a = beckmann_a(alpha[slanted], cos[slanted], sin2[slanted], sqrt=np.sqrt)
         g[slanted[a == 0.0]] = 0.0
         near = (a != 0.0) & (a < BECKMANN_G1_ONE)
         a = a[near]
         with np.errstate(over="ignore"):  # subnormal a: lam = inf, G1 = 0 (as in Python)
-            lam = 0.5 * (INV_SQRT_PI * np.exp(-a * a) / a - erfc(a))
+            lam = beckmann_lambda(a, exp=np.exp, erfc=erfc)
         g[slanted[near]] = 1.0 / (1.0 + np.maximum(0.0, lam))
         return g
 
     def tan2_half_vector(self, alpha, r1):
-        return -(alpha * alpha) * np.log1p(-r1)
+        return beckmann_tan2(alpha * alpha, r1, log1p=np.log1p)
 
 
 def cook_torrance_kernel(material: CookTorrance) -> type[CookTorranceKernel]:
