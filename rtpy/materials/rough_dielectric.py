@@ -102,10 +102,25 @@ def fresnel_dielectric(cos_i: float, eta: float) -> float:
     light arriving at incidence cosine cos_i (in (0, 1]) from the side of index n_i,
     with eta = n_t / n_i the index beyond the boundary over this side's. 1 under total
     internal reflection (sin(theta_t) = sin(theta_i) / eta >= 1)."""
-    sin2_t = (1.0 - cos_i * cos_i) / (eta * eta)
+    sin2_t = refracted_sin2(cos_i, eta)
     if sin2_t >= 1.0:
         return 1.0
-    cos_t = math.sqrt(1.0 - sin2_t)
+    return fresnel_unpolarised(cos_i, math.sqrt(1.0 - sin2_t), eta)
+
+
+# The formulas below work on floats and on numpy arrays alike: the numpy backend's
+# rough dielectric computes with them.
+
+
+def refracted_sin2(cos_i, eta):
+    """sin^2 of the refracted angle by Snell's law, sin_t = sin_i / eta (>= 1: total
+    internal reflection)."""
+    return (1.0 - cos_i * cos_i) / (eta * eta)
+
+
+def fresnel_unpolarised(cos_i, cos_t, eta):
+    """The mean of the s- and p-polarised Fresnel reflectances of the boundary between
+    the incidence cosine cos_i and the refracted cosine cos_t."""
     r_s = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
     r_p = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
     return 0.5 * (r_s * r_s + r_p * r_p)

@@ -8,7 +8,13 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...materials import RoughDielectric
+from ...materials import rough_dielectric as scalar
 from ...materials.glossy import MAX_PDF
+from ...materials.rough_dielectric import (
+    fresnel_unpolarised,
+    refracted_sin2,
+    refraction_jacobian,
+)
 from ..arrays import compose, select
 from ..hit_info import HitBatch
 from ..onb import ONB
@@ -22,24 +28,16 @@ from .material import Kernel, param
 def fresnel_dielectric(cos_i: np.ndarray, eta: np.ndarray) -> np.ndarray:
     """rough_dielectric.fresnel_dielectric: the exact Fresnel reflectance at incidence
     cosines cos_i in (0, 1], eta = n_t / n_i; 1 under total internal reflection."""
-    sin2_t = (1.0 - cos_i * cos_i) / (eta * eta)
+    sin2_t = refracted_sin2(cos_i, eta)
     tir = sin2_t >= 1.0
     cos_t = np.sqrt(np.where(tir, 0.0, 1.0 - sin2_t))
-    r_s = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
-    r_p = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
-    return np.where(tir, 1.0, 0.5 * (r_s * r_s + r_p * r_p))
+    return np.where(tir, 1.0, fresnel_unpolarised(cos_i, cos_t, eta))
 
 
 def reflection_jacobian(wo_m: np.ndarray) -> np.ndarray:
-    """rough_dielectric.reflection_jacobian: 1 / (4 |wo.m|)."""
+    """rough_dielectric.reflection_jacobian, 1 / (4 |wo.m|), on arrays."""
     with np.errstate(over="ignore"):  # wo.m subnormal: inf, saturated by the pdf
-        return 0.25 / wo_m
-
-
-def refraction_jacobian(wo_m: np.ndarray, wi_m: np.ndarray, eta: np.ndarray) -> np.ndarray:
-    """rough_dielectric.refraction_jacobian: eta^2 |wi.m| / (eta wi.m + wo.m)^2."""
-    denominator = eta * wi_m + wo_m
-    return eta * eta * np.abs(wi_m) / (denominator * denominator)
+        return scalar.reflection_jacobian(wo_m)
 
 
 def where3(mask: np.ndarray, a: Columns, b: Columns) -> Columns:
