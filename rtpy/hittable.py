@@ -98,7 +98,7 @@ class Hittable:
         )
         if cos_light < 1e-12:
             return None
-        return direction, dist2 / (cos_light * self.area())
+        return direction, area_to_solid_angle(dist2, cos_light, self.area())
 
     def sample_hit(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float, HitInfo] | None:
         """Light sampling from p: (the unit direction sample_direction draws, its
@@ -126,7 +126,7 @@ class Hittable:
         cos_light = abs(dx * n.e0 + dy * n.e1 + dz * n.e2) / math.sqrt(dist2)
         if cos_light < 1e-12:
             return 0.0
-        return dist2 / (cos_light * self.area())
+        return area_to_solid_angle(dist2, cos_light, self.area())
 
 
 class FlatShape(Hittable):
@@ -142,3 +142,10 @@ class FlatShape(Hittable):
 
     def area(self) -> float:
         return self._area
+
+
+def area_to_solid_angle(dist2, cos_light, area):
+    """The solid-angle density at a point of a light point drawn uniformly by area:
+    (1 / area) dist^2 / |cos theta_light|, dist2 the squared distance between them and
+    cos_light = |cos theta_light| at the light (floats, or arrays in the numpy backend)."""
+    return dist2 / (cos_light * area)

@@ -74,7 +74,7 @@ class OrenNayar(Material):
         projected = cos_oi - cos_o * cos_i
         if projected <= 0.0:
             return self.A
-        return self.A + self.B * projected / max(cos_i, cos_o, MIN_COS)
+        return rough_factor(self.A, self.B, projected, max(cos_i, cos_o, MIN_COS))
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
         """albedo / pi * factor; black unless wo and wi both lie above the surface."""
@@ -106,3 +106,9 @@ class OrenNayar(Material):
             return None
         factor = self.factor(cos_o, cos_i, -dot(ray_in.direction, wi))
         return ScatterInfo(sample.scattered_ray, sample.attenuation * factor, sample.pdf)
+
+
+def rough_factor(a, b, projected, larger_cosine):
+    """A + B (wo . wi - cos_o cos_i) / max(cos_o, cos_i): Oren-Nayar's factor where the
+    projections' dot product is positive (floats, or arrays in the numpy kernel)."""
+    return a + b * projected / larger_cosine

@@ -43,8 +43,7 @@ def sample_cosine_power(exponent: float, r1: float, r2: float) -> Vec3:
     1994, "Using the Modified Phong Reflectance Model for Physically Based
     Rendering", KU Leuven report CW 197).
     """
-    cos_theta = r1 ** (1.0 / (exponent + 1.0))
-    sin_theta = math.sqrt(max(0.0, 1.0 - cos_theta * cos_theta))
+    cos_theta, sin_theta = cosine_power_angle(exponent, r1)
     phi = 2.0 * math.pi * r2
     return Vec3(sin_theta * math.cos(phi), sin_theta * math.sin(phi), cos_theta)
 
@@ -55,7 +54,23 @@ def cosine_power_pdf(exponent: float, cos_theta: float) -> float:
     Willems 1994)."""
     if cos_theta <= 0.0:
         return 0.0
-    return (exponent + 1.0) * INV_TWO_PI * cos_theta**exponent
+    return cosine_power_density(exponent, cos_theta**exponent)
+
+
+# The two below work on floats and on numpy arrays alike (the numpy backend passes its
+# sqrt and maximum): the numpy kernels compute with them.
+
+
+def cosine_power_angle(exponent, r1, sqrt=math.sqrt, maximum=max):
+    """(cos, sin) of theta drawn with density (n + 1) / (2 pi) cos^n(theta) from a uniform
+    r1: cos(theta) = r1^(1 / (n + 1)), inverting the distribution 1 - cos^(n + 1)."""
+    cos_theta = r1 ** (1.0 / (exponent + 1.0))
+    return cos_theta, sqrt(maximum(0.0, 1.0 - cos_theta * cos_theta))
+
+
+def cosine_power_density(exponent, power):
+    """(n + 1) / (2 pi) cos^n(theta), from power = cos^n(theta)."""
+    return (exponent + 1.0) * INV_TWO_PI * power
 
 
 class Phong(Material):

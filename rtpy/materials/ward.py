@@ -49,6 +49,7 @@ from ..texture import Texture
 from ..vec3 import BLACK, WHITE, Color, Vec3, dot, halfvector, reflect
 from .glossy import INV_PI, diffuse_probability, mixture_pdf, reflected_density, weighted_sample
 from .material import Material, as_texture, check_strengths, material_number
+from .microfacet import cos_sin_of_tan2
 
 # Widths below this are computed as this (a mirror to every practical purpose):
 # the lobe's peak 1 / (4 pi alpha_x alpha_y) and the exponent's 1 / alpha^2 would
@@ -60,6 +61,36 @@ MAX_EXPONENT = 700.0
 # 1 / sqrt(cos cos) finite (at most 1e100) when both directions graze the surface
 # to within 1e-100 radians, and changes nothing anywhere else.
 MIN_COS_PRODUCT = 1e-200
+
+
+# The formulas below work on floats and on numpy arrays alike (the numpy backend
+# passes its exp and log1p): the numpy kernel computes with them.
+
+
+def squared_slopes(hx, hy, ax, ay):
+    """(hx / alpha_x)^2 + (hy / alpha_y)^2 of a half vector's frame coordinates: the
+    slope exponent times hz^2."""
+    sx, sy = hx / ax, hy / ay
+    return sx * sx + sy * sy
+
+
+def half_vector_tan2(r1, cos_phi, sin_phi, ax, ay, log1p=math.log1p):
+    """tan^2(theta_h) = -ln(1 - r1) / (cos^2(phi_h) / alpha_x^2 + sin^2(phi_h) / alpha_y^2)
+    of a half vector drawn at azimuth phi_h (Walter 2005)."""
+    a = cos_phi * cos_phi / (ax * ax) + sin_phi * sin_phi / (ay * ay)
+    return -log1p(-r1) / a
+
+
+def highlight_lobe(exponent, cos_i, cos_o, ax, ay, exp=math.exp, sqrt=math.sqrt, maximum=max):
+    """exp(-slope exponent) / (4 pi alpha_x alpha_y sqrt(cos_i cos_o)), the product of the
+    cosines kept from 0 (MIN_COS_PRODUCT)."""
+    root = sqrt(maximum(cos_i * cos_o, MIN_COS_PRODUCT))
+    return exp(-exponent) / (4.0 * math.pi * ax * ay * root)
+
+
+def half_vector_density(exponent, cos, ax, ay, exp=math.exp):
+    """p_h = exp(-slope exponent) / (pi alpha_x alpha_y cos^3(theta_h))."""
+    return exp(-exponent) / (math.pi * ax * ay * cos**3)
 
 
 class Ward(Material):
@@ -103,9 +134,8 @@ class Ward(Material):
         (hx^2 / alpha_x^2 + hy^2 / alpha_y^2) / hz^2 with (hx, hy, hz) its coordinates in
         the frame: tan(theta_h) cos(phi_h) = hx / hz and tan(theta_h) sin(phi_h) = hy / hz
         are the facet's slopes along x and y. Infinite for h in the tangent plane."""
-        sx, sy = dot(h, frame.u) / self.ax, dot(h, frame.v) / self.ay
+        numerator = squared_slopes(dot(h, frame.u), dot(h, frame.v), self.ax, self.ay)
         hz = dot(h, frame.w)
-        numerator = sx * sx + sy * sy
         if hz * hz == 0.0:
             return math.inf if numerator > 0.0 else 0.0
         return numerator / (hz * hz)
@@ -123,10 +153,7 @@ class Ward(Material):
         angle = 2.0 * math.pi * r2
         phi = math.atan2(ay * math.sin(angle), ax * math.cos(angle))
         cos_phi, sin_phi = math.cos(phi), math.sin(phi)
-        a = cos_phi * cos_phi / (ax * ax) + sin_phi * sin_phi / (ay * ay)
-        tan2 = -math.log1p(-r1) / a
-        cos = 1.0 / math.sqrt(1.0 + tan2)
-        sin = math.sqrt(tan2) * cos
+        cos, sin = cos_sin_of_tan2(half_vector_tan2(r1, cos_phi, sin_phi, ax, ay))
         return Vec3(sin * cos_phi, sin * sin_phi, cos)
 
     def half_vector_pdf(self, frame: ONB, h: Vec3) -> float:
@@ -138,7 +165,7 @@ class Ward(Material):
         exponent = self.slope_exponent(frame, h)
         if exponent > MAX_EXPONENT:  # exp() is 0; and below it tan^2 <= 700, cos^3 > 5e-5
             return 0.0
-        return math.exp(-exponent) / (math.pi * self.ax * self.ay * cos**3)
+        return half_vector_density(exponent, cos, self.ax, self.ay)
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
         """kd * albedo / pi + ks * exp(-slope exponent of h)
@@ -151,8 +178,7 @@ class Ward(Material):
         exponent = self.slope_exponent(hit.frame, wo + wi)  # wo + wi: h before normalising
         f = self.albedo.value(hit) * (self.kd * INV_PI)
         if self.ks > 0.0 and exponent <= MAX_EXPONENT:
-            root = math.sqrt(max(cos_i * cos_o, MIN_COS_PRODUCT))
-            lobe = math.exp(-exponent) / (4.0 * math.pi * self.ax * self.ay * root)
+            lobe = highlight_lobe(exponent, cos_i, cos_o, self.ax, self.ay)
             f = f + WHITE * (self.ks * lobe)
         return f
 

@@ -6,19 +6,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ...materials import Dielectric
+from ...materials import Dielectric, schlick  # the course function, on arrays as it is
 from ..arrays import true
 from ..hit_info import HitBatch
 from ..scatter_info import ScatterBatch, SpecularRays
 from ..vec3 import components, dot, reflect, refract, stack
 from .material import AlbedoKernel, param
-
-
-def schlick(cosine: np.ndarray, ior_ratio: np.ndarray) -> np.ndarray:
-    """rtpy.materials.schlick: Schlick's approximation of the Fresnel reflectance."""
-    r0 = (1.0 - ior_ratio) / (1.0 + ior_ratio)
-    r0 = r0 * r0
-    return r0 + (1.0 - r0) * (1.0 - cosine) ** 5
 
 
 class DielectricKernel(AlbedoKernel):

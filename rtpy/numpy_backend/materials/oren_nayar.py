@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...materials import OrenNayar
-from ...materials.oren_nayar import MIN_COS
+from ...materials.oren_nayar import MIN_COS, rough_factor
 from ..arrays import select
 from ..hit_info import HitBatch
 from ..onb import ONB
@@ -36,7 +36,8 @@ class OrenNayarKernel(AlbedoKernel):
         a, b = self.A[slots], self.B[slots]
         projected = cos_oi - cos_o * cos_i
         rough = (b != 0.0) & (projected > 0.0)
-        return np.where(rough, a + b * projected / np.maximum(np.maximum(cos_i, cos_o), MIN_COS), a)
+        larger = np.maximum(np.maximum(cos_i, cos_o), MIN_COS)
+        return np.where(rough, rough_factor(a, b, projected, larger), a)
 
     def BRDF(self, slots: np.ndarray, hits: HitBatch, wi: np.ndarray) -> np.ndarray:
         """albedo / pi * factor; black unless wo and wi both lie above the surface."""

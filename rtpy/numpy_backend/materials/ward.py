@@ -2,13 +2,19 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
 from ...materials import Ward
-from ...materials.ward import MAX_EXPONENT, MIN_COS_PRODUCT
+from ...materials.microfacet import cos_sin_of_tan2
+from ...materials.ward import (
+    MAX_EXPONENT,
+    half_vector_density,
+    half_vector_tan2,
+    highlight_lobe,
+    squared_slopes,
+)
 from ..onb import ONB
 from ..sampling import cos_sin_2pi
 from ..vec3 import Columns, dot, halfvector, reflect
@@ -31,9 +37,8 @@ class WardKernel(GlossyKernel):
     def slope_exponent(self, ax, ay, frame: ONB, h: Columns) -> np.ndarray:
         """Ward.slope_exponent: (hx^2 / alpha_x^2 + hy^2 / alpha_y^2) / hz^2 with h's
         coordinates in the frame, for h of any length; infinite in the tangent plane."""
-        sx, sy = dot(h, frame.u) / ax, dot(h, frame.v) / ay
+        numerator = squared_slopes(dot(h, frame.u), dot(h, frame.v), ax, ay)
         hz = dot(h, frame.w)
-        numerator = sx * sx + sy * sy
         hz2 = hz * hz
         flat = hz2 == 0.0
         exponent = numerator / np.where(flat, 1.0, hz2)
@@ -44,10 +49,8 @@ class WardKernel(GlossyKernel):
         cos_angle, sin_angle = cos_sin_2pi(r2)
         phi = np.arctan2(ay * sin_angle, ax * cos_angle)
         cos_phi, sin_phi = np.cos(phi), np.sin(phi)
-        a = cos_phi * cos_phi / (ax * ax) + sin_phi * sin_phi / (ay * ay)
-        tan2 = -np.log1p(-r1) / a
-        cos = 1.0 / np.sqrt(1.0 + tan2)
-        sin = np.sqrt(tan2) * cos
+        tan2 = half_vector_tan2(r1, cos_phi, sin_phi, ax, ay, log1p=np.log1p)
+        cos, sin = cos_sin_of_tan2(tan2, sqrt=np.sqrt)
         return sin * cos_phi, sin * sin_phi, cos
 
     def half_vector_pdf(self, ax, ay, frame: ONB, h: Columns) -> np.ndarray:
@@ -56,7 +59,7 @@ class WardKernel(GlossyKernel):
         exponent = self.slope_exponent(ax, ay, frame, h)
         ok = (cos > 0.0) & ~(exponent > MAX_EXPONENT)
         cos = np.where(ok, cos, 1.0)
-        p = np.exp(-np.where(ok, exponent, 0.0)) / (math.pi * ax * ay * cos**3)
+        p = half_vector_density(np.where(ok, exponent, 0.0), cos, ax, ay, exp=np.exp)
         return np.where(ok, p, 0.0)
 
     def highlight(self, b: Bounce) -> np.ndarray:
@@ -67,8 +70,10 @@ class WardKernel(GlossyKernel):
         h = (wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2])  # h before normalising
         exponent = self.slope_exponent(ax, ay, b.frame, h)
         lit = (self.ks[b.slots] > 0.0) & (exponent <= MAX_EXPONENT)
-        root = np.sqrt(np.maximum(b.cos_i * b.cos_o, MIN_COS_PRODUCT))
-        lobe = np.exp(-np.where(lit, exponent, 0.0)) / (4.0 * math.pi * ax * ay * root)
+        exponent = np.where(lit, exponent, 0.0)
+        lobe = highlight_lobe(
+            exponent, b.cos_i, b.cos_o, ax, ay, exp=np.exp, sqrt=np.sqrt, maximum=np.maximum
+        )
         return np.where(lit, self.ks[b.slots] * lobe, 0.0)
 
     def highlight_pdf(self, b: Bounce) -> np.ndarray:
