@@ -98,7 +98,7 @@ class Hittable:
         )
         if cos_light < 1e-12:
             return None
-        return direction, dist2 / (cos_light * self.area())
+        return direction, area_pdf(dist2, cos_light, self.area())
 
     def sample_hit(self, p: Vec3, r1: float, r2: float) -> tuple[Vec3, float, HitInfo] | None:
         """Light sampling from p: (the unit direction sample_direction draws, its
@@ -126,7 +126,14 @@ class Hittable:
         cos_light = abs(dx * n.e0 + dy * n.e1 + dz * n.e2) / math.sqrt(dist2)
         if cos_light < 1e-12:
             return 0.0
-        return dist2 / (cos_light * self.area())
+        return area_pdf(dist2, cos_light, self.area())
+
+
+def area_pdf(dist2, cos_light, area):
+    """The solid-angle density at a point of sampling a surface uniformly by area,
+    toward a point dist2 = distance^2 away whose normal makes |cos| = cos_light with
+    the direction: dist^2 / (cos_light * area). Floats or numpy arrays."""
+    return dist2 / (cos_light * area)
 
 
 class FlatShape(Hittable):

@@ -80,9 +80,17 @@ def random_unit_vector() -> Vec3:
 def random_in_unit_disk() -> Vec3:
     """Uniform in the unit disk of the z = 0 plane."""
     r = _generator.random
-    radius = math.sqrt(r())
-    phi = 2.0 * math.pi * r()
-    return Vec3(radius * math.cos(phi), radius * math.sin(phi), 0.0)
+    r1 = r()
+    return Vec3(*disk_point(r1, r()), 0.0)
+
+
+def disk_point(r1, r2, sqrt=math.sqrt, cos=math.cos, sin=math.sin):
+    """(x, y) uniform in the unit disk from two uniform numbers: radius sqrt(r1),
+    angle 2 pi r2. Floats or numpy arrays (with numpy's sqrt, cos and sin, which call
+    the same C library as math's)."""
+    radius = sqrt(r1)
+    phi = 2.0 * math.pi * r2
+    return radius * cos(phi), radius * sin(phi)
 
 
 def random_cosine_direction() -> Vec3:

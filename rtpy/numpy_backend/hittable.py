@@ -22,7 +22,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..hit_info import HitInfo
-from ..hittable import MIN_LIGHT_DISTANCE2, Hittable
+from ..hittable import MIN_LIGHT_DISTANCE2, Hittable, area_pdf
 from ..ray import Ray
 from ..vec3 import Vec3
 from .arrays import at, axpy, dot, scale
@@ -219,7 +219,7 @@ def area_direction(
         direction = scale(dv, 1.0 / dist)
         cos_light = np.abs(dot(direction, normal))
         valid &= cos_light >= 1e-12
-        pdf = dist2 / (cos_light * area)
+        pdf = area_pdf(dist2, cos_light, area)
     return direction, np.where(valid, pdf, 0.0), valid, dist
 
 
@@ -231,7 +231,7 @@ def area_direction_pdf(p: np.ndarray, q: np.ndarray, n: np.ndarray, area: np.nda
     # Grazing or coincident points divide by ~0 here; np.where below discards them.
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         cos_light = np.abs(dot(dv, n)) / np.sqrt(dist2)
-        pdf = dist2 / (cos_light * area)
+        pdf = area_pdf(dist2, cos_light, area)
     return np.where((dist2 < MIN_LIGHT_DISTANCE2) | ~(cos_light >= 1e-12), 0.0, pdf)
 
 
