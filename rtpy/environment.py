@@ -74,6 +74,7 @@ class SkyBand(Environment):
     def radiance_array(self, d: np.ndarray) -> np.ndarray:
         import numpy as np
 
+        # Twin of radiance kept: einsum's sum of squares is not length()'s order.
         cos_theta = d[:, 1] / np.sqrt(np.einsum("ij,ij->i", d, d))
         inside = (cos_theta >= self._cos_lo) & (cos_theta <= self._cos_hi)
         value = np.array([self.value.e0, self.value.e1, self.value.e2])

@@ -107,7 +107,13 @@ class Triangle(FlatShape):
         return min(1.0, max(0.0, u)), min(1.0, max(0.0, v))
 
     def sample_point(self, r1: float, r2: float) -> tuple[Vec3, Vec3]:
-        # Uniform by area: s = sqrt(r1) warps the unit square onto the triangle.
-        s = math.sqrt(r1)
-        wb, wc = s * (1.0 - r2), s * r2
+        wb, wc = triangle_weights(r1, r2)
         return self.a + self.e1 * wb + self.e2 * wc, self.normal
+
+
+def triangle_weights(r1, r2, sqrt=math.sqrt):
+    """The barycentric weights (of b, of c) of a point uniform by area on a triangle,
+    from two uniform numbers: s = sqrt(r1) warps the unit square onto the triangle.
+    Floats or numpy arrays (with numpy's sqrt)."""
+    s = sqrt(r1)
+    return s * (1.0 - r2), s * r2

@@ -97,6 +97,7 @@ class QuadSet(PlanarSet):
         # np.where(ok, t, inf), which numpy runs several times slower
         return np.fmax(t, _MISS.take(ok.view(np.uint8)))
 
+    # Twin kept: Quad.hit_t is the week-4 exercise; here (a, b) by the A, B products.
     def hit_t(self, o, d, k, t_min, t_max):
         n = self.normal[k]
         A, B = self.A[k], self.B[k]
@@ -109,7 +110,8 @@ class QuadSet(PlanarSet):
         return np.where(ok, t, INF)
 
     def surface_uv(self, k, point):
-        # Quad._coords, then clamped to [0, 1].
+        # Quad._coords, then clamped to [0, 1]. Twin kept: _coords is the week-4
+        # exercise in Vec3 form (cross, dot); here the same products column by column.
         q, w, u, v = self.q[k], self.w[k], self.u[k], self.v[k]
         px, py, pz = point[:, 0] - q[:, 0], point[:, 1] - q[:, 1], point[:, 2] - q[:, 2]
         a = (

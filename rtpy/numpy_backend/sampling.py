@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from ..sampling import cone_angle
+from ..sampling import cone_angle, disk_point
 from .onb import local_to_world
 from .vec3 import Columns
 
@@ -80,6 +80,7 @@ def cos_sin_2pi(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def uniform_sphere(r1: np.ndarray, r2: np.ndarray) -> Columns:
     """rtpy.sampling.uniform_sphere: points uniform on the unit sphere."""
+    # Twin kept: the azimuth comes from cos_sin_2pi, not the C library's cos and sin.
     z = 1.0 - 2.0 * r1
     s = np.sqrt(np.maximum(0.0, 1.0 - z * z))
     cos_phi, sin_phi = cos_sin_2pi(r2)
@@ -89,6 +90,7 @@ def uniform_sphere(r1: np.ndarray, r2: np.ndarray) -> Columns:
 def cosine_direction(r1: np.ndarray, r2: np.ndarray) -> Columns:
     """rtpy.sampling.random_cosine_direction from its two uniform numbers: local
     (x, y, z) in the z-up hemisphere with pdf cos(theta) / pi."""
+    # Twin kept: the azimuth comes from cos_sin_2pi, not the C library's cos and sin.
     cos_phi, sin_phi = cos_sin_2pi(r1)
     s = np.sqrt(r2)
     return s * cos_phi, s * sin_phi, np.sqrt(np.maximum(0.0, 1.0 - r2))
@@ -96,11 +98,8 @@ def cosine_direction(r1: np.ndarray, r2: np.ndarray) -> Columns:
 
 def unit_disk(r1: np.ndarray, r2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """rtpy.sampling.random_in_unit_disk from its two uniform numbers: (x, y) uniform
-    in the unit disk. numpy's cos and sin, like the scalar code's math.cos and
-    math.sin, call the C library, so the points are the scalar ones bit for bit."""
-    radius = np.sqrt(r1)
-    phi = 2.0 * math.pi * r2
-    return radius * np.cos(phi), radius * np.sin(phi)
+    in the unit disk, by rtpy.sampling.disk_point."""
+    return disk_point(r1, r2, sqrt=np.sqrt, cos=np.cos, sin=np.sin)
 
 
 def cone_direction(
@@ -119,6 +118,7 @@ def cone_direction(
 def power_heuristic(pdf_a: np.ndarray, pdf_b: np.ndarray) -> np.ndarray:
     """rtpy.sampling.power_heuristic: Veach's power heuristic (beta = 2), 0 where
     both densities vanish."""
+    # Twin kept: the zero case is the scalar's branch, the rest one line.
     a2 = pdf_a * pdf_a
     total = a2 + pdf_b * pdf_b
     with np.errstate(divide="ignore", invalid="ignore"):

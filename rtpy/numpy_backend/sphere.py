@@ -25,6 +25,7 @@ from .vec3 import rows_of, stack
 SPHERE_CHUNK = 16384
 
 
+# Twin kept: Sphere.hit_t is the week-4 exercise, in Vec3 form with early misses.
 def _sphere_roots(h, c_term, a, r, f2, t_min, t_max):
     """Sphere.hit_t's root step, op for op (see rtpy/sphere.py): the nearer root of
     a t^2 - 2 h t + c_term = 0 inside (t_min, t_max), else INF; and q, which is 0

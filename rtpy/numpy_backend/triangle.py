@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..mesh import Mesh, SmoothTriangle
-from ..triangle import PARALLEL_TOLERANCE, Triangle
+from ..triangle import PARALLEL_TOLERANCE, Triangle, triangle_weights
 from .arrays import at, axpy, dot, scale
 from .bvh import BVH
 from .hittable import INF, PlanarSet, area_direction_pdf
@@ -87,6 +87,8 @@ class TriangleSet(PlanarSet):
     def corners(self):
         return np.stack([self.a, self.a + self.e1, self.a + self.e2], 1)
 
+    # Twin kept: Moller-Trumbore (the week-4 exercise) in Plucker form, whose ray-side
+    # factors are one matrix product for all triangles.
     def _finish(self, det, parallel, u_num, v_num, t_num, t_min, t_max):
         # det = 0 or subnormal (parallel rays) makes u, v, t inf or NaN, and u + v
         # inf - inf; the parallel test below discards those rows.
@@ -123,7 +125,8 @@ class TriangleSet(PlanarSet):
         return self._finish(det, parallel, u_num, v_num, t_num, t_min, t_max)
 
     def surface_uv(self, k, point):
-        # Triangle.surface_uv: Cramer's rule in each triangle's coordinate plane.
+        # Triangle.surface_uv: Cramer's rule in each triangle's coordinate plane. Twin
+        # kept: each row's plane axes are gathered (take_along_axis), not indexed.
         a, e1, e2 = self._edges(k)
         _, axes, det = self._frame(k)
         p = point - a
@@ -139,6 +142,7 @@ class TriangleSet(PlanarSet):
     def shading_normal(self, k, point, geo):
         """SmoothTriangle.shading_normal at the hits `point` on triangles k (geometric
         normals geo): the interpolated vertex normal on geo's side; geo for flat ones."""
+        # Twin kept: the weights of all rows in one einsum, where the scalar adds Vec3s.
         smooth, vertex_normals = self._vertex_normals(k)
         if not smooth.any():
             return geo
@@ -157,8 +161,7 @@ class TriangleSet(PlanarSet):
         return area_direction_pdf(p, q, self._frame(k)[0], self.area(k))
 
     def sample_point(self, k, r1, r2):
-        s = np.sqrt(r1)
-        wb, wc = s * (1.0 - r2), s * r2
+        wb, wc = triangle_weights(r1, r2, sqrt=np.sqrt)
         a, e1, e2 = self._edges(k)
         p = a + wb[:, None] * e1 + wc[:, None] * e2
         return p, self._frame(k)[0]
