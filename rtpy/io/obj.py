@@ -89,7 +89,8 @@ def _index(word: str, count: int, what: str, line: int) -> int:
         raise ObjError(f"expected an integer {what} index, found {word!r}", line) from None
     k = i - 1 if i > 0 else count + i
     if i == 0 or not 0 <= k < count:
-        raise ObjError(f"{what} index {i} is out of range ({count} {what}s defined so far)", line)
+        plural = "vertices" if what == "vertex" else f"{what}s"
+        raise ObjError(f"{what} index {i} is out of range ({count} {plural} defined so far)", line)
     return k
 
 

@@ -123,15 +123,14 @@ def _block(raw: bytes, starts, ends, lines: np.ndarray) -> bytes:
     return text + b"\n"
 
 
-def _shape(block: bytes, classes: bytes) -> tuple[bytes, np.ndarray]:
-    """(shape, cls): the block's bytes classified (cls), then runs of number
-    characters and of blanks each made one "d" or " ", blanks before a newline
-    dropped (shape)."""
+def _shape(block: bytes, classes: bytes) -> bytes:
+    """The block's bytes classified, then runs of number characters and of blanks
+    each made one "d" or " ", blanks before a newline dropped."""
     cls = np.frombuffer(block.translate(classes), dtype=np.uint8)
     keep = np.ones(len(cls), dtype=bool)
     same = cls[1:] == cls[:-1]
     keep[1:] = ~(same & ((cls[1:] == ord("d")) | (cls[1:] == 32)))
-    return cls.compress(keep).tobytes().replace(b" \n", b"\n"), cls
+    return cls.compress(keep).tobytes().replace(b" \n", b"\n")
 
 
 def _vectors(raw, starts, ends, lines, shape: bytes) -> np.ndarray | None:
@@ -139,7 +138,7 @@ def _vectors(raw, starts, ends, lines, shape: bytes) -> np.ndarray | None:
     block = _block(raw, starts, ends, lines)
     if not block:
         return np.zeros((0, 3))
-    found, _ = _shape(block, FLOAT_CLASSES)
+    found = _shape(block, FLOAT_CLASSES)
     if found != shape * len(lines):
         return None
     numbers = _numbers(block, np.float64)
@@ -153,7 +152,7 @@ def _texcoords(raw, starts, ends, lines) -> bool:
     block = _block(raw, starts, ends, lines)
     if not block:
         return True
-    found, _ = _shape(block, FLOAT_CLASSES)
+    found = _shape(block, FLOAT_CLASSES)
     for shape in (b"vt d d d\n", b"vt d d\n", b"vt d\n"):
         found = found.replace(shape, b"")
     numbers = _numbers(block, np.float64)
@@ -173,30 +172,6 @@ def _numbers(block: bytes, dtype) -> np.ndarray | None:
             return None
 
 
-def _indices(block: bytes, cls: np.ndarray) -> np.ndarray | None:
-    """The integers of an `f` block (cls: its bytes classified by INT_CLASSES), in
-    order. Without signs, digit by digit in numpy; else by _numbers. Too large ones
-    come out saturated, so out of range where they are checked."""
-    if b"-" in block or b"+" in block:
-        return _numbers(block, np.int64)
-    digit = np.concatenate([[False], cls == ord("d"), [False]])
-    edge = np.flatnonzero(digit[1:] != digit[:-1])
-    start, length = edge[0::2], edge[1::2] - edge[0::2]
-    if length.size and length.max() > 18:
-        return None
-    values = np.zeros(len(start), dtype=np.int64)
-    buf = np.frombuffer(block, dtype=np.uint8)
-    for n in np.unique(length).tolist():  # the numbers of n digits, together
-        which = np.flatnonzero(length == n)
-        at = start.take(which)
-        value = np.zeros(len(at), dtype=np.int64)
-        for j in range(n):
-            value *= 10
-            value += buf.take(at + j) - 48
-        values[which] = value
-    return values
-
-
 def _faces(raw, starts, ends, lines) -> np.ndarray | None:
     """The (T, 3, 2) triangles of the `f` lines (fanned as obj.py fans them), their
     indices resolved against the elements defined above each line; None where a face
@@ -205,7 +180,7 @@ def _faces(raw, starts, ends, lines) -> np.ndarray | None:
     if f_lines.size == 0:
         return np.zeros((0, 3, 2), dtype=np.int64)
     block = _block(raw, starts, ends, f_lines)
-    found, cls = _shape(block, INT_CLASSES)
+    found = _shape(block, INT_CLASSES)
     form = next((f for f in FORMS if found.startswith(b"f" + f + b" ")), None)
     form = form or next((f for f in FORMS if found.startswith(b"f" + f + b"\n")), None)
     if form is None:
@@ -222,7 +197,8 @@ def _faces(raw, starts, ends, lines) -> np.ndarray | None:
     corners = newline - line_start - 1
     if (corners < 3).any():
         return None
-    numbers = _indices(block, cls)
+    # Integers too large for int64 come out saturated: out of range where checked.
+    numbers = _numbers(block, np.int64)
     if numbers is None or len(numbers) != per_corner * int(corners.sum()):
         return None
     numbers = numbers.reshape(-1, per_corner)

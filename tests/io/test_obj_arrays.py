@@ -171,6 +171,21 @@ def test_a_large_file_is_read_here_with_the_same_floats(tmp_path):
     assert fast is not None and same(fast, parse_obj(text))
 
 
+@pytest.mark.parametrize(
+    "index", ["3", "0003", "18446744073709551619", "9223372036854775810", "-18446744073709551617"]
+)
+def test_indices_of_any_length_get_parse_objs_answer(index):
+    """An index beyond int64 is out of range (parse_obj's error), never wrapped round to
+    a vertex that exists."""
+    text = TRIANGLE + f"f 1 2 {index}\n"
+    assert disagreement(text) is None
+    fast = parse_obj_bytes(text.encode())
+    if int(index) != 3:
+        assert fast is None  # left to parse_obj, which names the line
+        with pytest.raises(ObjError, match="out of range .3 vertices defined so far"):
+            parse_obj(text)
+
+
 # --- the checks can fail -------------------------------------------------------------
 
 
