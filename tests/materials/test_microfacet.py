@@ -9,17 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from rtpy.materials.microfacet import (
-    beckmann_a,
-    beckmann_d,
-    beckmann_exponent,
-    beckmann_lambda,
-    beckmann_tan2,
-    cos_sin_of_tan2,
-    ggx_d,
-    ggx_g1,
-    ggx_tan2,
-)
+from rtpy.materials import microfacet as mf
 
 ALPHAS = (0.05, 0.3, 1.0)
 
@@ -43,8 +33,8 @@ def test_ggx_d_is_the_textbook_form_and_normalised(alpha):
     for theta in (0.0, 0.3, 1.2):
         c, s = math.cos(theta), math.sin(theta)
         textbook = a2 / (math.pi * c**4 * (a2 + math.tan(theta) ** 2) ** 2)
-        assert ggx_d(a2, c * c, s * s) == pytest.approx(textbook, rel=1e-12)
-    total = projected_integral(lambda t: ggx_d(a2, np.cos(t) ** 2, np.sin(t) ** 2))
+        assert mf.ggx_d(a2, c * c, s * s) == pytest.approx(textbook, rel=1e-12)
+    total = projected_integral(lambda t: mf.ggx_d(a2, np.cos(t) ** 2, np.sin(t) ** 2))
     assert total == pytest.approx(1.0, rel=1e-4)
 
 
@@ -53,7 +43,7 @@ def test_beckmann_d_is_the_textbook_form_and_normalised(alpha):
     a2 = alpha * alpha
 
     def d(cos2, sin2, exp=math.exp):
-        return beckmann_d(a2, cos2, beckmann_exponent(a2, cos2, sin2), exp=exp)
+        return mf.beckmann_d(a2, cos2, mf.beckmann_exponent(a2, cos2, sin2), exp=exp)
 
     for theta in (0.0, 0.3, 1.2):
         c, s = math.cos(theta), math.sin(theta)
@@ -68,15 +58,15 @@ def test_the_g1_terms_are_the_textbook_forms(alpha):
     for theta in (0.1, 0.7, 1.5):
         c, s, tan = math.cos(theta), math.sin(theta), math.tan(theta)
         textbook_ggx = 2.0 / (1.0 + math.sqrt(1.0 + alpha * alpha * tan * tan))
-        assert ggx_g1(alpha * alpha, c, s * s) == pytest.approx(textbook_ggx, rel=1e-12)
-        a = beckmann_a(alpha, c, s * s)
+        assert mf.ggx_g1(alpha * alpha, c, s * s) == pytest.approx(textbook_ggx, rel=1e-12)
+        a = mf.beckmann_a(alpha, c, s * s)
         assert a == pytest.approx(1.0 / (alpha * tan), rel=1e-12)
         textbook_lambda = (math.erf(a) - 1.0) / 2.0 + math.exp(-a * a) / (
             2.0 * a * math.sqrt(math.pi)
         )
-        assert beckmann_lambda(a) == pytest.approx(textbook_lambda, rel=1e-9, abs=1e-15)
-    assert ggx_g1(alpha * alpha, 1.0, 0.0) == 1.0  # looking straight down
-    assert ggx_g1(alpha * alpha, 1e-12, 1.0) == pytest.approx(2e-12 / alpha, rel=1e-9)  # grazing
+        assert mf.beckmann_lambda(a) == pytest.approx(textbook_lambda, rel=1e-9, abs=1e-15)
+    assert mf.ggx_g1(alpha * alpha, 1.0, 0.0) == 1.0  # looking straight down
+    assert mf.ggx_g1(alpha * alpha, 1e-12, 1.0) == pytest.approx(2e-12 / alpha, rel=1e-9)  # grazing
 
 
 def test_beckmann_lambda_keeps_its_precision_where_erf_cancels():
@@ -85,22 +75,22 @@ def test_beckmann_lambda_keeps_its_precision_where_erf_cancels():
     # The asymptotic series of erfc: Lambda ~ exp(-a^2) / (4 a^3 sqrt(pi)) (1 - 3 / (2 a^2) + ...)
     leading = math.exp(-a * a) / (4.0 * a**3 * math.sqrt(math.pi))
     series = leading * (1.0 - 3.0 / (2.0 * a * a) + 15.0 / (4.0 * a**4) - 105.0 / (8.0 * a**6))
-    assert beckmann_lambda(a) == pytest.approx(series, rel=2e-3)
+    assert mf.beckmann_lambda(a) == pytest.approx(series, rel=2e-3)
 
 
 @pytest.mark.parametrize("r1", [0.0, 0.1, 0.5, 0.99])
 def test_the_samplers_invert_the_cdfs_of_d_cos(r1):
     """P(tan^2 <= x) is x / (alpha^2 + x) for GGX and 1 - exp(-x / alpha^2) for Beckmann."""
     a2 = 0.09
-    x = ggx_tan2(a2, r1)
+    x = mf.ggx_tan2(a2, r1)
     assert x / (a2 + x) == pytest.approx(r1, abs=1e-15)
-    x = beckmann_tan2(a2, r1)
+    x = mf.beckmann_tan2(a2, r1)
     assert -math.expm1(-x / a2) == pytest.approx(r1, abs=1e-15)
 
 
 def test_cos_sin_of_tan2():
     for tan2 in (0.0, 1e-10, 1.0, 1e8):
-        c, s = cos_sin_of_tan2(tan2)
+        c, s = mf.cos_sin_of_tan2(tan2)
         assert c * c + s * s == pytest.approx(1.0, rel=1e-15)
         assert s == pytest.approx(math.sqrt(tan2) * c, rel=1e-15)
 
@@ -113,19 +103,19 @@ def test_arrays_give_the_numbers_floats_give():
     sin2 = 1.0 - cos * cos
     r1 = rng.random(100)
     batched = (
-        ggx_d(a2, cos * cos, sin2),
-        ggx_g1(a2, cos, sin2, sqrt=np.sqrt),
-        beckmann_a(np.sqrt(a2), cos, sin2, sqrt=np.sqrt),
-        ggx_tan2(a2, r1),
-        cos_sin_of_tan2(ggx_tan2(a2, r1), sqrt=np.sqrt)[1],
+        mf.ggx_d(a2, cos * cos, sin2),
+        mf.ggx_g1(a2, cos, sin2, sqrt=np.sqrt),
+        mf.beckmann_a(np.sqrt(a2), cos, sin2, sqrt=np.sqrt),
+        mf.ggx_tan2(a2, r1),
+        mf.cos_sin_of_tan2(mf.ggx_tan2(a2, r1), sqrt=np.sqrt)[1],
     )
     for i in range(100):
         a, c, s, r = float(a2[i]), float(cos[i]), float(sin2[i]), float(r1[i])
         one = (
-            ggx_d(a, c * c, s),
-            ggx_g1(a, c, s),
-            beckmann_a(math.sqrt(a), c, s),
-            ggx_tan2(a, r),
-            cos_sin_of_tan2(ggx_tan2(a, r))[1],
+            mf.ggx_d(a, c * c, s),
+            mf.ggx_g1(a, c, s),
+            mf.beckmann_a(math.sqrt(a), c, s),
+            mf.ggx_tan2(a, r),
+            mf.cos_sin_of_tan2(mf.ggx_tan2(a, r))[1],
         )
         assert one == tuple(float(b[i]) for b in batched)

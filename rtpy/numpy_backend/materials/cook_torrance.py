@@ -8,19 +8,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ...materials import CookTorrance
+from ...materials import CookTorrance, microfacet
 from ...materials.cook_torrance import schlick_weight
-from ...materials.microfacet import (
-    beckmann_a,
-    beckmann_d,
-    beckmann_exponent,
-    beckmann_lambda,
-    beckmann_tan2,
-    cos_sin_of_tan2,
-    ggx_d,
-    ggx_g1,
-    ggx_tan2,
-)
 from ..onb import ONB
 from ..sampling import cos_sin_2pi
 from ..vec3 import Columns, cross, dot, halfvector, reflect
@@ -82,7 +71,7 @@ class CookTorranceKernel(GlossyKernel):
 
     def sample_half_vector(self, alpha: np.ndarray, r1: np.ndarray, r2: np.ndarray) -> Columns:
         """CookTorrance.sample_half_vector: local (x, y, z) around the normal (z)."""
-        cos, sin = cos_sin_of_tan2(self.tan2_half_vector(alpha, r1), sqrt=np.sqrt)
+        cos, sin = microfacet.cos_sin_of_tan2(self.tan2_half_vector(alpha, r1), sqrt=np.sqrt)
         cos_phi, sin_phi = cos_sin_2pi(r2)
         return sin * cos_phi, sin * sin_phi, cos
 
@@ -111,26 +100,26 @@ class CookTorranceKernel(GlossyKernel):
 
 class GGXKernel(CookTorranceKernel):
     def distribution(self, a2, cos2, sin2, ok):
-        return np.where(ok, ggx_d(a2, cos2, sin2), 0.0)  # cos2 is 1 where not ok: k > 0
+        return np.where(ok, microfacet.ggx_d(a2, cos2, sin2), 0.0)  # cos2 is 1 where not ok: k > 0
 
     def G1(self, alpha, normal, v):
         cos = dot(normal, v)
         up = cos > 0.0
         c = cross(normal, v)
         sin2 = dot(c, c)
-        g = ggx_g1(alpha * alpha, np.where(up, cos, 1.0), sin2, sqrt=np.sqrt)
+        g = microfacet.ggx_g1(alpha * alpha, np.where(up, cos, 1.0), sin2, sqrt=np.sqrt)
         return np.where(up, np.where(sin2 == 0.0, 1.0, g), 0.0)
 
     def tan2_half_vector(self, alpha, r1):
-        return ggx_tan2(alpha * alpha, r1)
+        return microfacet.ggx_tan2(alpha * alpha, r1)
 
 
 class BeckmannKernel(CookTorranceKernel):
     def distribution(self, a2, cos2, sin2, ok):
         ok = ok & (a2 * cos2 != 0.0)  # underflow for tiny widths at the horizon
-        exponent = beckmann_exponent(a2, np.where(ok, cos2, 1.0), sin2)
+        exponent = microfacet.beckmann_exponent(a2, np.where(ok, cos2, 1.0), sin2)
         ok &= ~(exponent > 700.0)  # exp underflows
-        d = beckmann_d(a2, cos2, np.where(ok, exponent, 0.0), exp=np.exp)
+        d = microfacet.beckmann_d(a2, cos2, np.where(ok, exponent, 0.0), exp=np.exp)
         return np.where(ok, d, 0.0)
 
     def G1(self, alpha, normal, v):
@@ -139,17 +128,17 @@ class BeckmannKernel(CookTorranceKernel):
         sin2 = dot(c, c)
         g = np.where(cos > 0.0, 1.0, 0.0)  # 1 also where sin2 = 0 and where a >= 6
         slanted = np.flatnonzero((cos > 0.0) & (sin2 != 0.0))
-        a = beckmann_a(alpha[slanted], cos[slanted], sin2[slanted], sqrt=np.sqrt)
+        a = microfacet.beckmann_a(alpha[slanted], cos[slanted], sin2[slanted], sqrt=np.sqrt)
         g[slanted[a == 0.0]] = 0.0
         near = (a != 0.0) & (a < BECKMANN_G1_ONE)
         a = a[near]
         with np.errstate(over="ignore"):  # subnormal a: lam = inf, G1 = 0 (as in Python)
-            lam = beckmann_lambda(a, exp=np.exp, erfc=erfc)
+            lam = microfacet.beckmann_lambda(a, exp=np.exp, erfc=erfc)
         g[slanted[near]] = 1.0 / (1.0 + np.maximum(0.0, lam))
         return g
 
     def tan2_half_vector(self, alpha, r1):
-        return beckmann_tan2(alpha * alpha, r1, log1p=np.log1p)
+        return microfacet.beckmann_tan2(alpha * alpha, r1, log1p=np.log1p)
 
 
 def cook_torrance_kernel(material: CookTorrance) -> type[CookTorranceKernel]:
