@@ -152,6 +152,19 @@ def test_the_usual_shapes_are_read_here(text):
     assert fast is not None and same(fast, parse_obj(text))
 
 
+@settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow])
+@given(obj_texts(), st.sampled_from([1, 7, 64]))
+def test_the_text_classified_in_pieces_gives_the_same_answer(text, chunk):
+    """Large blocks are classified a CHUNK of lines at a time: the pieces' shapes must
+    join into the whole block's."""
+    whole = parse_obj_bytes(text.encode("utf-8"))
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(obj_arrays, "CHUNK", chunk)
+        pieces = parse_obj_bytes(text.encode("utf-8"))
+    assert (whole is None) == (pieces is None)
+    assert whole is None or same(whole, pieces)
+
+
 def test_read_obj_gives_parse_objs_errors_with_their_lines(tmp_path):
     path = tmp_path / "bad.obj"
     text = "v 0 0 0\nv 1 0 0\nv 0 1 0\n# fine so far\nf 1 2 4\n"
