@@ -69,7 +69,7 @@ def build_tree(lo: np.ndarray, hi: np.ndarray, leaf_size: int | None = None) -> 
     # Keys in the final order: the cluster's rank above its code, so sorted throughout.
     rank = np.repeat(np.arange(len(c_perm), dtype=np.int64), size)
     keys = (rank << 30) | codes.take(positions)
-    sorted_lo, sorted_hi = lo.take(order, axis=0), hi.take(order, axis=0)
+    sorted_lo, sorted_hi = sorted_lo.take(positions, axis=0), sorted_hi.take(positions, axis=0)
     nodes.to_primitives(offset)
     _bottom_levels(nodes, keys, leaf_size)
     return nodes.tree(sorted_lo, sorted_hi, order)

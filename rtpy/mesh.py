@@ -260,13 +260,18 @@ class Mesh(Hittable):
         ROUNDING_MARGIN of the mesh's magnitude as the BVH grows a scene's boxes."""
         import numpy as np
 
-        corners = [self.vertices.take(self.faces[:, i], axis=0) for i in range(3)]
-        lo = np.minimum(np.minimum(corners[0], corners[1]), corners[2])
-        hi = np.maximum(np.maximum(corners[0], corners[1]), corners[2])
-        magnitude = np.maximum(np.abs(lo).max(axis=1), np.abs(hi).max(axis=1))
-        pad = np.maximum(BOX_PADDING * magnitude, np.spacing(magnitude))[:, None]
-        margin = ROUNDING_MARGIN * float(magnitude.max()) + pad
-        return lo - margin, hi + margin
+        a, b, c = (self.vertices.take(self.faces[:, i], axis=0) for i in range(3))
+        lo = np.minimum(a, b)
+        np.minimum(lo, c, out=lo)
+        hi = np.maximum(a, b, out=a)
+        np.maximum(hi, c, out=hi)
+        size = np.maximum(np.abs(lo), np.abs(hi), out=b)
+        magnitude = np.maximum(np.maximum(size[:, 0], size[:, 1]), size[:, 2])
+        pad = np.maximum(BOX_PADDING * magnitude, np.spacing(magnitude))
+        margin = (ROUNDING_MARGIN * float(magnitude.max()) + pad)[:, None]
+        lo -= margin
+        hi += margin
+        return lo, hi
 
     # --- Hittable -----------------------------------------------------------------
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:

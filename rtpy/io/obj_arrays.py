@@ -67,7 +67,9 @@ def parse_obj_bytes(raw: bytes) -> ObjMesh | None:
     if not raw:
         return ObjMesh(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3, 2), dtype=np.int64))
     buf = np.frombuffer(raw, dtype=np.uint8)
-    newline = np.flatnonzero(buf == 10)
+    newline = np.concatenate(  # by pieces, as _shape works
+        [np.flatnonzero(buf[i : i + CHUNK] == 10) + i for i in range(0, len(buf), CHUNK)]
+    )
     starts = np.concatenate([[0], newline + 1])
     ends = np.concatenate([newline, [len(raw)]])
     kind = _line_kinds(raw, buf, starts, ends)
@@ -210,11 +212,15 @@ def _faces(raw, starts, ends, lines) -> np.ndarray | None:
     if numbers is None or len(numbers) != per_corner * int(corners.sum()):
         return None
     numbers = numbers.reshape(-1, per_corner)
-    line_of_corner = np.repeat(f_lines, corners)
 
     def resolve(column, defined_lines):  # 0-based indices, or None if one is out of range
         i = numbers[:, column]
-        count = np.searchsorted(defined_lines, line_of_corner)  # defined above the face
+        if defined_lines.size == 0 or defined_lines[-1] < f_lines[0]:
+            count = defined_lines.size  # all defined above the first face: one count
+        else:
+            count = np.repeat(np.searchsorted(defined_lines, f_lines), corners)
+        if i.min() > 0:  # no relative indices
+            return None if (i > count).any() else i - 1
         k = np.where(i > 0, i - 1, count + i)
         return None if ((i == 0) | (k < 0) | (k >= count)).any() else k
 
@@ -226,6 +232,8 @@ def _faces(raw, starts, ends, lines) -> np.ndarray | None:
         n = resolve(vn_col, lines[VN])
         if n is None:
             return None
+    if (corners == 3).all():
+        return np.stack([p.reshape(-1, 3), n.reshape(-1, 3)], axis=2)
     # Fan each face of c corners from its first: (0, j, j + 1) for j = 1 .. c - 2.
     first = np.concatenate([[0], np.cumsum(corners)[:-1]])
     tris = corners - 2
