@@ -179,6 +179,8 @@ def _top_levels(nodes: _Nodes, c_lo, c_hi, c_count, leaf_size: int) -> np.ndarra
     m = len(c_lo)
     perm = np.arange(m, dtype=np.int64)
     centroid = 0.5 * (c_lo + c_hi)
+    # Coordinates in rows: ufunc.at is fast on one-dimensional arrays only.
+    c_lo_t, c_hi_t = np.ascontiguousarray(c_lo.T), np.ascontiguousarray(c_hi.T)
     ids = np.zeros(1, dtype=np.int64)
     start, end = np.zeros(1, dtype=np.int64), np.full(1, m, dtype=np.int64)
     while ids.size:
@@ -200,7 +202,7 @@ def _top_levels(nodes: _Nodes, c_lo, c_hi, c_count, leaf_size: int) -> np.ndarra
         nmax = np.maximum.reduceat(cc, first, axis=0)
         ext = nmax - nmin
         weight = c_count.take(member).astype(np.float64)
-        m_lo, m_hi = c_lo.take(member, axis=0), c_hi.take(member, axis=0)
+        m_lo, m_hi = c_lo_t.take(member, axis=1), c_hi_t.take(member, axis=1)
         cost = np.full((s, 3, BINS - 1), np.inf)
         bins = np.empty((3, len(member)), dtype=np.int64)
         for axis in range(3):
@@ -209,12 +211,13 @@ def _top_levels(nodes: _Nodes, c_lo, c_hi, c_count, leaf_size: int) -> np.ndarra
             np.clip(b, 0, BINS - 1, out=b)
             bins[axis] = b
             key = node * BINS + b
-            b_lo = np.full((s * BINS, 3), np.inf)
-            b_hi = np.full((s * BINS, 3), -np.inf)
-            np.minimum.at(b_lo, key, m_lo)
-            np.maximum.at(b_hi, key, m_hi)
+            b_lo = np.full((3, s * BINS), np.inf)
+            b_hi = np.full((3, s * BINS), -np.inf)
+            for i in range(3):
+                np.minimum.at(b_lo[i], key, m_lo[i])
+                np.maximum.at(b_hi[i], key, m_hi[i])
             n = np.bincount(key, weights=weight, minlength=s * BINS).reshape(s, BINS)
-            b_lo, b_hi = b_lo.reshape(s, BINS, 3), b_hi.reshape(s, BINS, 3)
+            b_lo, b_hi = b_lo.T.reshape(s, BINS, 3), b_hi.T.reshape(s, BINS, 3)
             n_left = np.cumsum(n, axis=1)[:, :-1]
             left = _area(np.minimum.accumulate(b_lo, axis=1), np.maximum.accumulate(b_hi, axis=1))
             r_lo = np.minimum.accumulate(b_lo[:, ::-1], axis=1)[:, ::-1]
