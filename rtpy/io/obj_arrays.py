@@ -122,8 +122,10 @@ def _block(raw: bytes, starts, ends, lines: np.ndarray) -> bytes:
     first = lines[np.concatenate([[0], breaks])]
     last = lines[np.concatenate([breaks - 1, [lines.size - 1]])]
     a, b = starts[first].tolist(), ends[last].tolist()
-    text = b"\n".join(raw[i:j] for i, j in zip(a, b, strict=True))
-    return text + b"\n"
+    # Each run with the newline after it (one slice, not copied again, for one run);
+    # the file's last line may have none.
+    text = b"".join(raw[i : j + 1] for i, j in zip(a, b, strict=True))
+    return text if text.endswith(b"\n") else text + b"\n"
 
 
 def _shape(block: bytes, classes: bytes) -> bytes:
