@@ -70,6 +70,7 @@ _LAZY = {
     "RenderedImage": ".rendered_image",
     "Renderer": ".renderer",
     "mesh_from_obj": ".io.obj",
+    "mesh_from_ply": ".io.ply",
 }
 
 
@@ -119,6 +120,7 @@ __all__ = [
     "Mesh",
     "Transform",
     "mesh_from_obj",
+    "mesh_from_ply",
     "PointLight",
     # materials and textures
     "Material",

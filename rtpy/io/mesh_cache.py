@@ -26,6 +26,7 @@ import numpy as np
 from ..bvh import Tree
 from ..mesh import Mesh, Transform
 from .obj import mesh_from_obj
+from .ply import mesh_from_ply
 
 FORMAT = 1
 MIN_FACES = 50_000
@@ -45,16 +46,18 @@ def cache_folder() -> Path | None:
 
 
 def load_mesh(path: Path, material, transform: Transform) -> tuple[Mesh, int]:
-    """(the mesh of the OBJ file at path, the number of faces the file has): from the
-    cache when it has it, else read (rtpy.io.obj.mesh_from_obj, its errors), built, and
-    kept when it is large."""
+    """(the mesh of the OBJ or PLY file at path, the number of faces the file has):
+    from the cache when it has it, else read (rtpy.io.obj.mesh_from_obj, or
+    rtpy.io.ply.mesh_from_ply for a name ending in .ply, with their errors), built,
+    and kept when it is large."""
     folder = cache_folder()
     entry = None if folder is None else folder / _key(path, transform)
     if entry is not None and entry.is_dir():
         found = _read(entry, material)
         if found is not None:
             return found
-    mesh = mesh_from_obj(path, material, transform)
+    read = mesh_from_ply if path.suffix.lower() == ".ply" else mesh_from_obj
+    mesh = read(path, material, transform)
     faces = len(mesh) + mesh.skipped  # the file's, the degenerate ones too
     if entry is not None and len(mesh) >= MIN_FACES:
         _write(entry, mesh, faces)

@@ -153,7 +153,7 @@ def _vectors(raw, starts, ends, lines, shape: bytes) -> np.ndarray | None:
     found = _shape(block, FLOAT_CLASSES)
     if found != shape * len(lines):
         return None
-    numbers = _numbers(block, np.float64)
+    numbers = read_numbers(block, np.float64)
     if numbers is None or len(numbers) != 3 * len(lines) or not np.isfinite(numbers).all():
         return None
     return numbers.reshape(-1, 3)
@@ -167,11 +167,11 @@ def _texcoords(raw, starts, ends, lines) -> bool:
     found = _shape(block, FLOAT_CLASSES)
     for shape in (b"vt d d d\n", b"vt d d\n", b"vt d\n"):
         found = found.replace(shape, b"")
-    numbers = _numbers(block, np.float64)
+    numbers = read_numbers(block, np.float64)
     return found == b"" and numbers is not None and bool(np.isfinite(numbers).all())
 
 
-def _numbers(block: bytes, dtype) -> np.ndarray | None:
+def read_numbers(block: bytes, dtype) -> np.ndarray | None:
     """Every number of the block, its keywords and slashes read as blanks, parsed by
     numpy as float() and int() parse them (the shape checks allow only the characters
     of numbers); None if numpy cannot read one."""
@@ -210,7 +210,7 @@ def _faces(raw, starts, ends, lines) -> np.ndarray | None:
     if (corners < 3).any():
         return None
     # Integers too large for int64 come out saturated: out of range where checked.
-    numbers = _numbers(block, np.int64)
+    numbers = read_numbers(block, np.int64)
     if numbers is None or len(numbers) != per_corner * int(corners.sum()):
         return None
     numbers = numbers.reshape(-1, per_corner)

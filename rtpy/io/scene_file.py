@@ -65,6 +65,7 @@ from ..vec3 import Color, Vec3
 from .material_params import Param, material_parameters
 from .mesh_cache import load_mesh
 from .obj import ObjError
+from .ply import PlyError
 from .scene_tables import SceneError, SceneWarning, TableReader
 from .toml_lines import TomlLines, Where, quote_key
 
@@ -342,9 +343,9 @@ class _Loader(TableReader):
         )
 
     def mesh(self, w: Where, t: dict) -> list:
-        """The triangles of a [[objects]] table of type "mesh" (an OBJ file)."""
+        """The triangles of a [[objects]] table of type "mesh" (an OBJ or PLY file)."""
         self.check_keys(w, t, OBJECT_KEYS["mesh"], 'type "mesh"')
-        what = "the path of a Wavefront OBJ file"
+        what = "the path of a Wavefront OBJ or PLY file"
         rel = self.require(w, t, "path", what)
         if not isinstance(rel, str) or not rel:
             raise self.expected(w, "path", what, rel)
@@ -360,15 +361,16 @@ class _Loader(TableReader):
         resolved = self.path.parent / rel
         self.files.append(resolved)
         transform = self.build(w, "scale", lambda _: Transform(translate, rotate, scale), None)
+        kind, a_kind = ("PLY", "a PLY") if resolved.suffix.lower() == ".ply" else ("OBJ", "an OBJ")
         try:
             mesh, faces = load_mesh(resolved, material, transform)
         except FileNotFoundError:
-            raise self.fail(w, "path", f"OBJ file not found: {resolved}") from None
+            raise self.fail(w, "path", f"{kind} file not found: {resolved}") from None
         except IsADirectoryError:
-            raise self.fail(w, "path", f"{resolved} is a directory, not an OBJ file") from None
+            raise self.fail(w, "path", f"{resolved} is a directory, not {a_kind} file") from None
         except OSError as e:
             raise self.fail(w, "path", f"cannot read {resolved}: {e.strerror or e}") from None
-        except ObjError as e:
+        except (ObjError, PlyError) as e:
             at = f" line {e.line}" if e.line is not None else ""
             raise self.fail(w, "path", f"{resolved}{at}: {e.detail}") from None
         except (ValueError, ArithmeticError) as e:  # a vertex out of range once placed

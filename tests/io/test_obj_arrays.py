@@ -208,7 +208,7 @@ def _single_precision(block, dtype):
     return None if numbers is None else numbers.astype(np.float32).astype(dtype)
 
 
-PARSE = obj_arrays._numbers
+PARSE = obj_arrays.read_numbers
 
 
 # Texts on which each planted mistake changes obj_arrays' answer: the agreement check
@@ -232,7 +232,7 @@ TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
         ),
         # numbers rounded to single precision
         (
-            lambda m: m.setattr(obj_arrays, "_numbers", _single_precision),
+            lambda m: m.setattr(obj_arrays, "read_numbers", _single_precision),
             "v 0.1 0.2 0.3\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
         ),
     ],

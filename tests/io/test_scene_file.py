@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import math
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
@@ -624,6 +625,48 @@ def test_a_mesh_path_must_be_a_file(tmp_path):
     assert "is a directory" in str(mesh_error(tmp_path, None, name="d.obj"))
     err = error_of(mesh_scene(tmp_path, None).replace('path = "m.obj"\n', ""), tmp_path / "s.toml")
     assert err.key == "path" and "missing required key" in str(err)
+
+
+TETRA_PLY = """\
+ply
+format ascii 1.0
+element vertex 4
+property double x
+property double y
+property double z
+element face 4
+property list uchar int vertex_indices
+end_header
+0 0 0
+1 0 0
+0 1 0
+0 0 1
+3 0 2 1
+3 0 1 3
+3 0 3 2
+3 1 2 3
+"""
+
+
+def test_a_ply_mesh_is_read_as_the_same_obj_mesh_is(tmp_path):
+    flat = TETRA.replace("f 1//1 3//3 2//2", "f 1 3 2")
+    (obj,) = load_mesh(tmp_path, flat, "scale = 2\n").objects
+    (ply,) = load_mesh(tmp_path, TETRA_PLY, "scale = 2\n", name="m.PLY").objects
+    assert np.array_equal(ply.vertices, obj.vertices) and np.array_equal(ply.faces, obj.faces)
+    assert np.array_equal(ply.tree.lo, obj.tree.lo)
+
+
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        (None, "PLY file not found"),
+        (TETRA_PLY.replace("3 1 2 3", "3 1 2 4"), "m.ply line 17: face 4: vertex index 4"),
+        (TETRA_PLY.replace("format ascii", "format text"), "m.ply line 2: unknown format"),
+    ],
+)
+def test_ply_errors_name_the_file_and_line(tmp_path, text, words):
+    err = mesh_error(tmp_path, text, name="m.ply")
+    assert err.key == "path" and words in str(err) and len(str(err).splitlines()) == 1
 
 
 def test_degenerate_faces_are_skipped_and_counted_in_one_warning(tmp_path):
