@@ -4,6 +4,9 @@ stats (image.stats["peak_rss_mb"]) and `rtpy bench`.
 Linux reads the kernel's high-water mark (/proc/self/status), which
 reset_peak_memory() resets; elsewhere getrusage's maximum since the process
 started. The module imports `resource` only when asked (Windows has none).
+
+reuse_freed_memory() tells the C library to keep freed memory for the next array,
+which a render calls before it loads its scene.
 """
 
 from __future__ import annotations
@@ -11,7 +14,12 @@ from __future__ import annotations
 import math
 import sys
 
-__all__ = ["max_rss_mb", "peak_memory_mb", "reset_peak_memory"]
+__all__ = ["max_rss_mb", "peak_memory_mb", "reset_peak_memory", "reuse_freed_memory"]
+
+# mallopt(3) parameters, from glibc's malloc.h
+M_TRIM_THRESHOLD = -1
+M_MMAP_THRESHOLD = -3
+KEEP_BYTES = 1 << 30  # blocks up to this size come from the heap and stay there
 
 
 def reset_peak_memory() -> bool:
@@ -63,3 +71,30 @@ def peak_memory_mb(children: bool = False) -> float:
         return own
     known = [mb for mb in (own, max_rss_mb(children=True)) if not math.isnan(mb)]
     return max(known, default=math.nan)
+
+
+def reuse_freed_memory() -> bool:
+    """Have freed memory kept for the next allocation rather than given back to the
+    system at once (glibc's malloc, on Linux); True where that was set.
+
+    glibc gives every block larger than its mmap threshold (at most 32 MB) pages of
+    its own and unmaps them when the block is freed, so the next array that size is
+    faulted in again page by page. Reading and building a million-triangle mesh makes
+    hundreds of such temporaries, and their page faults took a quarter of a first
+    render's time (docs/performance.md#scene-size). With both thresholds at 1 GiB the
+    temporaries reuse the heap; the memory a process holds at its peak is the same.
+    Elsewhere (macOS, Windows, musl) nothing is changed and False is returned.
+    """
+    if not sys.platform.startswith("linux"):
+        return False
+    import ctypes
+
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):
+        return False
+    mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
+    mallopt.restype = ctypes.c_int
+    return bool(mallopt(M_MMAP_THRESHOLD, KEEP_BYTES)) and bool(
+        mallopt(M_TRIM_THRESHOLD, KEEP_BYTES)
+    )

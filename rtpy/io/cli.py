@@ -344,9 +344,12 @@ def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
 
 
 def _render(args: argparse.Namespace) -> int:
+    from ..memory import reuse_freed_memory
     from ..render_state import ResumeError
     from .bundled import resolve_scene
     from .scene_file import SceneError, SceneWarning, load_scene
+
+    reuse_freed_memory()  # a large mesh's temporaries, reused rather than faulted in anew
 
     try:
         load_plugins(args.plugin)
