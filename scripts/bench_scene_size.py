@@ -1,18 +1,22 @@
-"""What a scene's size costs: a UV sphere of 1k to 1M triangles read from an OBJ file.
+"""What a scene's size costs: a UV sphere of 1k to 1M triangles read from an OBJ or PLY file.
 
     python scripts/bench_scene_size.py [--sizes 1000 10000 100000 1000000] [--repeat 3]
                                        [--write-doc] [--quick]
 
 The meshes and their scenes (rtpy/bench/meshes.py: the sphere on a ground sphere
-under the sky, max depth 4) are written to a temporary folder. For each size:
+under the sky, max depth 4) are written to a temporary folder, the mesh both as an
+OBJ text file and as a binary PLY file (float32, as downloaded scans come). For each
+size:
 
-- read and build: in a fresh process, seconds of rtpy.io.obj.read_obj, and of
-  rtpy.mesh.Mesh (placing the vertices, leaving out degenerate faces, building the
-  tree: rtpy/bvh_build.py), on one core;
+- read and build: in a fresh process set up as a render is (rtpy.memory
+  .reuse_freed_memory), seconds of rtpy.io.obj.read_obj, of rtpy.io.ply.read_ply,
+  and of rtpy.mesh.Mesh (placing the vertices, leaving out degenerate faces,
+  building the tree: rtpy/bvh_build.py), on one core;
 - whole renders, `python -m rtpy render SCENE -q -j 2`, numpy backend at 128x72 x
   16 spp, scalar at 64x36 x 2 spp (sizes up to --scalar-max): "first" with the mesh
-  cache off (RTPY_MESH_CACHE=0: read and built in the render), "again" with the mesh
-  built by an earlier render (rtpy/io/mesh_cache.py);
+  cache off (RTPY_MESH_CACHE=0: read and built in the render), from the OBJ file
+  and, numpy only, from the PLY file; "again" with the mesh built by an earlier
+  render (rtpy/io/mesh_cache.py);
 - the peak memory of the whole process tree of each render: the sum over the
   processes of their proportional set size (Linux /proc/PID/smaps_rollup, shared
   pages split between the processes sharing them), sampled every 20 ms;
@@ -52,22 +56,33 @@ MEMORY_GOAL_MB = 1000
 
 
 def stages_child(scene: str) -> dict:
-    """Seconds to read the scene's OBJ file and to build its Mesh, in this process."""
+    """Seconds to read the scene's OBJ file, its PLY file, and to build its Mesh (of
+    the OBJ file's arrays), in this process."""
     import numpy  # noqa: F401  (imported before the clock starts, as a render has it)
 
     import rtpy.bvh_build  # noqa: F401
     import rtpy.io.obj_arrays  # noqa: F401
     from rtpy.io.obj import read_obj
+    from rtpy.io.ply import read_ply
     from rtpy.materials import Lambertian
+    from rtpy.memory import reuse_freed_memory
     from rtpy.mesh import Mesh
 
+    reuse_freed_memory()  # as a render does
     obj_path = Path(scene).with_suffix(".obj")
     start = time.perf_counter()
+    read_ply(obj_path.with_suffix(".ply"))
+    ply = time.perf_counter()
     obj = read_obj(obj_path)
     read = time.perf_counter()
     mesh = Mesh(obj.positions, obj.normals, obj.triangles, Lambertian())
     built = time.perf_counter()
-    return {"read": read - start, "build": built - read, "triangles": len(mesh)}
+    return {
+        "read": read - ply,
+        "read ply": ply - start,
+        "build": built - read,
+        "triangles": len(mesh),
+    }
 
 
 def sky_map(height: int = 64, width: int = 8):
@@ -182,6 +197,7 @@ def measure(folder: Path, size: int, repeat: int, scalar_max: int) -> dict:
     from rtpy.bench.meshes import write_scene
 
     scene = write_scene(folder, size)
+    ply_scene = write_scene(folder, size, ".ply")
     out = folder / "out.png"
     stages = json.loads(
         subprocess.run(
@@ -194,14 +210,18 @@ def measure(folder: Path, size: int, repeat: int, scalar_max: int) -> dict:
     cold = dict(os.environ, RTPY_MESH_CACHE="0")
     warm = dict(os.environ, RTPY_CACHE=str(folder / "cache"), RTPY_MESH_CACHE="1")
     runs: dict[str, list[tuple[float, float]]] = {}
-    configs = {"numpy first": (NUMPY, cold), "numpy again": (NUMPY, warm)}
+    configs = {
+        "numpy first": (scene, NUMPY, cold),
+        "numpy first ply": (ply_scene, NUMPY, cold),
+        "numpy again": (scene, NUMPY, warm),
+    }
     if size <= scalar_max:
-        configs |= {"scalar first": (SCALAR, cold), "scalar again": (SCALAR, warm)}
+        configs |= {"scalar first": (scene, SCALAR, cold), "scalar again": (scene, SCALAR, warm)}
     run(render_command(scene, NUMPY, out), warm)  # the mesh built once, for "again"
     mitsuba = have_mitsuba()
     for _ in range(repeat):
-        for name, (flags, env) in configs.items():
-            runs.setdefault(name, []).append(run(render_command(scene, flags, out), env))
+        for name, (path, flags, env) in configs.items():
+            runs.setdefault(name, []).append(run(render_command(path, flags, out), env))
         if mitsuba:
             command = [sys.executable, __file__, "--mitsuba", str(scene), str(folder / "m.npy")]
             runs.setdefault("mitsuba", []).append(run(command))
@@ -222,20 +242,26 @@ def cell(row: dict, key: str, fmt: str = "{:.2f}") -> str:
 
 def table(rows: list[dict]) -> list[str]:
     head = (
-        "| triangles | read s | build s | numpy first s | numpy again s | numpy peak MB "
-        "| scalar first s | scalar again s | scalar peak MB | Mitsuba 3 s |"
+        "| triangles | read OBJ s | read PLY s | build s | numpy first s | numpy first PLY s "
+        "| numpy again s | numpy peak MB | scalar first s | scalar again s | scalar peak MB "
+        "| Mitsuba 3 s |"
     )
-    lines = [head, "|" + "---|" * 10]
+    lines = [head, "|" + "---|" * 12]
     for r in rows:
-        numpy_mb = max(r.get("numpy first MB", 0), r.get("numpy again MB", 0))
+        numpy_mb = max(r.get(f"numpy {k} MB", 0) for k in ("first", "first ply", "again"))
         scalar_mb = max(r.get("scalar first MB", 0), r.get("scalar again MB", 0))
         lines.append(
-            f"| {r['triangles']:,} | {r['read']:.2f} | {r['build']:.2f} "
-            f"| {cell(r, 'numpy first')} | {cell(r, 'numpy again')} | {numpy_mb:.0f} "
+            f"| {r['triangles']:,} | {r['read']:.2f} | {r['read ply']:.2f} | {r['build']:.2f} "
+            f"| {cell(r, 'numpy first')} | {cell(r, 'numpy first ply')} "
+            f"| {cell(r, 'numpy again')} | {numpy_mb:.0f} "
             f"| {cell(r, 'scalar first')} | {cell(r, 'scalar again')} "
             f"| {f'{scalar_mb:.0f}' if scalar_mb else '-'} | {cell(r, 'mitsuba')} |"
         )
     return lines
+
+
+def ratio(big: dict, base: dict, key: str) -> float:
+    return big[key] / base[key]
 
 
 def ratios(rows: list[dict]) -> list[str]:
@@ -246,14 +272,16 @@ def ratios(rows: list[dict]) -> list[str]:
         big = next((r for r in rows if r["size"] == size), None)
         if big is None or f"{backend} first" not in big:
             continue
-        first = big[f"{backend} first"] / base[f"{backend} first"]
-        again = big[f"{backend} again"] / base[f"{backend} again"]
-        peak = max(big[f"{backend} first MB"], big[f"{backend} again MB"])
+        ply = ""
+        if f"{backend} first ply" in big:
+            ply = f", {ratio(big, base, backend + ' first ply'):.1f}x the first time from PLY"
+        peak = max(v for k, v in big.items() if k.startswith(backend) and k.endswith(" MB"))
         memory = f" (goal: at most {MEMORY_GOAL_MB} MB)" if backend == "numpy" else ""
         lines.append(
             f"- {backend}, {big['triangles']:,} / {base['triangles']:,} triangles, whole "
-            f"process: {first:.1f}x the first time, {again:.1f}x again (goal: at most "
-            f"{goal:g}x); peak {peak:.0f} MB{memory}"
+            f"process: {ratio(big, base, backend + ' first'):.1f}x the first time from OBJ{ply}, "
+            f"{ratio(big, base, backend + ' again'):.1f}x again (goal: at most {goal:g}x); "
+            f"peak {peak:.0f} MB{memory}"
         )
     big = rows[-1]
     if "mitsuba" in big and "mitsuba" in base:

@@ -1,6 +1,7 @@
 """The meshes of the scene-size bench (scripts/bench_scene_size.py, docs/performance.md):
-a UV sphere of about n triangles with its vertex normals, written as an OBJ file,
-on a ground sphere under the sky. Made on the fly, never committed.
+a UV sphere of about n triangles with its vertex normals, written as an OBJ file or
+as a binary PLY file (the form downloaded scans come in), on a ground sphere under
+the sky. Made on the fly, never committed.
 """
 
 from __future__ import annotations
@@ -55,8 +56,32 @@ def write_obj(path: Path, positions: np.ndarray, faces: np.ndarray) -> None:
         out.write("".join(map(f, *(faces + 1).T.tolist())))
 
 
+def write_ply(path: Path, positions: np.ndarray, faces: np.ndarray) -> None:
+    """A binary little-endian PLY file of the positions and their normals (the
+    positions), as float32, and the faces as lists of three int32 indices."""
+    vertex = np.empty(len(positions), dtype="<f4, <f4, <f4, <f4, <f4, <f4")
+    for i, column in enumerate(np.concatenate([positions, positions], axis=1).T):
+        vertex[f"f{i}"] = column
+    face = np.empty(len(faces), dtype=[("n", "u1"), ("v", "<i4", 3)])
+    face["n"], face["v"] = 3, faces
+    header = [
+        "ply",
+        "format binary_little_endian 1.0",
+        f"comment a UV sphere of {len(faces)} triangles (rtpy/bench/meshes.py)",
+        f"element vertex {len(positions)}",
+        *(f"property float {name}" for name in ("x", "y", "z", "nx", "ny", "nz")),
+        f"element face {len(faces)}",
+        "property list uchar int vertex_indices",
+        "end_header",
+    ]
+    with open(path, "wb") as out:
+        out.write(("\n".join(header) + "\n").encode())
+        out.write(vertex.tobytes())
+        out.write(face.tobytes())
+
+
 SCENE = """\
-# A UV sphere of {triangles} triangles read from {obj}, on a ground sphere, under the sky
+# A UV sphere of {triangles} triangles read from {mesh}, on a ground sphere, under the sky
 [camera]
 look_from = [0, 1.2, 4]
 look_at = [0, 0.2, 0]
@@ -85,17 +110,19 @@ material = "ground"
 
 [[objects]]
 type = "mesh"
-path = "{obj}"
+path = "{mesh}"
 material = "model"
 """
 
 
-def write_scene(folder: Path, triangles: int) -> Path:
-    """The scene file (and its OBJ file) of a sphere of about `triangles` triangles
-    in `folder`; its name says the size (sphere_1000.toml)."""
+def write_scene(folder: Path, triangles: int, suffix: str = ".obj") -> Path:
+    """The scene file (and its mesh file, .obj or .ply by suffix) of a sphere of about
+    `triangles` triangles in `folder`; its name says the size and the mesh file's
+    form (sphere_1000.toml, sphere_1000_ply.toml)."""
     positions, faces = uv_sphere(triangles)
-    obj = folder / f"sphere_{triangles}.obj"
-    write_obj(obj, positions, faces)
-    scene = folder / f"sphere_{triangles}.toml"
-    scene.write_text(SCENE.format(triangles=len(faces), obj=obj.name))
+    mesh = folder / f"sphere_{triangles}{suffix}"
+    {".obj": write_obj, ".ply": write_ply}[suffix](mesh, positions, faces)
+    name = f"sphere_{triangles}" if suffix == ".obj" else f"sphere_{triangles}_ply"
+    scene = folder / f"{name}.toml"
+    scene.write_text(SCENE.format(triangles=len(faces), mesh=mesh.name))
     return scene

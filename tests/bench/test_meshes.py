@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 import rtpy
-from rtpy.bench.meshes import uv_sphere, write_obj, write_scene
+from rtpy.bench.meshes import uv_sphere, write_obj, write_ply, write_scene
 from rtpy.io.obj import read_obj
+from rtpy.io.ply import parse_ply, read_ply
 
 
 @pytest.mark.parametrize("triangles", [10, 1000, 20_000])
@@ -33,4 +34,21 @@ def test_the_obj_file_and_scene_read_back(tmp_path):
     assert np.array_equal(obj.triangles[:, :, 0], faces)
     assert np.array_equal(obj.triangles[:, :, 1], faces)  # v//vn: the vertex's normal
     scene = rtpy.load_scene(write_scene(tmp_path, 200))
+    assert len(scene.objects[1]) == len(faces)
+
+
+def test_the_ply_file_and_scene_read_back(tmp_path):
+    positions, faces = uv_sphere(200)
+    write_ply(tmp_path / "s.ply", positions, faces)
+    ply = read_ply(tmp_path / "s.ply")
+    assert np.array_equal(ply.positions, positions.astype(np.float32))
+    assert np.array_equal(ply.normals, positions.astype(np.float32))
+    assert np.array_equal(ply.triangles[:, :, 0], faces)
+    assert np.array_equal(ply.triangles[:, :, 1], faces)  # each vertex its normal
+    # the same columns the record-by-record reader (the definition) finds
+    assert np.array_equal(parse_ply((tmp_path / "s.ply").read_bytes(), fast=False).triangles,
+                          ply.triangles)  # fmt: skip
+    scene_file = write_scene(tmp_path, 200, ".ply")
+    assert scene_file.name == "sphere_200_ply.toml"
+    scene = rtpy.load_scene(scene_file)
     assert len(scene.objects[1]) == len(faces)
