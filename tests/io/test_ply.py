@@ -56,8 +56,10 @@ def square(fmt="ascii", normals=False):
 
 
 def same(a, b) -> bool:
+    """The same arrays, NaN where NaN (a changed byte can make a float NaN in both)."""
     return all(
-        np.array_equal(getattr(a, k), getattr(b, k)) and getattr(a, k).shape == getattr(b, k).shape
+        np.array_equal(getattr(a, k), getattr(b, k), equal_nan=True)
+        and getattr(a, k).shape == getattr(b, k).shape
         for k in ("positions", "normals", "triangles")
     )
 
