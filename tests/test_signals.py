@@ -361,8 +361,10 @@ def test_a_signal_at_a_random_moment(tmp_path, index):
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_sigterm_after_a_pass_writes_it_and_exits_143(tmp_path):
     """SIGTERM once the progress bar shows the first passes done (scalar, 2 workers):
-    exit 143, the image of the finished passes."""
-    run = Run("scalar", 2, signal.SIGTERM, delay=-1.0, again=None, existing=True, spp=16)
+    exit 143, the image of the finished passes. The render is long (seconds) so that
+    the bar, refreshed every 0.1 s, shows it between 25% and 99% however fast the
+    machine."""
+    run = Run("scalar", 2, signal.SIGTERM, delay=-1.0, again=None, existing=True, spp=1024)
     proc, outputs = start(run, tmp_path)  # delay < 0: with the progress bar
     seen = read_until(proc, lambda text: re.search(r"(2[5-9]|[3-9]\d)%\|", text) is not None)
     proc.send_signal(signal.SIGTERM)
