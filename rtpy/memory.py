@@ -5,8 +5,9 @@ Linux reads the kernel's high-water mark (/proc/self/status), which
 reset_peak_memory() resets; elsewhere getrusage's maximum since the process
 started. The module imports `resource` only when asked (Windows has none).
 
-reuse_freed_memory() tells the C library to keep freed memory for the next array,
-which a render calls before it loads its scene.
+tune_for_large_scenes(), which a render calls before it loads its scene, tells the
+C library to keep freed memory for the next array (reuse_freed_memory) and numpy
+to back its arrays with ordinary pages (avoid_huge_pages).
 """
 
 from __future__ import annotations
@@ -14,7 +15,14 @@ from __future__ import annotations
 import math
 import sys
 
-__all__ = ["max_rss_mb", "peak_memory_mb", "reset_peak_memory", "reuse_freed_memory"]
+__all__ = [
+    "avoid_huge_pages",
+    "max_rss_mb",
+    "peak_memory_mb",
+    "reset_peak_memory",
+    "reuse_freed_memory",
+    "tune_for_large_scenes",
+]
 
 # mallopt(3) parameters, from glibc's malloc.h
 M_TRIM_THRESHOLD = -1
@@ -99,3 +107,32 @@ def reuse_freed_memory() -> bool:
     return bool(mallopt(M_MMAP_THRESHOLD, KEEP_BYTES)) and bool(
         mallopt(M_TRIM_THRESHOLD, KEEP_BYTES)
     )
+
+
+def avoid_huge_pages() -> bool:
+    """Stop numpy from asking the kernel (Linux) to back its arrays of 4 MB or more
+    with 2 MB pages; True where numpy asked until now.
+
+    Where transparent huge pages are given on request (the usual "madvise" setting),
+    the kernel finds a free 2 MB page at the first touch of each, compacting memory
+    if it must, while the process waits. A first render of a million triangles from
+    binary PLY spent about 1 s of system time so (docs/performance.md#scene-size):
+    2.0 s in all against 1.4 s with ordinary 4 kB pages. Elsewhere numpy never asks,
+    and False is returned.
+    """
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        from numpy._core import multiarray
+    except ImportError:  # numpy 1
+        from numpy.core import multiarray
+    set_advice = getattr(multiarray, "_set_madvise_hugepage", None)
+    return False if set_advice is None else bool(set_advice(False))
+
+
+def tune_for_large_scenes() -> None:
+    """The memory policy of a render (reuse_freed_memory and avoid_huge_pages), which
+    lets a million-triangle mesh be read and built without page faults dominating;
+    a no-op where the platform offers neither."""
+    reuse_freed_memory()
+    avoid_huge_pages()

@@ -9,7 +9,7 @@ OBJ text file and as a binary PLY file (float32, as downloaded scans come). For 
 size:
 
 - read and build: in a fresh process set up as a render is (rtpy.memory
-  .reuse_freed_memory), seconds of rtpy.io.obj.read_obj, of rtpy.io.ply.read_ply,
+  .tune_for_large_scenes), seconds of rtpy.io.obj.read_obj, of rtpy.io.ply.read_ply,
   and of rtpy.mesh.Mesh (placing the vertices, leaving out degenerate faces,
   building the tree: rtpy/bvh_build.py), on one core;
 - whole renders, `python -m rtpy render SCENE -q -j 2`, numpy backend at 128x72 x
@@ -65,10 +65,10 @@ def stages_child(scene: str) -> dict:
     from rtpy.io.obj import read_obj
     from rtpy.io.ply import read_ply
     from rtpy.materials import Lambertian
-    from rtpy.memory import reuse_freed_memory
+    from rtpy.memory import tune_for_large_scenes
     from rtpy.mesh import Mesh
 
-    reuse_freed_memory()  # as a render does
+    tune_for_large_scenes()  # as a render does
     obj_path = Path(scene).with_suffix(".obj")
     start = time.perf_counter()
     read_ply(obj_path.with_suffix(".ply"))

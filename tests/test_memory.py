@@ -99,3 +99,50 @@ def test_freed_memory_is_reused_without_faulting_it_in_again():
     assert int(found) < 16
     # The check can fail: without the setting glibc unmaps the freed block.
     assert int(faults_of_a_second_array("default")) >= 16
+
+
+PAGES_CHILD = """
+import resource, sys
+import numpy as np
+from rtpy.memory import avoid_huge_pages
+
+if sys.argv[1] == "small" and not avoid_huge_pages():
+    print("unsupported")
+    sys.exit(0)
+before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+np.ones(96 << 17)  # 96 MB, fresh
+print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
+"""
+SMALL_PAGES = (96 << 20) // 4096
+
+
+def huge_pages_on_request() -> bool:
+    """The kernel gives transparent huge pages to memory that asks for them only."""
+    try:
+        with open("/sys/kernel/mm/transparent_hugepage/enabled") as f:
+            return "[madvise]" in f.read()
+    except OSError:
+        return False
+
+
+def faults_of_a_fresh_array(mode: str) -> str:
+    env = {k: v for k, v in os.environ.items() if k != "NUMPY_MADVISE_HUGEPAGE"}  # its default
+    return subprocess.run(
+        [sys.executable, "-c", PAGES_CHILD, mode],
+        capture_output=True,
+        text=True,
+        check=True,
+        env=env,
+    ).stdout.strip()
+
+
+def test_numpy_arrays_get_small_pages():
+    """avoid_huge_pages: a fresh 96 MB array is faulted in by 4 kB pages, as many
+    faults as pages, not by 48 huge ones the kernel may compact memory to find."""
+    found = faults_of_a_fresh_array("small")
+    if found == "unsupported":
+        assert not sys.platform.startswith("linux")  # numpy asks for huge pages on Linux
+        pytest.skip("numpy asks for no huge pages here")
+    if not huge_pages_on_request():
+        pytest.skip("the kernel's huge pages are not given on request")
+    assert int(found) >= SMALL_PAGES  # numpy's default here: 49 faults (huge pages)

@@ -344,12 +344,12 @@ def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
 
 
 def _render(args: argparse.Namespace) -> int:
-    from ..memory import reuse_freed_memory
+    from ..memory import tune_for_large_scenes
     from ..render_state import ResumeError
     from .bundled import resolve_scene
     from .scene_file import SceneError, SceneWarning, load_scene
 
-    reuse_freed_memory()  # a large mesh's temporaries, reused rather than faulted in anew
+    tune_for_large_scenes()
 
     try:
         load_plugins(args.plugin)
