@@ -14,7 +14,8 @@ The shape of every line is checked at once: its bytes are classified (a number's
 characters, blanks, slashes, the keyword), runs of one class collapsed, and the
 result compared with the shapes allowed ("v d d d", "f d//d d//d d//d", ...). The
 numbers are then parsed by numpy.fromstring, which rounds decimals correctly as
-float() does (Python's own string-to-double).
+float() does (Python's own string-to-double). In a large file the vertex lines are
+read by a second process (rtpy/io/forked.py) while this one reads the faces.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import warnings
 
 import numpy as np
 
+from .forked import Forked
 from .obj import IGNORED, ObjMesh
 
 # Byte classes for the shape of a line: a number's characters become "d", blanks " ".
@@ -53,6 +55,7 @@ FORMS = {
 V, VN, VT, F, SKIP, OTHER = range(6)
 BLANK_LETTERS = bytes.maketrans(b"vntf/", b"     ")
 CHUNK = 1 << 20  # bytes of text classified at a time (_shape)
+PARALLEL_BYTES = 8 << 20  # `v`, `vn` and `vt` text read by a second process (Forked)
 
 
 def parse_obj_bytes(raw: bytes) -> ObjMesh | None:
@@ -76,14 +79,24 @@ def parse_obj_bytes(raw: bytes) -> ObjMesh | None:
     if kind is None:
         return None
     lines = [np.flatnonzero(kind == k) for k in (V, VN, VT, F)]
-    positions = _vectors(raw, starts, ends, lines[V], b"v d d d\n")
-    normals = _vectors(raw, starts, ends, lines[VN], b"vn d d d\n")
-    if positions is None or normals is None or not _texcoords(raw, starts, ends, lines[VT]):
-        return None
-    triangles = _faces(raw, starts, ends, lines)
-    if triangles is None:
+    # The vertices' numbers in a second process while this one reads the faces.
+    vertex_bytes = int((ends - starts)[np.concatenate(lines[:3])].sum())
+    fork = vertex_bytes >= PARALLEL_BYTES
+    with Forked(_vertices, raw, starts, ends, lines, fork=fork) as vertices:
+        triangles = _faces(raw, starts, ends, lines)
+        positions, normals, texcoords = vertices.result()
+    if positions is None or normals is None or not texcoords or triangles is None:
         return None
     return ObjMesh(positions, normals, triangles)
+
+
+def _vertices(raw, starts, ends, lines) -> tuple:
+    """(positions or None, normals or None, whether the `vt` lines are readable)."""
+    return (
+        _vectors(raw, starts, ends, lines[V], b"v d d d\n"),
+        _vectors(raw, starts, ends, lines[VN], b"vn d d d\n"),
+        _texcoords(raw, starts, ends, lines[VT]),
+    )
 
 
 def _line_kinds(raw: bytes, buf, starts, ends) -> np.ndarray | None:
