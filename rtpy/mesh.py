@@ -202,7 +202,9 @@ class Mesh(Hittable):
         if len(self.faces):
             from .bvh_build import build_tree
 
-            self.tree = build_tree(*self.triangle_boxes())
+            if self.skipped:
+                a, b, c = (p.compress(kept, axis=0) for p in (a, b, c))
+            self.tree = build_tree(*_boxes(a, b, c))
         self.__setstate__({})
 
     @classmethod
@@ -258,20 +260,7 @@ class Mesh(Hittable):
         """(lo, hi), (T, 3) each: every triangle's box as Triangle.bounding_box makes
         it (padded by BOX_PADDING of its magnitude, at least an ulp), grown by
         ROUNDING_MARGIN of the mesh's magnitude as the BVH grows a scene's boxes."""
-        import numpy as np
-
-        a, b, c = (self.vertices.take(self.faces[:, i], axis=0) for i in range(3))
-        lo = np.minimum(a, b)
-        np.minimum(lo, c, out=lo)
-        hi = np.maximum(a, b, out=a)
-        np.maximum(hi, c, out=hi)
-        size = np.maximum(np.abs(lo), np.abs(hi), out=b)
-        magnitude = np.maximum(np.maximum(size[:, 0], size[:, 1]), size[:, 2])
-        pad = np.maximum(BOX_PADDING * magnitude, np.spacing(magnitude))
-        margin = (ROUNDING_MARGIN * float(magnitude.max()) + pad)[:, None]
-        lo -= margin
-        hi += margin
-        return lo, hi
+        return _boxes(*(self.vertices.take(self.faces[:, i], axis=0) for i in range(3)))
 
     # --- Hittable -----------------------------------------------------------------
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
@@ -300,6 +289,24 @@ class Mesh(Hittable):
             return None
         lo, hi = self.tree.lo[0].tolist(), self.tree.hi[0].tolist()
         return AABB(Vec3(*lo), Vec3(*hi))
+
+
+def _boxes(a, b, c):
+    """Mesh.triangle_boxes of the triangles of corners a, b, c ((T, 3) each; a and b
+    are overwritten)."""
+    import numpy as np
+
+    lo = np.minimum(a, b)
+    np.minimum(lo, c, out=lo)
+    hi = np.maximum(a, b, out=a)
+    np.maximum(hi, c, out=hi)
+    size = np.maximum(hi, np.negative(lo, out=b), out=b)  # max(|lo|, |hi|): lo <= hi
+    magnitude = np.maximum(np.maximum(size[:, 0], size[:, 1]), size[:, 2])
+    pad = np.maximum(BOX_PADDING * magnitude, np.spacing(magnitude))
+    margin = (ROUNDING_MARGIN * float(magnitude.max()) + pad)[:, None]
+    lo -= margin
+    hi += margin
+    return lo, hi
 
 
 def _cross(u, v):
