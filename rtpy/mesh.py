@@ -300,7 +300,9 @@ def _boxes(a, b, c):
     np.minimum(lo, c, out=lo)
     hi = np.maximum(a, b, out=a)
     np.maximum(hi, c, out=hi)
-    size = np.maximum(hi, np.negative(lo, out=b), out=b)  # max(|lo|, |hi|): lo <= hi
+    # max(|lo|, |hi|) is max(hi, -lo) as lo <= hi (up to the sign of a zero, which the
+    # largest over x, y, z is only for a degenerate triangle at the origin)
+    size = np.maximum(hi, np.negative(lo, out=b), out=b)
     magnitude = np.maximum(np.maximum(size[:, 0], size[:, 1]), size[:, 2])
     pad = np.maximum(BOX_PADDING * magnitude, np.spacing(magnitude))
     margin = (ROUNDING_MARGIN * float(magnitude.max()) + pad)[:, None]

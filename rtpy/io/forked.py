@@ -102,7 +102,6 @@ def _child(send, function: Callable[..., Any], args: tuple) -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signals.unblock()  # born with them blocked (signals.held)
     try:
-        answer = (function(*args),)
+        send.send((function(*args),))
     except BaseException:  # noqa: BLE001 - result() calls the function again, here
         return
-    send.send(answer)
