@@ -75,18 +75,23 @@ print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
 """
 
 
-def faults_of_a_second_array(mode: str) -> str:
-    """The page faults of allocating and filling a 96 MB array a second time, in a
-    fresh process (the setting is process-wide)."""
-    # glibc's own defaults: no thresholds set from the environment
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("MALLOC_", "GLIBC_TUNABLES"))}
+def child_says(code: str, mode: str) -> str:
+    """What a fresh process running `code` with argument `mode` prints (the settings
+    are process-wide), under glibc's and numpy's own defaults: no malloc thresholds or
+    huge-page choice taken from the environment."""
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if not k.startswith(("MALLOC_", "GLIBC_TUNABLES", "NUMPY_MADVISE_HUGEPAGE"))
+    }
     return subprocess.run(
-        [sys.executable, "-c", REUSE_CHILD, mode],
-        capture_output=True,
-        text=True,
-        check=True,
-        env=env,
+        [sys.executable, "-c", code, mode], capture_output=True, text=True, check=True, env=env
     ).stdout.strip()
+
+
+def faults_of_a_second_array(mode: str) -> str:
+    """The page faults of allocating and filling a 96 MB array a second time."""
+    return child_says(REUSE_CHILD, mode)
 
 
 def test_freed_memory_is_reused_without_faulting_it_in_again():
@@ -126,14 +131,8 @@ def huge_pages_on_request() -> bool:
 
 
 def faults_of_a_fresh_array(mode: str) -> str:
-    env = {k: v for k, v in os.environ.items() if k != "NUMPY_MADVISE_HUGEPAGE"}  # its default
-    return subprocess.run(
-        [sys.executable, "-c", PAGES_CHILD, mode],
-        capture_output=True,
-        text=True,
-        check=True,
-        env=env,
-    ).stdout.strip()
+    """The page faults of allocating and filling a fresh 96 MB array."""
+    return child_says(PAGES_CHILD, mode)
 
 
 def test_numpy_arrays_get_small_pages():

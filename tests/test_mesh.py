@@ -12,6 +12,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rtpy.bench.meshes import uv_sphere
+from rtpy.bvh import ROUNDING_MARGIN
 from rtpy.hit_info import HitInfo
 from rtpy.interval import Interval
 from rtpy.materials import Lambertian
@@ -296,3 +297,29 @@ def test_a_pickled_mesh_keeps_its_arrays_and_tree_not_its_triangle_objects():
         assert np.array_equal(getattr(copy.tree, name), getattr(mesh.tree, name))
     ray = random_queries(np.random.default_rng(5), 1)[0]
     assert copy.hit_t(ray, 0.0, math.inf) == mesh.hit_t(ray, 0.0, math.inf)
+
+
+def test_the_triangle_boxes_are_the_triangles_own_grown_by_the_bvhs_margin():
+    """Mesh.triangle_boxes (numpy, for the tree) is Triangle.bounding_box (the padded
+    box of the scalar path) grown by ROUNDING_MARGIN of the mesh's magnitude, as
+    rtpy.bvh.BVH grows a scene's boxes: equal up to the rounding of adding the pad and
+    the margin in the other order. Triangles in every octant, of sizes 1e-3 to 1e3,
+    some flat along an axis (their box's thickness is the pad alone)."""
+    rng = np.random.default_rng(11)
+    corners = rng.normal(size=(300, 3, 3)) * 10.0 ** rng.integers(-3, 4, (300, 1, 1))
+    corners += rng.normal(size=(300, 1, 3)) * 5.0
+    corners[::7, :, 2] = corners[::7, :1, 2]  # flat in z
+    faces = np.arange(900).reshape(300, 3)
+    triangles = np.stack([faces, np.full_like(faces, -1)], axis=2)  # no normals
+    mesh = Mesh(corners.reshape(-1, 3), np.zeros((0, 3)), triangles, MAT)
+    assert len(mesh) == 300
+    lo, hi = mesh.triangle_boxes()
+    raw = [mesh[k].bounding_box() for k in range(len(mesh))]
+    unpadded = np.abs(corners).max()
+    margin = ROUNDING_MARGIN * unpadded
+    for k, box in enumerate(raw):
+        want_lo = np.array([box.x0, box.y0, box.z0]) - margin
+        want_hi = np.array([box.x1, box.y1, box.z1]) + margin
+        ulps = 4 * np.spacing(np.abs(corners[k]).max() + margin)
+        assert np.all(np.abs(lo[k] - want_lo) <= ulps), k
+        assert np.all(np.abs(hi[k] - want_hi) <= ulps), k
