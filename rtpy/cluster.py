@@ -89,6 +89,7 @@ class DaskCluster(Executor):
         import distributed
 
         before = set(multiprocessing.active_children())
+        had_tracker = _resource_tracker_running()
         started = time.perf_counter()
         client, close = None, _nothing
         pending: dict = {}
@@ -113,28 +114,29 @@ class DaskCluster(Executor):
             waited = 0.0
             while pending:
                 step = POLL_SECONDS if timeout is None else min(POLL_SECONDS, timeout)
-                try:
-                    done = distributed.wait(
-                        list(pending), timeout=step, return_when="FIRST_COMPLETED"
-                    )
-                except TimeoutError:
+                # Dask is called with the signals held (they act when it returns, at
+                # most POLL_SECONDS later): a KeyboardInterrupt inside its calls can
+                # make it log a traceback (distributed.utils.sync then cancels a
+                # future it has not made yet).
+                with signals.held():
+                    results = _finished(distributed, pending, step)
+                    submit()
+                if results is None:
                     waited += step
                     if timeout is not None and waited >= timeout:
                         waited = 0.0
                         yield None
                     continue
                 waited = 0.0
-                for future in done.done:
-                    del pending[future]
-                    result = _result(future, distributed)
-                    submit()
-                    yield result
+                yield from results
         finally:
             if pending:
                 client.cancel(list(pending))
             pending.clear()
             close()
             end_processes(before, grace=CONNECT_SECONDS)  # a local cluster's, once closed
+            if not had_tracker:
+                _stop_resource_tracker()
 
     def _connect(self, distributed) -> tuple[object, Callable[[], None]]:
         """The client, and what ends what was started for this render."""
@@ -166,6 +168,24 @@ class DaskCluster(Executor):
 
 def _nothing() -> None:
     pass
+
+
+def _resource_tracker_running() -> bool:
+    """multiprocessing's resource tracker runs for this process (POSIX: a process
+    that processes started by spawn, such as a local cluster's, report to)."""
+    from multiprocessing import resource_tracker
+
+    return getattr(resource_tracker._resource_tracker, "_fd", None) is not None
+
+
+def _stop_resource_tracker() -> None:
+    """Stop the resource tracker that a local cluster started, and wait for it: it
+    would end on its own only after this process, so it outlived the render."""
+    from multiprocessing import resource_tracker
+
+    stop = getattr(resource_tracker._resource_tracker, "_stop", None)
+    if stop is not None:
+        stop()
 
 
 def _local_cluster(distributed, workers: int):
@@ -250,6 +270,18 @@ def _versions() -> tuple[str, str, str]:
     import numpy
 
     return version(), numpy.__version__, platform.python_version()
+
+
+def _finished(distributed, pending: dict, timeout: float) -> list[Result] | None:
+    """The results of the pending futures done within `timeout` seconds, taken out of
+    `pending`; None if none is."""
+    try:
+        done = distributed.wait(list(pending), timeout=timeout, return_when="FIRST_COMPLETED")
+    except TimeoutError:
+        return None
+    for future in done.done:
+        del pending[future]
+    return [_result(future, distributed) for future in done.done]
 
 
 def _result(future, distributed) -> Result:

@@ -13,6 +13,7 @@ import signal
 import subprocess
 import sys
 import time
+from multiprocessing import resource_tracker
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +26,7 @@ from rtpy.numpy_backend import renderer as numpy_renderer
 
 from .commands import read_until
 from .io.test_cli import material_registry  # noqa: F401 (a fixture the tests use)
-from .test_signals import group_processes
+from .test_signals import child_processes, group_processes
 
 distributed = pytest.importorskip("distributed")
 
@@ -204,6 +205,16 @@ def test_a_local_cluster_gives_the_image_of_two_local_workers(small_units, two_w
     image = rtpy.render(rtpy.load_scene(SCENE), cluster="local", workers=2, **RENDER)
     assert image.stats["executor"] == "dask" and image.stats["workers"] == 2
     np.testing.assert_array_equal(image.linear, two_workers_here)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_local_cluster_leaves_no_process_when_the_render_returns():
+    """Not even multiprocessing's resource tracker, which the cluster's processes
+    (started by spawn) start, and which would otherwise end only after this one."""
+    resource_tracker._resource_tracker._stop()  # as in a new process: not yet started
+    before = child_processes(os.getpid())
+    rtpy.render(rtpy.load_scene(SCENE), cluster="local", workers=2, **RENDER)
+    assert child_processes(os.getpid()) == before
 
 
 def paths_done(text: str) -> float:

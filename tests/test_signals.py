@@ -18,6 +18,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -235,18 +236,29 @@ def send(proc: subprocess.Popen, run: Run) -> None:
         pass
 
 
-def group_processes(pgid: int) -> list[str]:
-    """The processes of group pgid still running (Linux /proc; zombies left out)."""
-    found = []
+def _processes() -> Iterator[tuple[int, int, str]]:
+    """(parent, group, "pid (name) command line") of each process still running
+    (Linux /proc; zombies left out)."""
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
             text = stat.read_text()
+            command = (stat.parent / "cmdline").read_bytes().replace(b"\0", b" ")
         except OSError:  # it ended meanwhile
             continue
-        fields = text.rsplit(")", 1)[1].split()  # after "pid (name)": state, ppid, pgrp
-        if int(fields[2]) == pgid and fields[0] != "Z":
-            found.append(text.split(")", 1)[0] + ")")
-    return found
+        state, parent, group = text.rsplit(")", 1)[1].split()[:3]  # after "pid (name)"
+        if state != "Z":
+            name = text.split(")", 1)[0] + ")"
+            yield int(parent), int(group), f"{name} {command.decode(errors='replace')[:200]}"
+
+
+def group_processes(pgid: int) -> list[str]:
+    """The processes of group pgid still running."""
+    return [process for _, group, process in _processes() if group == pgid]
+
+
+def child_processes(pid: int) -> list[str]:
+    """The children of process pid still running."""
+    return [process for parent, _, process in _processes() if parent == pid]
 
 
 @cache
