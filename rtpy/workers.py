@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 
 from . import signals
 from .executor import Executor, Result, WorkerError
+from .memory import give_back_freed_memory
 from .plugins import PLUGINS, load_listed_plugins
 
 if TYPE_CHECKING:
@@ -141,6 +142,8 @@ class WorkerProcesses(Executor):
         workers = (
             min(self.workers, WINDOWS_MAX_WORKERS) if sys.platform == "win32" else self.workers
         )
+        if method == "fork":  # the workers copy no page of a block freed here
+            give_back_freed_memory()
         if method == "forkserver":  # started now, not with the signals blocked below
             from multiprocessing import forkserver
 

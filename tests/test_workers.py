@@ -3,6 +3,7 @@ one error when they cannot start, and the CPUs a render may use."""
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import pickle
 import subprocess
@@ -12,6 +13,7 @@ import numpy as np
 import pytest
 
 import rtpy
+import rtpy.workers
 from rtpy.workers import available_cpus
 
 from .test_renderer import small_scene
@@ -22,6 +24,22 @@ def test_workers_give_the_same_image_under_every_start_method(start_method):
     one = rtpy.render(scene, camera=camera, spp=4, seed=3)
     two = rtpy.render(scene, camera=camera, spp=4, seed=3, workers=2)
     np.testing.assert_array_equal(one.linear, two.linear)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="Windows cannot fork")
+@pytest.mark.parametrize("start_method", ["fork"], indirect=True)
+def test_forked_workers_start_from_a_parent_that_gave_back_its_freed_memory(
+    monkeypatch, start_method
+):
+    workers_then = []
+    monkeypatch.setattr(
+        rtpy.workers,
+        "give_back_freed_memory",
+        lambda: workers_then.append(len(multiprocessing.active_children())),
+    )
+    scene, camera = small_scene()
+    rtpy.render(scene, camera=camera, spp=2, workers=2)
+    assert workers_then == [0]  # once, before the first worker
 
 
 # A program run in its own interpreter with the start method forced: a worker that
