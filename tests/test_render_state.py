@@ -10,8 +10,12 @@ import numpy as np
 import pytest
 
 import rtpy
-from rtpy import Color, Lambertian, Sphere, Vec3
-from rtpy.render_state import FORMAT, ResumeError, state_path
+from rtpy import Color, Lambertian, Scene, Sphere, Vec3
+from rtpy.backend import make_backend
+from rtpy.bvh_build import build_tree
+from rtpy.mesh import Mesh
+from rtpy.render_settings import RenderSettings
+from rtpy.render_state import FORMAT, Checkpoint, ResumeError, state_path
 
 from .test_renderer import Clock, small_scene
 
@@ -207,3 +211,26 @@ def test_resume_without_a_saved_render_starts_from_the_first_pass(tmp_path):
 
 def test_the_command_line_keeps_the_state_beside_the_output(tmp_path):
     assert state_path(tmp_path / "out.png") == tmp_path / "out.png.resume.npz"
+
+
+def scene_digest(tmp_path, scene: Scene) -> str:
+    """The digest of `scene` a checkpoint keys its state with."""
+    _, camera = small_scene()
+    backend = make_backend("numpy", scene, camera, RenderSettings())
+    return Checkpoint(tmp_path / "s.npz", backend).scene
+
+
+def test_the_scene_digest_sees_every_vertex_and_no_tree(tmp_path):
+    """A mesh's arrays are hashed whole, its tree not at all: a tree is made from
+    them and never changes the image, and it is half a large mesh's bytes."""
+    rng = np.random.default_rng(4)
+    positions = rng.uniform(-1, 1, (300, 3))
+    triangles = np.stack([np.arange(300).reshape(100, 3), np.full((100, 3), -1)], axis=2)
+    mesh = Mesh(positions, np.zeros((0, 3)), triangles, Lambertian())
+    digest = scene_digest(tmp_path, Scene([mesh]))
+    moved = positions.copy()
+    moved[217, 1] = np.nextafter(moved[217, 1], 2.0)
+    other = Mesh(moved, np.zeros((0, 3)), triangles, Lambertian())
+    assert scene_digest(tmp_path, Scene([other])) != digest
+    mesh.tree = build_tree(*mesh.triangle_boxes(), leaf_size=1)  # another tree
+    assert scene_digest(tmp_path, Scene([mesh])) == digest
