@@ -47,7 +47,7 @@ if TYPE_CHECKING:
 __all__ = ["CHECKPOINT_SECONDS", "FORMAT", "Checkpoint", "ResumeError", "state_path"]
 
 CHECKPOINT_SECONDS = 30.0  # about the most a crash loses
-FORMAT = 1
+FORMAT = 2  # of the state file, and of the scene digest that keys it
 # Settings that do not change the sums: the display transform, when to stop.
 NOT_IN_THE_SUMS = ("gamma", "time_limit")
 
