@@ -96,16 +96,9 @@ def reuse_freed_memory() -> bool:
     blocks are not given back (565 MB against 542 MB for that render).
     Elsewhere (macOS, Windows, musl) nothing is changed and False is returned.
     """
-    if not sys.platform.startswith("linux"):
+    mallopt = _c_library_function("mallopt", "c_int", "c_int")
+    if mallopt is None:
         return False
-    import ctypes
-
-    try:
-        mallopt = ctypes.CDLL(None).mallopt
-    except (OSError, AttributeError):
-        return False
-    mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
-    mallopt.restype = ctypes.c_int
     return bool(mallopt(M_MMAP_THRESHOLD, KEEP_BYTES)) and bool(
         mallopt(M_TRIM_THRESHOLD, KEEP_BYTES)
     )
@@ -124,18 +117,27 @@ def give_back_freed_memory() -> bool:
     at 134 MB rather than 516 MB while the workers render.
     Elsewhere (macOS, Windows, musl) nothing is done and False is returned.
     """
-    if not sys.platform.startswith("linux"):
+    malloc_trim = _c_library_function("malloc_trim", "c_size_t")
+    if malloc_trim is None:
         return False
+    malloc_trim(0)
+    return True
+
+
+def _c_library_function(name: str, *argument_types: str):
+    """The C library's function `name` (Linux), taking arguments of the given ctypes
+    types and returning an int; None elsewhere or where the library has none."""
+    if not sys.platform.startswith("linux"):
+        return None
     import ctypes
 
     try:
-        malloc_trim = ctypes.CDLL(None).malloc_trim
+        function = getattr(ctypes.CDLL(None), name)
     except (OSError, AttributeError):
-        return False
-    malloc_trim.argtypes = [ctypes.c_size_t]
-    malloc_trim.restype = ctypes.c_int
-    malloc_trim(0)
-    return True
+        return None
+    function.argtypes = [getattr(ctypes, t) for t in argument_types]
+    function.restype = ctypes.c_int
+    return function
 
 
 def avoid_huge_pages() -> bool:
