@@ -42,22 +42,26 @@ def build_tree(lo: np.ndarray, hi: np.ndarray, leaf_size: int | None = None) -> 
     """The tree over K >= 1 boxes lo[i] .. hi[i] ((K, 3) arrays of finite floats),
     leaves of at most leaf_size (default rtpy.bvh.LEAF_SIZE) primitives."""
     leaf_size = bvh.LEAF_SIZE if leaf_size is None else leaf_size
-    lo = np.ascontiguousarray(lo, dtype=np.float64)
-    hi = np.ascontiguousarray(hi, dtype=np.float64)
-    k = len(lo)
+    # The work is done on columns, (3, K): numpy reduces, gathers and scans along the
+    # contiguous axis several times faster than over the rows of a (K, 3) array. A
+    # (K, 3) view of such columns (Mesh's boxes) is taken as it is, without a copy.
+    lo_t = np.ascontiguousarray(np.asarray(lo, dtype=np.float64).T)
+    hi_t = np.ascontiguousarray(np.asarray(hi, dtype=np.float64).T)
+    k = lo_t.shape[1]
     if k == 0:
         raise ValueError("a tree needs at least one box")
-    codes = morton_codes(0.5 * (lo + hi))
+    centroid = lo_t + hi_t
+    centroid *= 0.5
+    codes = morton_codes(centroid.T)
     order = np.argsort(codes, kind="stable")
-    codes = codes[order]
-    sorted_lo, sorted_hi = lo.take(order, axis=0), hi.take(order, axis=0)
+    codes = codes.take(order)
     # Clusters: runs of equal top bits.
     cell = codes >> (30 - CLUSTER_BITS)
     first = np.flatnonzero(np.diff(cell)) + 1
     c_start = np.concatenate([[0], first]).astype(np.int64)
     c_end = np.concatenate([first, [k]]).astype(np.int64)
-    c_lo = np.minimum.reduceat(sorted_lo, c_start, axis=0)
-    c_hi = np.maximum.reduceat(sorted_hi, c_start, axis=0)
+    c_lo = np.minimum.reduceat(lo_t.take(order, axis=1), c_start, axis=1)
+    c_hi = np.maximum.reduceat(hi_t.take(order, axis=1), c_start, axis=1)
     nodes = _Nodes(k, len(c_start))
     c_perm = _top_levels(nodes, c_lo, c_hi, c_end - c_start, leaf_size)
     # The primitives in the clusters' final order; node ranges over clusters become
@@ -69,28 +73,25 @@ def build_tree(lo: np.ndarray, hi: np.ndarray, leaf_size: int | None = None) -> 
     # Keys in the final order: the cluster's rank above its code, so sorted throughout.
     rank = np.repeat(np.arange(len(c_perm), dtype=np.int64), size)
     keys = (rank << 30) | codes.take(positions)
-    sorted_lo, sorted_hi = sorted_lo.take(positions, axis=0), sorted_hi.take(positions, axis=0)
     nodes.to_primitives(offset)
     _bottom_levels(nodes, keys, leaf_size)
-    return nodes.tree(sorted_lo, sorted_hi, order)
+    return nodes.tree(lo_t, hi_t, order)
 
 
 def morton_codes(points: np.ndarray) -> np.ndarray:
     """(K,) int64 30-bit Morton codes of points (K, 3) on a 1024^3 grid over their
     bounds (an axis along which all points agree gets coordinate 0)."""
-    # Column by column: numpy reduces a (K, 3) array over its rows ten times slower.
-    pmin = np.array([points[:, i].min() for i in range(3)])
-    pmax = np.array([points[:, i].max() for i in range(3)])
-    extent = pmax - pmin
-    scale = np.divide(1024.0, extent, out=np.zeros(3), where=extent > 0.0)
-    q = points - pmin
-    q *= scale
-    cells = q.astype(np.int64)
-    np.clip(cells, 0, 1023, out=cells)
-    code = _spread(cells[:, 0]) << 2
-    code |= _spread(cells[:, 1]) << 1
-    code |= _spread(cells[:, 2])
-    return code
+    codes = np.zeros(len(points), dtype=np.int64)
+    for i in range(3):  # column by column: x's bits highest in each triple
+        column = points[:, i]
+        low, high = column.min(), column.max()
+        extent = high - low
+        q = column - low
+        q *= 1024.0 / extent if extent > 0.0 else 0.0
+        cell = q.astype(np.int64)
+        np.clip(cell, 0, 1023, out=cell)
+        codes |= _spread(cell) << (2 - i)
+    return codes
 
 
 def _spread(x: np.ndarray) -> np.ndarray:
@@ -113,9 +114,20 @@ def _ranges(start: np.ndarray, length: np.ndarray) -> np.ndarray:
     return shift + np.arange(total, dtype=np.int64)
 
 
+def _scan(op, a: np.ndarray) -> np.ndarray:
+    """op.accumulate(a, axis=1) of a (3, BINS, S) array, a bin at a time: twenty
+    times faster than numpy's accumulate, which scans element by element."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 0]
+    for i in range(1, a.shape[1]):
+        op(out[:, i - 1], a[:, i], out=out[:, i])
+    return out
+
+
 def _area(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The surface areas of boxes given as columns (3, ...)."""
     e = np.maximum(hi - lo, 0.0)
-    return 2.0 * (e[..., 0] * e[..., 1] + e[..., 1] * e[..., 2] + e[..., 2] * e[..., 0])
+    return 2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0])
 
 
 class _Nodes:
@@ -149,40 +161,48 @@ class _Nodes:
         n = self.n
         self.start[:n], self.end[:n] = offset[self.start[:n]], offset[self.end[:n]]
 
-    def tree(self, sorted_lo, sorted_hi, order) -> Tree:
+    def tree(self, lo_t, hi_t, order) -> Tree:
+        """The Tree, given the primitives' boxes as columns (3, K) and their final
+        order."""
         n = self.n
         start, end, child = self.start[:n], self.end[:n], self.child[:n]
         leaf = child < 0
         count = np.where(leaf, end - start, 0)
         child = np.where(leaf, start, child)
-        lo = np.empty((n, 3))
-        hi = np.empty((n, 3))
-        # The leaves' ranges partition the primitives: in the order of their starts,
-        # reduceat over those starts gives their boxes.
+        lo = np.empty((3, n))
+        hi = np.empty((3, n))
+        # A leaf's box: the union of its primitives' boxes, taken for all leaves at
+        # once as the union of their first, second, ... primitive's (a leaf's last
+        # one again past its count).
         leaves = np.flatnonzero(leaf)
-        owner = np.full(len(order), -1, dtype=np.int64)
-        owner[start.take(leaves)] = leaves
-        firsts = np.flatnonzero(owner >= 0)
-        leaves = owner.take(firsts)
-        lo[leaves] = np.minimum.reduceat(sorted_lo, firsts, axis=0)
-        hi[leaves] = np.maximum.reduceat(sorted_hi, firsts, axis=0)
+        first, last = start.take(leaves), end.take(leaves) - 1
+        for j in range(int((last - first).max()) + 1):
+            prims = order.take(np.minimum(first + j, last))
+            box_lo, box_hi = lo_t.take(prims, axis=1), hi_t.take(prims, axis=1)
+            if j == 0:
+                leaf_lo, leaf_hi = box_lo, box_hi
+            else:
+                np.minimum(leaf_lo, box_lo, out=leaf_lo)
+                np.maximum(leaf_hi, box_hi, out=leaf_hi)
+        lo[:, leaves], hi[:, leaves] = leaf_lo, leaf_hi
         for ids in reversed(self.splits):  # children before their parents
             c = child[ids]
-            lo[ids] = np.minimum(lo[c], lo[c + 1])
-            hi[ids] = np.maximum(hi[c], hi[c + 1])
+            lo[:, ids] = np.minimum(lo[:, c], lo[:, c + 1])
+            hi[:, ids] = np.maximum(hi[:, c], hi[:, c + 1])
         axis = self.axis[:n].copy()
+        # The search gathers a node's box at a time: rows (n, 3).
+        lo, hi = np.ascontiguousarray(lo.T), np.ascontiguousarray(hi.T)
         return Tree(lo, hi, child.astype(np.int32), count.astype(np.int32), axis, order)
 
 
 def _top_levels(nodes: _Nodes, c_lo, c_hi, c_count, leaf_size: int) -> np.ndarray:
-    """Split the root's clusters by binned SAH, level by level, until every node holds
-    one cluster or at most leaf_size primitives; returns the clusters' final order
-    (every node's clusters adjacent in it)."""
-    m = len(c_lo)
+    """Split the root's clusters (their boxes as columns c_lo, c_hi (3, M)) by binned
+    SAH, level by level, until every node holds one cluster or at most leaf_size
+    primitives; returns the clusters' final order (every node's clusters adjacent in
+    it)."""
+    m = c_lo.shape[1]
     perm = np.arange(m, dtype=np.int64)
     centroid = 0.5 * (c_lo + c_hi)
-    # Coordinates in rows: ufunc.at is fast on one-dimensional arrays only.
-    c_lo_t, c_hi_t = np.ascontiguousarray(c_lo.T), np.ascontiguousarray(c_hi.T)
     ids = np.zeros(1, dtype=np.int64)
     start, end = np.zeros(1, dtype=np.int64), np.full(1, m, dtype=np.int64)
     while ids.size:
@@ -199,40 +219,42 @@ def _top_levels(nodes: _Nodes, c_lo, c_hi, c_count, leaf_size: int) -> np.ndarra
         member = perm.take(pos)
         node = np.repeat(np.arange(s), length)
         first = np.concatenate([[0], np.cumsum(length)[:-1]])
-        cc = centroid.take(member, axis=0)
-        nmin = np.minimum.reduceat(cc, first, axis=0)
-        nmax = np.maximum.reduceat(cc, first, axis=0)
-        ext = nmax - nmin
+        cc = centroid.take(member, axis=1)
+        nmin = np.minimum.reduceat(cc, first, axis=1)
+        ext = np.maximum.reduceat(cc, first, axis=1) - nmin
         weight = c_count.take(member).astype(np.float64)
-        m_lo, m_hi = c_lo_t.take(member, axis=1), c_hi_t.take(member, axis=1)
-        cost = np.full((s, 3, BINS - 1), np.inf)
+        m_lo, m_hi = c_lo.take(member, axis=1), c_hi.take(member, axis=1)
+        # Per axis, bin and node (the nodes innermost, so the scans over the bins
+        # run over whole rows): the clusters' count and box, then the cost of each
+        # plane between bins.
+        cost = np.full((3, BINS - 1, s), np.inf)
         bins = np.empty((3, len(member)), dtype=np.int64)
         for axis in range(3):
-            scale = np.divide(BINS, ext[:, axis], out=np.zeros(s), where=ext[:, axis] > 0.0)
-            b = ((cc[:, axis] - nmin[node, axis]) * scale[node]).astype(np.int64)
+            scale = np.divide(BINS, ext[axis], out=np.zeros(s), where=ext[axis] > 0.0)
+            b = ((cc[axis] - nmin[axis, node]) * scale[node]).astype(np.int64)
             np.clip(b, 0, BINS - 1, out=b)
             bins[axis] = b
-            key = node * BINS + b
-            b_lo = np.full((3, s * BINS), np.inf)
-            b_hi = np.full((3, s * BINS), -np.inf)
+            key = b * s + node
+            b_lo = np.full((3, BINS * s), np.inf)
+            b_hi = np.full((3, BINS * s), -np.inf)
             for i in range(3):
                 np.minimum.at(b_lo[i], key, m_lo[i])
                 np.maximum.at(b_hi[i], key, m_hi[i])
-            n = np.bincount(key, weights=weight, minlength=s * BINS).reshape(s, BINS)
-            b_lo, b_hi = b_lo.T.reshape(s, BINS, 3), b_hi.T.reshape(s, BINS, 3)
-            n_left = np.cumsum(n, axis=1)[:, :-1]
-            left = _area(np.minimum.accumulate(b_lo, axis=1), np.maximum.accumulate(b_hi, axis=1))
-            r_lo = np.minimum.accumulate(b_lo[:, ::-1], axis=1)[:, ::-1]
-            r_hi = np.maximum.accumulate(b_hi[:, ::-1], axis=1)[:, ::-1]
-            right = _area(r_lo, r_hi)
-            total = n.sum(axis=1)[:, None]
+            n = np.bincount(key, weights=weight, minlength=BINS * s).reshape(BINS, s)
+            b_lo, b_hi = b_lo.reshape(3, BINS, s), b_hi.reshape(3, BINS, s)
+            n_left = np.cumsum(n, axis=0)[:-1]
+            left = _area(_scan(np.minimum, b_lo), _scan(np.maximum, b_hi))
+            right = _area(
+                _scan(np.minimum, b_lo[:, ::-1])[:, ::-1], _scan(np.maximum, b_hi[:, ::-1])[:, ::-1]
+            )
+            total = n.sum(axis=0)
             with np.errstate(invalid="ignore"):  # empty sides: inf * 0
-                c = left[:, :-1] * n_left + right[:, 1:] * (total - n_left)
-            cost[:, axis] = np.where((n_left > 0) & (n_left < total), c, np.inf)
-        flat = cost.reshape(s, -1)
-        best = flat.argmin(axis=1)
+                c = left[:-1] * n_left + right[1:] * (total - n_left)
+            cost[axis] = np.where((n_left > 0) & (n_left < total), c, np.inf)
+        flat = cost.reshape(-1, s)
+        best = flat.argmin(axis=0)
         axis_of, plane = np.divmod(best, BINS - 1)
-        found = np.isfinite(flat[np.arange(s), best])
+        found = np.isfinite(flat[best, np.arange(s)])
         # Right of the chosen plane; where no plane separates (all centroids in one
         # bin), the second half of the node's clusters.
         right_side = bins[axis_of[node], np.arange(len(member))] > plane[node]

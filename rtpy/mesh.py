@@ -186,9 +186,11 @@ class Mesh(Hittable):
         shading = transform.normals(normals)
         faces = corners[:, :, 0]
         # Triangle's arithmetic: twice the area |(b - a) x (c - a)|, kept from MIN_AREA.
-        a, b, c = (points.take(faces[:, i], axis=0) for i in range(3))
+        # The corners as columns (3, T): numpy is fastest along the contiguous axis.
+        columns = np.ascontiguousarray(points.T)
+        a, b, c = (columns.take(faces[:, i], axis=1) for i in range(3))
         n = _cross(b - a, c - a)
-        kept = np.sqrt(n[:, 0] * n[:, 0] + n[:, 1] * n[:, 1] + n[:, 2] * n[:, 2]) >= MIN_AREA
+        kept = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) >= MIN_AREA
         self.skipped = int(len(kept) - np.count_nonzero(kept))
         self.faces = faces.compress(kept, axis=0).astype(np.int32)
         corner_normals = corners[:, :, 1].compress(kept, axis=0)
@@ -203,7 +205,7 @@ class Mesh(Hittable):
             from .bvh_build import build_tree
 
             if self.skipped:
-                a, b, c = (p.compress(kept, axis=0) for p in (a, b, c))
+                a, b, c = (p.compress(kept, axis=1) for p in (a, b, c))
             self.tree = build_tree(*_boxes(a, b, c))
         self.__setstate__({})
 
@@ -260,7 +262,8 @@ class Mesh(Hittable):
         """(lo, hi), (T, 3) each: every triangle's box as Triangle.bounding_box makes
         it (padded by BOX_PADDING of its magnitude, at least an ulp), grown by
         ROUNDING_MARGIN of the mesh's magnitude as the BVH grows a scene's boxes."""
-        return _boxes(*(self.vertices.take(self.faces[:, i], axis=0) for i in range(3)))
+        columns = self.vertices.T
+        return _boxes(*(columns.take(self.faces[:, i], axis=1) for i in range(3)))
 
     # --- Hittable -----------------------------------------------------------------
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
@@ -292,8 +295,8 @@ class Mesh(Hittable):
 
 
 def _boxes(a, b, c):
-    """Mesh.triangle_boxes of the triangles of corners a, b, c ((T, 3) each; a and b
-    are overwritten)."""
+    """Mesh.triangle_boxes of the triangles of corners a, b, c, given as columns
+    ((3, T) each; a and b are overwritten): (T, 3) views of (3, T) columns."""
     import numpy as np
 
     lo = np.minimum(a, b)
@@ -303,22 +306,22 @@ def _boxes(a, b, c):
     # max(|lo|, |hi|) is max(hi, -lo) as lo <= hi (up to the sign of a zero, which the
     # largest over x, y, z is only for a degenerate triangle at the origin)
     size = np.maximum(hi, np.negative(lo, out=b), out=b)
-    magnitude = np.maximum(np.maximum(size[:, 0], size[:, 1]), size[:, 2])
+    magnitude = np.maximum(np.maximum(size[0], size[1]), size[2])
     pad = np.maximum(BOX_PADDING * magnitude, np.spacing(magnitude))
-    margin = (ROUNDING_MARGIN * float(magnitude.max()) + pad)[:, None]
+    margin = ROUNDING_MARGIN * float(magnitude.max()) + pad
     lo -= margin
     hi += margin
-    return lo, hi
+    return lo.T, hi.T
 
 
 def _cross(u, v):
-    """cross() of the rows of two (K, 3) arrays, in its arithmetic."""
+    """cross() of the columns of two (3, K) arrays, in its arithmetic."""
     import numpy as np
 
     out = np.empty_like(u)
-    out[:, 0] = u[:, 1] * v[:, 2] - u[:, 2] * v[:, 1]
-    out[:, 1] = u[:, 2] * v[:, 0] - u[:, 0] * v[:, 2]
-    out[:, 2] = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+    out[0] = u[1] * v[2] - u[2] * v[1]
+    out[1] = u[2] * v[0] - u[0] * v[2]
+    out[2] = u[0] * v[1] - u[1] * v[0]
     return out
 
 
