@@ -50,14 +50,16 @@ def build_tree(lo: np.ndarray, hi: np.ndarray, leaf_size: int | None = None) -> 
     k = lo_t.shape[1]
     if k == 0:
         raise ValueError("a tree needs at least one box")
+    # Every temporary of a million boxes is new memory, which the kernel hands out a
+    # page at a time (about half a millisecond a MB): they are let go when done.
     centroid = lo_t + hi_t
     centroid *= 0.5
     codes = morton_codes(centroid.T)
+    del centroid
     order = np.argsort(codes, kind="stable")
     codes = codes.take(order)
     # Clusters: runs of equal top bits.
-    cell = codes >> (30 - CLUSTER_BITS)
-    first = np.flatnonzero(np.diff(cell)) + 1
+    first = np.flatnonzero(np.diff(codes >> (30 - CLUSTER_BITS))) + 1
     c_start = np.concatenate([[0], first]).astype(np.int64)
     c_end = np.concatenate([first, [k]]).astype(np.int64)
     c_lo = np.minimum.reduceat(lo_t.take(order, axis=1), c_start, axis=1)
@@ -71,8 +73,9 @@ def build_tree(lo: np.ndarray, hi: np.ndarray, leaf_size: int | None = None) -> 
     positions = _ranges(c_start.take(c_perm), size)
     order = order.take(positions)
     # Keys in the final order: the cluster's rank above its code, so sorted throughout.
-    rank = np.repeat(np.arange(len(c_perm), dtype=np.int64), size)
-    keys = (rank << 30) | codes.take(positions)
+    keys = np.repeat(np.arange(len(c_perm), dtype=np.int64) << 30, size)
+    keys |= codes.take(positions)
+    del codes, positions
     nodes.to_primitives(offset)
     _bottom_levels(nodes, keys, leaf_size)
     return nodes.tree(lo_t, hi_t, order)
@@ -134,12 +137,12 @@ class _Nodes:
     """The nodes made so far: node i covers start[i] .. end[i] (clusters during the
     top levels, primitives after to_primitives); an inner node's children are
     child[i] and child[i] + 1 (-1: a leaf), split along axis[i]. A tree over K
-    primitives has at most 2 K - 1 nodes."""
+    primitives has at most 2 K - 1 nodes (int32, as the Tree's arrays)."""
 
     def __init__(self, k: int, root_end: int) -> None:
-        self.start = np.zeros(2 * k, dtype=np.int64)
-        self.end = np.zeros(2 * k, dtype=np.int64)
-        self.child = np.full(2 * k, -1, dtype=np.int64)
+        self.start = np.zeros(2 * k, dtype=np.int32)
+        self.end = np.zeros(2 * k, dtype=np.int32)
+        self.child = np.full(2 * k, -1, dtype=np.int32)
         self.axis = np.zeros(2 * k, dtype=np.int8)
         self.end[0], self.n = root_end, 1
         self.splits: list[np.ndarray] = []  # per level: the nodes split then
@@ -169,8 +172,8 @@ class _Nodes:
         leaf = child < 0
         count = np.where(leaf, end - start, 0)
         child = np.where(leaf, start, child)
-        lo = np.empty((3, n))
-        hi = np.empty((3, n))
+        lo = np.empty((n, 3))
+        hi = np.empty((n, 3))
         # A leaf's box: the union of its primitives' boxes, taken for all leaves at
         # once as the union of their first, second, ... primitive's (a leaf's last
         # one again past its count).
@@ -184,15 +187,13 @@ class _Nodes:
             else:
                 np.minimum(leaf_lo, box_lo, out=leaf_lo)
                 np.maximum(leaf_hi, box_hi, out=leaf_hi)
-        lo[:, leaves], hi[:, leaves] = leaf_lo, leaf_hi
+        lo[leaves], hi[leaves] = leaf_lo.T, leaf_hi.T
         for ids in reversed(self.splits):  # children before their parents
             c = child[ids]
-            lo[:, ids] = np.minimum(lo[:, c], lo[:, c + 1])
-            hi[:, ids] = np.maximum(hi[:, c], hi[:, c + 1])
+            lo[ids] = np.minimum(lo[c], lo[c + 1])
+            hi[ids] = np.maximum(hi[c], hi[c + 1])
         axis = self.axis[:n].copy()
-        # The search gathers a node's box at a time: rows (n, 3).
-        lo, hi = np.ascontiguousarray(lo.T), np.ascontiguousarray(hi.T)
-        return Tree(lo, hi, child.astype(np.int32), count.astype(np.int32), axis, order)
+        return Tree(lo, hi, child, count, axis, order)
 
 
 def _top_levels(nodes: _Nodes, c_lo, c_hi, c_count, leaf_size: int) -> np.ndarray:

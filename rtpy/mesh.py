@@ -192,6 +192,12 @@ class Mesh(Hittable):
         n = _cross(b - a, c - a)
         kept = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) >= MIN_AREA
         self.skipped = int(len(kept) - np.count_nonzero(kept))
+        if self.skipped:
+            a, b, c = (p.compress(kept, axis=1) for p in (a, b, c))
+        boxes = _boxes(a, b, c) if len(a[0]) else None
+        # Arrays of a million triangles let go as soon as they are done with: new
+        # memory costs the time the kernel takes to give it (docs/performance.md).
+        del columns, a, b, c, n
         self.faces = faces.compress(kept, axis=0).astype(np.int32)
         corner_normals = corners[:, :, 1].compress(kept, axis=0)
         x, y, z = shading[:, 0], shading[:, 1], shading[:, 2]
@@ -200,13 +206,12 @@ class Mesh(Hittable):
         smooth = usable[corner_normals].all(axis=1)
         self.normals = shading
         self.face_normals = np.where(smooth[:, None], corner_normals, -1).astype(np.int32)
+        del corner_normals, smooth
         self.tree: Tree | None = None
-        if len(self.faces):
+        if boxes is not None:
             from .bvh_build import build_tree
 
-            if self.skipped:
-                a, b, c = (p.compress(kept, axis=1) for p in (a, b, c))
-            self.tree = build_tree(*_boxes(a, b, c))
+            self.tree = build_tree(*boxes)
         self.__setstate__({})
 
     @classmethod
