@@ -198,15 +198,17 @@ class Mesh(Hittable):
         # Arrays of a million triangles let go as soon as they are done with: new
         # memory costs the time the kernel takes to give it (docs/performance.md).
         del columns, a, b, c, n
-        self.faces = faces.compress(kept, axis=0).astype(np.int32)
-        corner_normals = corners[:, :, 1].compress(kept, axis=0)
+        corner_normals = corners[:, :, 1]
+        if self.skipped:
+            faces, corner_normals = faces.compress(kept, axis=0), corner_normals.compress(kept, 0)
+        self.faces = faces.astype(np.int32)
         x, y, z = shading[:, 0], shading[:, 1], shading[:, 2]
         length = np.sqrt(x * x + y * y + z * z)  # Vec3.length
         usable = np.append(np.isfinite(length) & (length > 0.0), False)  # [-1]: none
-        smooth = usable[corner_normals].all(axis=1)
         self.normals = shading
-        self.face_normals = np.where(smooth[:, None], corner_normals, -1).astype(np.int32)
-        del corner_normals, smooth
+        self.face_normals = corner_normals.astype(np.int32)
+        self.face_normals[~usable[corner_normals].all(axis=1)] = -1
+        del corner_normals
         self.tree: Tree | None = None
         if boxes is not None:
             from .bvh_build import build_tree
