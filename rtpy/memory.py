@@ -83,9 +83,11 @@ def peak_memory_mb(children: bool = False) -> float:
     return max(known, default=math.nan)
 
 
-def reuse_freed_memory() -> bool:
+def reuse_freed_memory(mmap_threshold: int = KEEP_BYTES, trim_threshold: int = KEEP_BYTES) -> bool:
     """Have freed memory kept for the next allocation rather than given back to the
-    system at once (glibc's malloc, on Linux); True where that was set.
+    system at once (glibc's malloc, on Linux): blocks up to mmap_threshold bytes come
+    from the heap, and freed memory at its top is given back only past trim_threshold
+    bytes. True where that was set.
 
     glibc gives every block larger than its mmap threshold (at most 32 MB) pages of
     its own and unmaps them when the block is freed, so the next array that size is
@@ -99,8 +101,8 @@ def reuse_freed_memory() -> bool:
     mallopt = _c_library_function("mallopt", "c_int", "c_int")
     if mallopt is None:
         return False
-    return bool(mallopt(M_MMAP_THRESHOLD, KEEP_BYTES)) and bool(
-        mallopt(M_TRIM_THRESHOLD, KEEP_BYTES)
+    return bool(mallopt(M_MMAP_THRESHOLD, mmap_threshold)) and bool(
+        mallopt(M_TRIM_THRESHOLD, trim_threshold)
     )
 
 

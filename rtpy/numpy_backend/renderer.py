@@ -14,14 +14,13 @@ Registered as "numpy" by rtpy.backends.
 
 from __future__ import annotations
 
-import ctypes
-import sys
 from collections.abc import Callable
 from functools import partial
 
 import numpy as np
 
 from ..backend import Backend
+from ..memory import reuse_freed_memory
 from ..plan import Plan, Unit
 from .camera import CameraRays
 from .integrators import BatchIntegrator, make_integrator
@@ -90,24 +89,17 @@ class NumpyBackend(Backend):
 
 def keep_freed_memory() -> None:
     """Ask glibc's malloc to keep freed blocks of up to 32 MB in the heap (Linux; a
-    no-op elsewhere). The backend allocates and frees the same temporaries of a few
-    hundred KB (arrays over a unit's rays) thousands of times per second; by default
-    glibc maps each one freshly from the kernel and unmaps it when it is freed, so
-    every page of every temporary faults on first touch, a large share of the render
-    time. This is malloc's documented tuning (mallopt, the MALLOC_MMAP_THRESHOLD_ and
-    MALLOC_TRIM_THRESHOLD_ variables), process-wide: the process keeps up to 128 MB of
-    freed memory for reuse instead of returning it."""
+    no-op elsewhere), once per process. The backend allocates and frees the same
+    temporaries of a few hundred KB (arrays over a unit's rays) thousands of times per
+    second; by default glibc maps each one freshly from the kernel and unmaps it when
+    it is freed, so every page of every temporary faults on first touch, a large share
+    of the render time. rtpy.memory.reuse_freed_memory sets malloc's documented tuning
+    (mallopt: the mmap and trim thresholds), process-wide: here the process keeps up to
+    128 MB of freed memory for reuse instead of returning it."""
     global _malloc_tuned
-    if _malloc_tuned or not sys.platform.startswith("linux"):
-        return
-    _malloc_tuned = True
-    try:
-        libc = ctypes.CDLL("libc.so.6")
-        libc.mallopt(M_MMAP_THRESHOLD, 32 << 20)
-        libc.mallopt(M_TRIM_THRESHOLD, 128 << 20)
-    except (OSError, AttributeError):  # not glibc: keep the allocator's defaults
-        pass
+    if not _malloc_tuned:
+        _malloc_tuned = True
+        reuse_freed_memory(mmap_threshold=32 << 20, trim_threshold=128 << 20)
 
 
-M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3  # glibc's <malloc.h>
 _malloc_tuned = False
