@@ -31,6 +31,8 @@ from .vec3 import Vec3, dot, unit_vector
 
 __all__ = ["Mesh", "SmoothTriangle", "Transform"]
 
+BLOCK = 1 << 15  # triangles whose boxes are made at a time (_boxes)
+
 
 class SmoothTriangle(Triangle):
     """A Triangle shaded with the normals given at its vertices (Phong shading).
@@ -185,19 +187,8 @@ class Mesh(Hittable):
         _check_vertices(points)
         shading = transform.normals(normals)
         faces = corners[:, :, 0]
-        # Triangle's arithmetic: twice the area |(b - a) x (c - a)|, kept from MIN_AREA.
-        # The corners as columns (3, T): numpy is fastest along the contiguous axis.
-        columns = np.ascontiguousarray(points.T)
-        a, b, c = (columns.take(faces[:, i], axis=1) for i in range(3))
-        n = _cross(b - a, c - a)
-        kept = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) >= MIN_AREA
+        kept, lo, hi = _boxes(points, faces)
         self.skipped = int(len(kept) - np.count_nonzero(kept))
-        if self.skipped:
-            a, b, c = (p.compress(kept, axis=1) for p in (a, b, c))
-        boxes = _boxes(a, b, c) if len(a[0]) else None
-        # Arrays of a million triangles let go as soon as they are done with: new
-        # memory costs the time the kernel takes to give it (docs/performance.md).
-        del columns, a, b, c, n
         corner_normals = corners[:, :, 1]
         if self.skipped:
             faces, corner_normals = faces.compress(kept, axis=0), corner_normals.compress(kept, 0)
@@ -207,13 +198,15 @@ class Mesh(Hittable):
         usable = np.append(np.isfinite(length) & (length > 0.0), False)  # [-1]: none
         self.normals = shading
         self.face_normals = corner_normals.astype(np.int32)
-        self.face_normals[~usable[corner_normals].all(axis=1)] = -1
+        # A face with a corner of no usable normal is flat (-1 on every corner).
+        if self.face_normals.size and not (usable[:-1].all() and self.face_normals.min() >= 0):
+            self.face_normals[~usable[corner_normals].all(axis=1)] = -1
         del corner_normals
         self.tree: Tree | None = None
-        if boxes is not None:
+        if len(lo):
             from .bvh_build import build_tree
 
-            self.tree = build_tree(*boxes)
+            self.tree = build_tree(lo, hi)
         self.__setstate__({})
 
     @classmethod
@@ -269,8 +262,8 @@ class Mesh(Hittable):
         """(lo, hi), (T, 3) each: every triangle's box as Triangle.bounding_box makes
         it (padded by BOX_PADDING of its magnitude, at least an ulp), grown by
         ROUNDING_MARGIN of the mesh's magnitude as the BVH grows a scene's boxes."""
-        columns = self.vertices.T
-        return _boxes(*(columns.take(self.faces[:, i], axis=1) for i in range(3)))
+        _, lo, hi = _boxes(self.vertices, self.faces)
+        return lo, hi
 
     # --- Hittable -----------------------------------------------------------------
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
@@ -301,24 +294,44 @@ class Mesh(Hittable):
         return AABB(Vec3(*lo), Vec3(*hi))
 
 
-def _boxes(a, b, c):
-    """Mesh.triangle_boxes of the triangles of corners a, b, c, given as columns
-    ((3, T) each; a and b are overwritten): (T, 3) views of (3, T) columns."""
+def _boxes(points, faces):
+    """(kept, lo, hi) of the triangles of corners points[faces] ((T, 3) indices):
+    kept (T,), whether a triangle is not degenerate (twice its area, |(b - a) x
+    (c - a)| in Triangle's arithmetic, at least MIN_AREA); lo and hi, the kept
+    triangles' boxes as Mesh.triangle_boxes makes them, (T', 3) views of (3, T')
+    columns."""
     import numpy as np
 
-    lo = np.minimum(a, b)
-    np.minimum(lo, c, out=lo)
-    hi = np.maximum(a, b, out=a)
-    np.maximum(hi, c, out=hi)
-    # max(|lo|, |hi|) is max(hi, -lo) as lo <= hi (up to the sign of a zero, which the
-    # largest over x, y, z is only for a degenerate triangle at the origin)
-    size = np.maximum(hi, np.negative(lo, out=b), out=b)
-    magnitude = np.maximum(np.maximum(size[0], size[1]), size[2])
-    pad = np.maximum(BOX_PADDING * magnitude, np.spacing(magnitude))
-    margin = ROUNDING_MARGIN * float(magnitude.max()) + pad
+    count = len(faces)
+    kept = np.empty(count, dtype=bool)
+    lo, hi, margin = np.empty((3, count)), np.empty((3, count)), np.empty(count)
+    largest = 0.0  # magnitude of the kept triangles
+    # The corners as columns (3, T), where numpy is fastest, a block of triangles at a
+    # time: the temporaries stay in the processor's cache and are made once.
+    columns = np.ascontiguousarray(points.T)
+    for s in range(0, count, BLOCK):
+        e = min(s + BLOCK, count)
+        a, b, c = (columns.take(faces[s:e, i], axis=1) for i in range(3))
+        n = _cross(b - a, c - a)
+        keep = kept[s:e]
+        np.greater_equal(np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), MIN_AREA, out=keep)
+        low, high = lo[:, s:e], hi[:, s:e]
+        np.minimum(np.minimum(a, b, out=n), c, out=low)
+        np.maximum(np.maximum(a, b, out=n), c, out=high)
+        # max(|lo|, |hi|) is max(hi, -lo) as lo <= hi (up to the sign of a zero, which
+        # the largest over x, y, z is only for a degenerate triangle at the origin)
+        size = np.maximum(high, np.negative(low, out=n), out=n)
+        magnitude = np.maximum(np.maximum(size[0], size[1]), size[2])
+        np.maximum(BOX_PADDING * magnitude, np.spacing(magnitude), out=margin[s:e])
+        if keep.any():
+            largest = max(largest, float(magnitude.compress(keep).max()))
+    if not kept.all():
+        lo, hi, margin = lo.compress(kept, 1), hi.compress(kept, 1), margin.compress(kept)
+    # The padding, and the tree's margin for rounding (rtpy/bvh.py)
+    margin += ROUNDING_MARGIN * largest
     lo -= margin
     hi += margin
-    return lo.T, hi.T
+    return kept, lo.T, hi.T
 
 
 def _cross(u, v):

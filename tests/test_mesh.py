@@ -325,6 +325,30 @@ def test_the_triangle_boxes_are_the_triangles_own_grown_by_the_bvhs_margin():
         assert np.all(np.abs(hi[k] - want_hi) <= ulps), k
 
 
+@pytest.mark.parametrize("block", [1, 2, 5, 1 << 15])
+def test_a_degenerate_face_changes_neither_the_boxes_nor_the_tree(monkeypatch, block):
+    """A face left out (collinear corners, here far from the others) is as if it
+    were not in the file: the tree's boxes are grown by the magnitude of the faces
+    kept alone, whichever blocks of faces the boxes are made in."""
+    import rtpy.mesh
+
+    monkeypatch.setattr(rtpy.mesh, "BLOCK", block)
+    rng = np.random.default_rng(3)
+    points = np.concatenate([rng.normal(size=(12, 3)), [[1e5, 0, 0], [2e5, 0, 0], [3e5, 0, 0]]])
+    faces = rng.integers(0, 12, size=(9, 3))
+    faces[:, 1] = (faces[:, 0] + 1) % 12  # distinct corners: none degenerate
+    faces[:, 2] = (faces[:, 0] + 2) % 12
+    with_it = np.insert(faces, 4, [12, 13, 14], axis=0)  # collinear: left out
+    meshes = [
+        Mesh(points, np.zeros((0, 3)), np.stack([f, np.full_like(f, -1)], axis=2), MAT)
+        for f in (faces, with_it)
+    ]
+    assert [m.skipped for m in meshes] == [0, 1]
+    assert np.array_equal(meshes[0].faces, meshes[1].faces)
+    for name in ("lo", "hi", "child", "count", "order"):
+        assert np.array_equal(getattr(meshes[0].tree, name), getattr(meshes[1].tree, name)), name
+
+
 def test_building_a_large_mesh_needs_little_more_memory_than_it_keeps():
     """New memory is paid for page by page (docs/performance.md#scene-size), so the
     constructor lets go of each array of the triangles' size once it is used: the
