@@ -7,26 +7,29 @@
 
 The modules follow the course's structure: vec3 / interval / ray / hit_info /
 scatter_info (utilities), camera, sphere / quad / triangle / scene (hittables),
-materials, light, texture, integrators, renderer. docs/course-map.md says where
-each name of the course's code is; docs/scene-format.md is the scene-file format.
+materials, light, texture, integrators; the render engine is rtpy.engine.
+docs/course-map.md says where each name of the course's code is;
+docs/scene-format.md is the scene-file format.
 
-This module is the package's front door, on the top floor with rtpy.io (see
-tests/test_layout.py's FLOORS): it exports the API of every floor, and imports
-rtpy.backends and rtpy.io.writers so that the core finds its backends and its
-image writers (rtpy.backend, rtpy.writer) by registration.
+This module is the package's front door (see tests/test_layout.py's FLOORS): it
+exports the API of every floor, and imports rtpy.engine.backends and rtpy.io.writers
+so that the engine finds its backends and its image writers (rtpy.engine.backend,
+rtpy.engine.writer) by registration.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from . import signals
+from .engine import signals
 
 if signals.starting_the_command_line():
-    signals.defer()  # before the imports below: see rtpy/signals.py
+    signals.defer()  # before the imports below: see rtpy/engine/signals.py
 
-from .backends import BACKENDS
 from .camera import Camera
+from .engine.backends import BACKENDS
+from .engine.plugins import load_plugin
+from .engine.render_request import render
 from .hit_info import HitInfo
 from .interval import Interval
 from .io import writers as _writers  # noqa: F401 (registers RenderedImage.save's formats)
@@ -48,10 +51,8 @@ from .materials import (
     register_material,
 )
 from .mesh import Mesh, SmoothTriangle, Transform
-from .plugins import load_plugin
 from .quad import Quad
 from .ray import Ray
-from .render_request import render
 from .render_settings import SETTINGS, RenderSettings
 from .scatter_info import ScatterInfo
 from .scene import Scene
@@ -61,14 +62,14 @@ from .triangle import Triangle
 from .vec3 import Color, Point3, Vec3
 
 if TYPE_CHECKING:
-    from .rendered_image import RenderedImage
-    from .renderer import Renderer
+    from .engine.rendered_image import RenderedImage
+    from .engine.renderer import Renderer
 
 # Imported on first use: `import rtpy` loads neither numpy, Pillow nor tqdm, which
 # only rendering and writing images need (a command starts sooner without them).
 _LAZY = {
-    "RenderedImage": ".rendered_image",
-    "Renderer": ".renderer",
+    "RenderedImage": ".engine.rendered_image",
+    "Renderer": ".engine.renderer",
     "mesh_from_obj": ".io.obj",
     "mesh_from_ply": ".io.ply",
 }
@@ -80,7 +81,7 @@ def __getattr__(name: str):
 
         value = getattr(import_module(_LAZY[name], __name__), name)
     elif name == "__version__":
-        from .version import version
+        from .engine.version import version
 
         value = version()
     else:

@@ -1,14 +1,14 @@
-"""`python -m rtpy`: see rtpy.io.cli; signals from start-up to exit: rtpy.signals."""
+"""`python -m rtpy`: see rtpy.cli.main; signals from start-up to exit: rtpy.engine.signals."""
 
 import gc
 import os
 import sys
 
-from . import signals
+from .engine import signals
 
 signals.defer()  # rtpy/__init__.py did it already when run as `python -m rtpy`
 
-from .io.cli import main  # noqa: E402 (imported with the signals deferred)
+from .cli.main import main  # noqa: E402 (imported with the signals deferred)
 
 
 def end(status: int) -> None:

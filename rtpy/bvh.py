@@ -8,7 +8,7 @@ objects.
 
 The tree is stored flat (Tree): arrays of boxes, children and leaves, which both
 backends search and which travel to worker processes as they are. It is built by
-rtpy/bvh_build.py (numpy: Morton codes, then the surface area heuristic, a million
+rtpy/_bvh_build.py (numpy: Morton codes, then the surface area heuristic, a million
 boxes in about a second) or, for reading, by build_readable below: top down, each
 node's objects split where the surface area heuristic (SAH) predicts the fewest
 tests per ray. Both trees give the same answers.
@@ -171,7 +171,7 @@ class BVH:
     margin   how much every object's box is grown; None: ROUNDING_MARGIN times the
              largest coordinate magnitude of all the boxes
     readable True: built by build_readable (this module, plain Python); False: by
-             rtpy.bvh_build (numpy, hundreds of times faster on large lists); None:
+             rtpy._bvh_build (numpy, hundreds of times faster on large lists); None:
              the readable builder below READABLE_MAX objects, where it is as fast
     """
 
@@ -348,7 +348,7 @@ def _take(values: list[int], positions) -> object:
 def _build_fast(boxes: list[AABB]) -> Tree:
     import numpy as np
 
-    from .bvh_build import build_tree
+    from ._bvh_build import build_tree
 
     lo = np.array([(b.x0, b.y0, b.z0) for b in boxes], dtype=np.float64)
     hi = np.array([(b.x1, b.y1, b.z1) for b in boxes], dtype=np.float64)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from .checks import (
+from ._checks import (
     ASPECT_RATIO,
     DEFOCUS_ANGLE,
     LENGTH,

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from .checks import RADIANCE, Range, checked_color, checked_number
+from ._checks import RADIANCE, Range, checked_color, checked_number
 from .vec3 import Color, Vec3
 
 if TYPE_CHECKING:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from .checks import RADIANCE, checked_color, checked_point
+from ._checks import RADIANCE, checked_color, checked_point
 from .hit_info import HitInfo
 from .hittable import MIN_LIGHT_DISTANCE2, Hittable
 from .sampling import generator

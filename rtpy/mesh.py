@@ -12,8 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from .bvh import AABB, BOX_PADDING, BVH, ROUNDING_MARGIN, Tree
-from .checks import (
+from ._checks import (
     ANGLE,
     MAX_COORDINATE,
     MIN_AREA,
@@ -23,6 +22,7 @@ from .checks import (
     checked_vector,
     point,
 )
+from .bvh import AABB, BOX_PADDING, BVH, ROUNDING_MARGIN, Tree
 from .hit_info import HitInfo
 from .hittable import Hittable
 from .ray import Ray
@@ -204,7 +204,7 @@ class Mesh(Hittable):
         del corner_normals
         self.tree: Tree | None = None
         if len(lo):
-            from .bvh_build import build_tree
+            from ._bvh_build import build_tree
 
             self.tree = build_tree(lo, hi)
         self.__setstate__({})

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from ._checks import MIN_AREA, checked_edge, checked_point
 from .bvh import AABB
-from .checks import MIN_AREA, checked_edge, checked_point
 from .hit_info import HitInfo
 from .hittable import FlatShape
 from .ray import Ray

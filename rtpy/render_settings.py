@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from .checks import (
+from ._checks import (
     GAMMA,
     NON_NEGATIVE,
     RADIANCE,

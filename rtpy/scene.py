@@ -6,9 +6,9 @@ import math
 from pathlib import Path
 from typing import Any
 
+from ._checks import checked, string
 from .bvh import BVH
 from .camera import Camera
-from .checks import checked, string
 from .environment import Environment
 from .hit_info import HitInfo
 from .hittable import Hittable

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 
+from ._checks import LENGTH, checked_number, checked_point
 from .bvh import AABB
-from .checks import LENGTH, checked_number, checked_point
 from .hit_info import HitInfo
 from .hittable import Hittable
 from .onb import local_to_world

@@ -6,7 +6,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .checks import LENGTH, UNIT, checked_color, checked_number
+from ._checks import LENGTH, UNIT, checked_color, checked_number
 from .hit_info import HitInfo
 from .vec3 import Color
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 
+from ._checks import MIN_AREA, checked_point
 from .bvh import AABB
-from .checks import MIN_AREA, checked_point
 from .hit_info import HitInfo
 from .hittable import FlatShape
 from .ray import Ray

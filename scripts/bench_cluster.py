@@ -35,7 +35,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from rtpy.bench.machine import compile_bytecode, machine
+from rtpy.cli.bench.machine import compile_bytecode, machine
 
 ROOT = Path(__file__).resolve().parent.parent
 BENCH_DOC, CLUSTER_DOC = ROOT / "docs" / "performance.md", ROOT / "docs" / "cluster.md"

@@ -134,8 +134,8 @@ def render_course(course_dir: str, width: int, spp: int, max_depth: int, seed: i
 def render_rtpy(width: int, spp: int, max_depth: int, seed: int) -> dict:
     """Render with the rtpy on sys.path, scalar backend, one process."""
     import rtpy
+    import rtpy.engine.renderer  # noqa: F401  imported here, they are not part of the render's time)
     import rtpy.io.preview  # noqa: F401  (these two rtpy.render imports on first use:
-    import rtpy.renderer  # noqa: F401  imported here, they are not part of the render's time)
     from rtpy.materials import DiffuseLight, Lambertian, Phong
 
     scene = rtpy.Scene(background=rtpy.Color(*BACKGROUND))

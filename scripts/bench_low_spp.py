@@ -100,8 +100,8 @@ def main() -> int:
         print(json.dumps(render_child(name, *map(int, numbers))))
         return 0
 
-    from rtpy.bench.machine import machine
-    from rtpy.bench.report import machine_lines, replace_generated
+    from rtpy.cli.bench.machine import machine
+    from rtpy.cli.bench.report import machine_lines, replace_generated
 
     before, rows = machine(), []
     for scene in args.scenes:

@@ -297,7 +297,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--quick", action="store_true", help="32x32, 16 spp, 2 rounds")
     args = parser.parse_args(argv)
-    from rtpy.bench.machine import compile_bytecode
+    from rtpy.cli.bench.machine import compile_bytecode
 
     compile_bytecode()  # whole processes are timed: as an installed rtpy starts
     if not have_mitsuba():

@@ -3,15 +3,15 @@
     python scripts/bench_scene_size.py [--sizes 1000 10000 100000 1000000] [--repeat 3]
                                        [--write-doc] [--quick]
 
-The meshes and their scenes (rtpy/bench/meshes.py: the sphere on a ground sphere
+The meshes and their scenes (rtpy/cli/bench/meshes.py: the sphere on a ground sphere
 under the sky, max depth 4) are written to a temporary folder, the mesh both as an
 OBJ text file and as a binary PLY file (float32, as downloaded scans come). For each
 size:
 
-- read and build: in a fresh process set up as a render is (rtpy.memory
+- read and build: in a fresh process set up as a render is (rtpy.engine.memory
   .tune_for_large_scenes), seconds of rtpy.io.obj.read_obj, of rtpy.io.ply.read_ply,
   and of rtpy.mesh.Mesh (placing the vertices, leaving out degenerate faces,
-  building the tree: rtpy/bvh_build.py), on one core;
+  building the tree: rtpy/_bvh_build.py), on one core;
 - whole renders, `python -m rtpy render SCENE -q -j 2`, numpy backend at 128x72 x
   16 spp, scalar at 64x36 x 2 spp (sizes up to --scalar-max): "first" with the mesh
   cache off (RTPY_MESH_CACHE=0: read and built in the render), from the OBJ file
@@ -60,12 +60,12 @@ def stages_child(scene: str) -> dict:
     the OBJ file's arrays), in this process."""
     import numpy  # noqa: F401  (imported before the clock starts, as a render has it)
 
-    import rtpy.bvh_build  # noqa: F401
+    import rtpy._bvh_build  # noqa: F401
     import rtpy.io.obj_arrays  # noqa: F401
+    from rtpy.engine.memory import tune_for_large_scenes
     from rtpy.io.obj import read_obj
     from rtpy.io.ply import read_ply
     from rtpy.materials import Lambertian
-    from rtpy.memory import tune_for_large_scenes
     from rtpy.mesh import Mesh
 
     tune_for_large_scenes()  # as a render does
@@ -97,7 +97,7 @@ def sky_map(height: int = 64, width: int = 8):
 
 
 def mitsuba_child(scene: str, out: str) -> None:
-    """A whole Mitsuba 3 render of the scene (rtpy/bench/meshes.py's) in this process."""
+    """A whole Mitsuba 3 render of the scene (rtpy/cli/bench/meshes.py's) in this process."""
     import drjit as dr
     import mitsuba as mi
     import numpy as np
@@ -194,7 +194,7 @@ def have_mitsuba() -> bool:
 
 def measure(folder: Path, size: int, repeat: int, scalar_max: int) -> dict:
     """Every figure of one size (medians over the repeats)."""
-    from rtpy.bench.meshes import write_scene
+    from rtpy.cli.bench.meshes import write_scene
 
     scene = write_scene(folder, size)
     ply_scene = write_scene(folder, size, ".ply")
@@ -311,8 +311,8 @@ def main() -> int:
     if args.quick:
         args.sizes, args.repeat = [1000, 10_000], 1
 
-    from rtpy.bench.machine import compile_bytecode, machine
-    from rtpy.bench.report import machine_lines, replace_generated
+    from rtpy.cli.bench.machine import compile_bytecode, machine
+    from rtpy.cli.bench.report import machine_lines, replace_generated
 
     compile_bytecode()
     before = machine()

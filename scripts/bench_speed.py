@@ -88,12 +88,12 @@ def startup_child(out: str) -> dict[str, float]:
     import PIL.Image  # noqa: F401
 
     mark("import Pillow")
-    from rtpy.io.cli import build_parser
+    from rtpy.cli.main import build_parser
 
     build_parser(every_command=False)  # as `rtpy render` builds it
     mark("rtpy's CLI imports and parser")
     import rtpy
-    import rtpy.renderer
+    import rtpy.engine.renderer
 
     mark("rtpy's renderer imports")
     import rtpy.numpy_backend.renderer  # noqa: F401
@@ -337,11 +337,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small images, 1 round")
     parser.add_argument("--write-doc", action="store_true", help="update docs/performance.md")
     args = parser.parse_args(argv)
-    from rtpy.bench.machine import compile_bytecode
+    from rtpy.cli.bench.machine import compile_bytecode
 
     compile_bytecode()  # whole processes are timed: as an installed rtpy starts
-    from rtpy.bench.machine import machine
-    from rtpy.bench.report import machine_lines, replace_generated
+    from rtpy.cli.bench.machine import machine
+    from rtpy.cli.bench.report import machine_lines, replace_generated
 
     repeat = 1 if args.quick else max(1, args.repeat)
     before = machine()

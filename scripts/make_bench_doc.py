@@ -2,7 +2,7 @@
 docs/bench/bench.png: run `rtpy bench` on the analytic scenes and two bundled
 scenes with both backends, and write the section between the markers of
 docs/bench.md with the command, the machine and its load, the table and what
-it shows (rtpy.bench.report.format_doc_section). The rest of docs/bench.md is
+it shows (rtpy.cli.bench.report.format_doc_section). The rest of docs/bench.md is
 written by hand.
 
 Run ``python scripts/make_bench_doc.py`` (about 15 minutes on 2 cores: 56
@@ -16,9 +16,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from rtpy.bench.machine import machine
-from rtpy.bench.report import format_doc_section, plot, replace_generated, write_outputs
-from rtpy.bench.run import run_bench
+from rtpy.cli.bench.machine import machine
+from rtpy.cli.bench.report import format_doc_section, plot, replace_generated, write_outputs
+from rtpy.cli.bench.run import run_bench
 from rtpy.testing.analytic_scenes import ANALYTIC_SCENES
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"

@@ -1,4 +1,4 @@
-"""Tests for rtpy.bvh_build: the tree holds every box once in nested boxes, whatever
+"""Tests for rtpy._bvh_build: the tree holds every box once in nested boxes, whatever
 the boxes; its cost by the surface area heuristic is near the readable builder's; and
 a ray visits about log n of its nodes."""
 
@@ -13,9 +13,9 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import rtpy.bvh
-from rtpy import bvh_build
+from rtpy import _bvh_build as bvh_build
+from rtpy._bvh_build import build_tree, morton_codes
 from rtpy.bvh import AABB, Tree, build_readable
-from rtpy.bvh_build import build_tree, morton_codes
 from rtpy.vec3 import Vec3
 
 from .tiers import slow_except

@@ -1,4 +1,4 @@
-"""Tests for rtpy.checks: the typed values of scene files. Through the loader,
+"""Tests for rtpy._checks: the typed values of scene files. Through the loader,
 each wrong type or range is a SceneError naming the file, table and key; the
 checks themselves say what was expected and found."""
 
@@ -11,9 +11,9 @@ import pytest
 from hypothesis import given, settings
 
 import rtpy
-from rtpy import checks
+from rtpy import _checks as checks
+from rtpy._checks import COORDINATE, LENGTH, RADIANCE, UNIT, Invalid, Range
 from rtpy.camera import Camera
-from rtpy.checks import COORDINATE, LENGTH, RADIANCE, UNIT, Invalid, Range
 from rtpy.environment import SkyBand
 from rtpy.io.material_params import material_parameters
 from rtpy.light import PointLight

@@ -11,8 +11,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rtpy.bench.meshes import uv_sphere
 from rtpy.bvh import ROUNDING_MARGIN
+from rtpy.cli.bench.meshes import uv_sphere
 from rtpy.hit_info import HitInfo
 from rtpy.interval import Interval
 from rtpy.materials import Lambertian

@@ -18,7 +18,7 @@ import multiprocessing, os, sys
 from pathlib import Path
 import numpy as np
 import rtpy
-from rtpy.bench.meshes import write_scene
+from rtpy.cli.bench.meshes import write_scene
 
 if __name__ == "__main__":
     method, folder = sys.argv[1], Path(sys.argv[2])
@@ -36,16 +36,16 @@ if __name__ == "__main__":
 
 GUARD_PLUGIN = """
 import os
-import rtpy.bvh_build
+import rtpy._bvh_build
 
-_build = rtpy.bvh_build.build_tree
+_build = rtpy._bvh_build.build_tree
 
 def guarded(*args, **kwargs):
     if os.getpid() != int(os.environ["PARENT_PID"]):
         raise RuntimeError("a worker process built a tree")
     return _build(*args, **kwargs)
 
-rtpy.bvh_build.build_tree = guarded
+rtpy._bvh_build.build_tree = guarded
 
 if os.environ["PLANT"] == "plant":  # the mistake the check must catch: a mesh rebuilt
     from rtpy.mesh import Mesh
@@ -54,7 +54,7 @@ if os.environ["PLANT"] == "plant":  # the mistake the check must catch: a mesh r
 
     def rebuild(self, state):
         keep(self, state)
-        self.tree = rtpy.bvh_build.build_tree(*self.triangle_boxes())
+        self.tree = rtpy._bvh_build.build_tree(*self.triangle_boxes())
 
     Mesh.__setstate__ = rebuild
 """

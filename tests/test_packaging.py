@@ -156,7 +156,7 @@ WITHOUT_TEST_EXTRAS = """
 import sys
 for name in ("pytest", "hypothesis", "_pytest"):
     sys.modules[name] = None  # not installed: `pip install rtpy` without [test]
-from rtpy.io.cli import main
+from rtpy.cli.main import main
 sys.exit(main(["render", "--help"]))
 """
 
@@ -175,4 +175,4 @@ def test_import_rtpy_loads_neither_numpy_nor_pillow_nor_tqdm():
     """They are for rendering and writing images; the scene classes do without."""
     loaded = modules_imported_by("import rtpy")
     assert "rtpy.vec3" in loaded
-    assert not loaded & {"numpy", "PIL", "tqdm", "importlib.metadata", "rtpy.renderer"}
+    assert not loaded & {"numpy", "PIL", "tqdm", "importlib.metadata", "rtpy.engine.renderer"}

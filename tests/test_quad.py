@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rtpy.checks import MIN_AREA
+from rtpy._checks import MIN_AREA
 from rtpy.interval import Interval
 from rtpy.materials import Lambertian
 from rtpy.quad import Quad

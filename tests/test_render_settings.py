@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import rtpy
-from rtpy.io.cli import UsageError
+from rtpy.cli.main import UsageError
 from rtpy.io.scene_file import SceneError, load_scene_text
 from rtpy.render_settings import (
     RENDER_KEYS,
@@ -25,8 +25,8 @@ from rtpy.scene import Scene
 from rtpy.sphere import Sphere
 from rtpy.vec3 import Color, Vec3
 
+from .cli.test_main import checked_by_the_command_line
 from .io.scene_text import VALUES, toml_value
-from .io.test_cli import checked_by_the_command_line
 
 
 def test_render_settings_fields_are_the_field_settings_with_their_defaults():

@@ -23,9 +23,7 @@ def bundled_dir() -> Path:
     except (ImportError, TypeError, ValueError):
         pass
     # A source checkout (or an editable install that does not map rtpy.scenes).
-    import rtpy
-
-    return Path(rtpy.__file__).resolve().parent.parent / "scenes"
+    return Path(__file__).resolve().parents[2] / "scenes"
 
 
 def _description(path: Path) -> str:

@@ -14,7 +14,7 @@ refuses a process, and when the child fails or dies. A child's exception is not
 passed on: the call here raises it again, with this process's traceback, so the
 answer is always the function's own.
 
-Signals: the child starts with SIGINT and SIGTERM held (rtpy.signals.held), then
+Signals: the child starts with SIGINT and SIGTERM held (rtpy.engine.signals.held), then
 ignores SIGINT (a terminal's Ctrl-C goes to every process of the group: this one
 stops the work) and ends at once on SIGTERM. Once result() returns or the `with`
 block is left, the child is gone.
@@ -29,7 +29,7 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-from .. import signals
+from ..engine import signals
 
 __all__ = ["Forked", "can_fork"]
 

@@ -12,7 +12,7 @@ Conventions used throughout rtpy:
   otherwise. Linear output (``.npy``, ``.pfm``, ``.exr``) is never encoded: it
   stores the radiance values exactly as rendered, unclamped.
 * ``.exr`` output needs the optional OpenEXR package (``pip install 'rtpy[exr]'``).
-* Every file is written atomically (rtpy.files.atomic_write): a crash or Ctrl-C
+* Every file is written atomically (rtpy.engine.files.atomic_write): a crash or Ctrl-C
   never leaves a half-written output file behind.
 * Output paths can (and should) be checked with :func:`check_image_path` or
   :func:`check_linear_path` *before* a long render starts, so that a typo in a
@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from ..display import Gamma, as_rgb, linear_to_srgb, png_info, to_8bit
-from ..files import (  # the file helpers, importable from here too
+from ..engine.display import Gamma, as_rgb, linear_to_srgb, png_info, to_8bit
+from ..engine.files import (  # the file helpers, importable from here too
     OutputError,
     StrPath,
     WriteError,

@@ -65,12 +65,12 @@ def load_mesh(path: Path, material, transform: Transform) -> tuple[Mesh, int]:
 
 
 def _key(path: Path, transform: Transform) -> str:
-    from .. import __version__
+    from ..engine.version import version
 
     stat = path.stat()
     parts = [
         FORMAT,
-        __version__,
+        version(),
         str(path.resolve()),
         stat.st_size,
         stat.st_mtime_ns,

@@ -9,7 +9,7 @@ import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from ..files import OutputError, StrPath, check_writable
+from ..engine.files import OutputError, StrPath, check_writable
 
 __all__ = ["check_folder", "check_output", "same_file"]
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterable
 
-from ..files import StrPath
-from ..rendered_image import RenderedImage
+from ..engine.files import StrPath
+from ..engine.rendered_image import RenderedImage
 from .image import check_image_path
 from .outputs import check_output
 

@@ -30,9 +30,8 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from .. import checks
-from ..camera import Camera
-from ..checks import (
+from .. import _checks as checks
+from .._checks import (
     ANY,
     ASPECT_RATIO,
     DEFOCUS_ANGLE,
@@ -44,6 +43,7 @@ from ..checks import (
     describe,
     suggest,
 )
+from ..camera import Camera
 from ..light import PointLight
 from ..materials import MATERIALS
 from ..materials.ranges import MATERIAL_RANGES

@@ -14,8 +14,8 @@ from dataclasses import KW_ONLY, dataclass
 from pathlib import Path
 from typing import Any
 
-from .. import checks
-from ..checks import ANY, Invalid, Range, describe, suggest
+from .. import _checks as checks
+from .._checks import ANY, Invalid, Range, describe, suggest
 from ..render_settings import SETTINGS, SettingError
 from ..vec3 import Color, Vec3
 from .toml_lines import TomlLines, Where, quote_key
@@ -123,7 +123,7 @@ class TableReader:
 
     # --- values -------------------------------------------------------------------
     def checked(self, where: Where, key: str, check: Callable, v: Any, *args) -> Any:
-        """check(v, *args) (one of rtpy.checks' checks), its Invalid as a SceneError."""
+        """check(v, *args) (one of rtpy._checks' checks), its Invalid as a SceneError."""
         try:
             return check(v, *args)
         except Invalid as e:

@@ -1,4 +1,4 @@
-"""The writers rtpy.io gives the core (rtpy.writer): RenderedImage.save writes the
+"""The writers rtpy.io gives the core (rtpy.engine.writer): RenderedImage.save writes the
 file formats of rtpy.io.image, and rtpy.render's preview= goes through
 rtpy.io.preview. Each is imported when first used: `import rtpy` imports this
 module, and loads neither numpy nor Pillow for it.
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..writer import register_writer
+from ..engine.writer import register_writer
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -16,8 +16,8 @@ if TYPE_CHECKING:
 
     import numpy as np
 
-    from ..display import Gamma
-    from ..files import StrPath
+    from ..engine.display import Gamma
+    from ..engine.files import StrPath
     from .preview import Preview
 
 __all__ = ["preview_target", "write_image"]

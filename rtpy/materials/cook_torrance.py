@@ -49,7 +49,7 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from ..checks import checked, string
+from .._checks import checked, string
 from ..hit_info import HitInfo
 from ..onb import ONB
 from ..ray import Ray

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..checks import boolean, checked
+from .._checks import boolean, checked
 from ..hit_info import HitInfo
 from ..vec3 import BLACK, Color
 from .material import Material, material_color

@@ -22,7 +22,7 @@ scattering() returns and never sample lights at them.
 
 from __future__ import annotations
 
-from ..checks import checked_color, checked_number
+from .._checks import checked_color, checked_number
 from ..hit_info import HitInfo
 from ..ray import Ray
 from ..scatter_info import ScatterInfo

@@ -5,7 +5,7 @@ scene loader (rtpy.io.scene_file, whose keys are the constructors' parameters).
 
 from __future__ import annotations
 
-from ..checks import EXPONENT, FUZZ, IOR, RADIANCE, ROUGHNESS, SIGMA, UNIT, Range
+from .._checks import EXPONENT, FUZZ, IOR, RADIANCE, ROUGHNESS, SIGMA, UNIT, Range
 
 __all__ = ["MATERIAL_RANGES"]
 

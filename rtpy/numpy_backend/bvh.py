@@ -1,7 +1,7 @@
 """Culling for primitive sets: a bounding volume hierarchy, and clusters of planar primitives.
 
 BVH is the batched twin of rtpy/bvh.py's search: the same flat tree (rtpy.bvh.Tree,
-built by rtpy/bvh_build.py), which all rays of a batch descend together, level by
+built by rtpy/_bvh_build.py), which all rays of a batch descend together, level by
 level, so a set of hundreds of spheres or a mesh of a million triangles costs only
 the boxes and primitives each ray comes near.
 
@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .. import bvh_build
+from .. import _bvh_build as bvh_build
 from .arrays import max3
 from .ray import ray_columns
 
@@ -36,7 +36,7 @@ BOX_CHUNK = 8192
 class BVH:
     """The search of an rtpy.bvh.Tree for many rays at once.
 
-    Built from K axis-aligned boxes (rtpy.bvh_build), or given a tree built already
+    Built from K axis-aligned boxes (rtpy._bvh_build), or given a tree built already
     (a Mesh's, which travels with the scene to every worker).
     """
 

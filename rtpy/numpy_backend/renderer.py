@@ -1,6 +1,6 @@
-"""NumpyBackend: the numpy backend of rtpy.renderer's one render loop.
+"""NumpyBackend: the numpy backend of rtpy.engine.renderer's one render loop.
 
-The loop (rtpy/renderer.py) and the plan (rtpy/plan.py) are the scalar backend's:
+The loop (rtpy/engine/renderer.py) and the plan (rtpy/engine/plan.py) are the scalar backend's:
 passes over the image cut into units of work, each unit drawing from its own
 generator seeded by (seed, region, pass), sums added in pass order, so the same
 seed gives the same image, bit for bit, wherever the units run. What differs is the
@@ -9,7 +9,7 @@ one wavefront of at most MAX_RAYS paths (numpy's cost per call is paid per segme
 of a wavefront, so small wavefronts are slow), and memory is bounded by the unit
 size, not by image size times spp. (The scalar and numpy backends draw different
 random numbers: their images agree up to Monte Carlo noise, not bit for bit.)
-Registered as "numpy" by rtpy.backends.
+Registered as "numpy" by rtpy.engine.backends.
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ from functools import partial
 
 import numpy as np
 
-from ..backend import Backend
-from ..memory import reuse_freed_memory
-from ..plan import Plan, Unit
+from ..engine.backend import Backend
+from ..engine.memory import reuse_freed_memory
+from ..engine.plan import Plan, Unit
 from .camera import CameraRays
 from .integrators import BatchIntegrator, make_integrator
 from .sampler import BATCH_SAMPLERS, LaneSampler
@@ -93,7 +93,7 @@ def keep_freed_memory() -> None:
     temporaries of a few hundred KB (arrays over a unit's rays) thousands of times per
     second; by default glibc maps each one freshly from the kernel and unmaps it when
     it is freed, so every page of every temporary faults on first touch, a large share
-    of the render time. rtpy.memory.reuse_freed_memory sets malloc's documented tuning
+    of the render time. rtpy.engine.memory.reuse_freed_memory sets malloc's documented tuning
     (mallopt: the mmap and trim thresholds), process-wide: here the process keeps up to
     128 MB of freed memory for reuse instead of returning it."""
     global _malloc_tuned

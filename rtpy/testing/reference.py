@@ -131,9 +131,11 @@ def render_reference(
 ) -> tuple[np.ndarray, np.ndarray, dict]:
     """(image, variance of the image, settings) by REFERENCE_RENDERS independent
     numpy-backend renders with path tracing, next-event estimation and MIS."""
-    from .. import load_scene, render
+    from ..engine.render_request import render
+    from ..io.bundled import resolve_scene
+    from ..io.scene_file import load_scene
 
-    scene = load_scene(str(scene_path))
+    scene = load_scene(resolve_scene(str(scene_path)))
     per = max(1, -(-spp // REFERENCE_RENDERS))
     start = time.perf_counter()
     images = np.stack(

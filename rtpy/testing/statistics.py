@@ -9,7 +9,7 @@
   p-value of a chi-square statistic x with k degrees of freedom.
 - block_z_test compares two images block by block against the noise each side
   measured (used by the graders and by the backends' agreement test).
-- peak_memory_mb / reset_peak_memory: rtpy.memory's, kept here by name.
+- peak_memory_mb / reset_peak_memory: rtpy.engine.memory's, kept here by name.
 
 The module imports only numpy and the standard library.
 """
@@ -22,7 +22,11 @@ from statistics import NormalDist
 
 import numpy as np
 
-from ..memory import max_rss_mb, peak_memory_mb, reset_peak_memory  # importable from here too
+from ..engine.memory import (  # importable from here too
+    max_rss_mb,
+    peak_memory_mb,
+    reset_peak_memory,
+)
 
 __all__ = [
     "BLOCK",

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import pytest
 
+from rtpy.cli.main import main
 from rtpy.grading.assignment import (
     NUMPY_USE,
     TEST_WEEKS_FILE,
@@ -48,7 +49,6 @@ from rtpy.grading.assignment import (
     student_pytest_options,
     weeks_of_tests,
 )
-from rtpy.io.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -236,7 +236,7 @@ def run_driver(repo: Path, driver: str, *args: str) -> tuple[dict, subprocess.Co
 SOLVED_DRIVER = """
 import json, sys
 from rtpy.grading import grade
-from rtpy.io.cli import main
+from rtpy.cli.main import main
 results = grade(sys.argv[1])
 out = sys.argv[2]
 renders = [main(["render", s, "--width", "16", "--spp", "1", "--max-depth", "3", "-o", out])

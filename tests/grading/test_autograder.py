@@ -35,9 +35,9 @@ from pathlib import Path
 
 import pytest
 
+from rtpy.cli.main import main
 from rtpy.grading.assignment import WEEKS, make_assignment
 from rtpy.grading.autograder import build_autograder, extract, task_files, task_regions
-from rtpy.io.cli import main
 
 from .test_assignment import MAKING, side_by_side
 

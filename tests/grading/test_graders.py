@@ -44,11 +44,11 @@ from rtpy import (
     Sphere,
     Triangle,
 )
+from rtpy.cli.main import main
 from rtpy.grading import compare, summarize
 from rtpy.grading.assignment import WEEKS
 from rtpy.grading.graders import collect_graders, local_probe
 from rtpy.grading.tasks import load_weeks
-from rtpy.io.cli import main
 from rtpy.materials import BlinnPhong, CookTorrance, Lambertian, Metal, Phong, Ward
 from rtpy.vec3 import Vec3
 

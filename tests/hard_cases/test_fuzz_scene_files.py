@@ -5,7 +5,7 @@ breaks it: wrong types, NaN and infinite numbers, unknown and missing keys,
 references to materials and textures that do not exist, degenerate quads and
 triangles of zero area, vup parallel to the view direction, zero, negative and
 absurd sizes (width 10^9, spp 0, a negative radius, a 2^70 integer), tables where
-values belong, and cut or garbled text. `rtpy.io.cli.main` runs in-process on the
+values belong, and cut or garbled text. `rtpy.cli.main.main` runs in-process on the
 file and must either render it (exit 0, a complete PNG) or print ONE line
 `rtpy: error: FILE: [table] key: ...` and exit 2 with nothing written: never a
 traceback, never a partial file. A few cases also run as real subprocesses.
@@ -28,7 +28,7 @@ from hypothesis import event, given
 from hypothesis import strategies as st
 from PIL import Image
 
-from rtpy.io.cli import main
+from rtpy.cli.main import main
 from tests.io.scene_text import VALUES, to_toml
 
 from ..commands import run_cli
@@ -170,7 +170,7 @@ def broken_files(draw) -> tuple[str, list[str]]:
 
 
 def run_main(argv: list[str]) -> tuple[int, str]:
-    """(exit status, stderr) of rtpy.io.cli.main run in this process."""
+    """(exit status, stderr) of rtpy.cli.main.main run in this process."""
     err = io.StringIO()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
         try:

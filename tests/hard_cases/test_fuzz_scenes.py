@@ -22,7 +22,7 @@ from hypothesis import given
 from PIL import Image
 
 import rtpy
-from rtpy.checks import MAX_RADIANCE
+from rtpy._checks import MAX_RADIANCE
 from rtpy.io.scene_file import SceneError, load_scene_text
 from tests.io.scene_text import to_toml
 

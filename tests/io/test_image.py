@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from rtpy.engine.rendered_image import RenderedImage
 from rtpy.io.image import (
     OutputError,
     WriteError,
@@ -24,7 +25,6 @@ from rtpy.io.image import (
     write_pfm,
     write_png,
 )
-from rtpy.rendered_image import RenderedImage
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

@@ -9,7 +9,7 @@ import os
 import numpy as np
 import pytest
 
-from rtpy.bench.meshes import uv_sphere, write_obj
+from rtpy.cli.bench.meshes import uv_sphere, write_obj
 from rtpy.io import mesh_cache
 from rtpy.io.mesh_cache import cache_folder, load_mesh
 from rtpy.materials import Lambertian

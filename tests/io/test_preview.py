@@ -10,9 +10,9 @@ import pytest
 from PIL import Image
 
 import rtpy
-from rtpy.files import OutputError
+from rtpy.engine.files import OutputError
+from rtpy.engine.rendered_image import RenderedImage
 from rtpy.io.preview import notebook_preview, preview_target
-from rtpy.rendered_image import RenderedImage
 
 
 def image(value: float) -> RenderedImage:

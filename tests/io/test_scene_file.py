@@ -11,9 +11,9 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
-from rtpy import checks
+from rtpy import _checks as checks
+from rtpy._checks import COORDINATE, LENGTH, RADIANCE, UNIT, Range
 from rtpy.camera import MAX_PIXELS, Camera
-from rtpy.checks import COORDINATE, LENGTH, RADIANCE, UNIT, Range
 from rtpy.io.material_params import material_parameters
 from rtpy.io.scene_file import (
     MAX_HEIGHT,

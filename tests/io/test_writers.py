@@ -1,14 +1,14 @@
 """rtpy.io.writers: `import rtpy` registers rtpy.io's image formats and previews with
-the core (rtpy.writer), and loads them only when first used."""
+the core (rtpy.engine.writer), and loads them only when first used."""
 
 from __future__ import annotations
 
 import numpy as np
 
 import rtpy
+from rtpy.engine.writer import writer
 from rtpy.io import writers
 from rtpy.io.image import read_pfm
-from rtpy.writer import writer
 
 from ..commands import modules_imported_by
 
@@ -36,5 +36,5 @@ def test_the_preview_writer_is_rtpy_io_preview_s(tmp_path):
 
 def test_registering_loads_neither_the_formats_nor_the_previews():
     loaded = modules_imported_by("import rtpy.io.writers")
-    assert "rtpy.writer" in loaded
+    assert "rtpy.engine.writer" in loaded
     assert not loaded & {"rtpy.io.image", "rtpy.io.preview", "numpy", "PIL"}

@@ -26,7 +26,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from rtpy.checks import ROUGHNESS
+from rtpy._checks import ROUGHNESS
 from rtpy.materials import CookTorrance
 from rtpy.vec3 import Color, Vec3
 

@@ -7,7 +7,7 @@ import inspect
 
 import pytest
 
-from rtpy.checks import Range
+from rtpy._checks import Range
 from rtpy.materials import MATERIALS, Lambertian, Metal
 from rtpy.materials.ranges import MATERIAL_RANGES
 

@@ -27,7 +27,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from rtpy.checks import ROUGHNESS
+from rtpy._checks import ROUGHNESS
 from rtpy.materials import Ward
 from rtpy.onb import ONB
 from rtpy.vec3 import Color, Vec3

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import rtpy
-from rtpy.io.cli import main
+from rtpy.cli.main import main
 from rtpy.materials.material import Material
 from rtpy.numpy_backend import renderer as numpy_renderer
 from rtpy.numpy_backend.materials.fallback import ScalarFallback
@@ -17,7 +17,7 @@ from rtpy.ray import spawn_ray
 from rtpy.scatter_info import ScatterInfo
 from rtpy.vec3 import Color
 
-from ..test_renderer import InterruptAfter, small_scene
+from ..engine.test_renderer import InterruptAfter, small_scene
 from .test_agreement import SEEDS, compare
 
 

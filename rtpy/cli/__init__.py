@@ -1,0 +1,1 @@
+"""The command line (`python -m rtpy`): rendering, scenes, grading, `bench`."""

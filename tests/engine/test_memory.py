@@ -1,0 +1,177 @@
+"""rtpy.engine.memory: the peak resident memory of a piece of work, with and without /proc
+and the `resource` module."""
+
+from __future__ import annotations
+
+import mmap
+import os
+import platform
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from rtpy.engine.memory import peak_memory_mb, reset_peak_memory
+
+
+def touched_pages(megabytes: int) -> mmap.mmap:
+    """Fresh anonymous memory, every page written (small pages: the resident size
+    grows by exactly this much, whatever the allocator or numpy would reuse)."""
+    memory = mmap.mmap(-1, megabytes << 20)
+    if hasattr(mmap, "MADV_NOHUGEPAGE"):
+        memory.madvise(mmap.MADV_NOHUGEPAGE)
+    np.frombuffer(memory, dtype=np.uint8)[::4096] = 1
+    return memory
+
+
+def test_peak_memory_sees_an_allocation_and_a_reset_forgets_it():
+    assert peak_memory_mb() > 0
+    if not reset_peak_memory():
+        pytest.skip("the peak can be reset on Linux only")
+    start = peak_memory_mb()
+    memory = touched_pages(64)
+    grown = peak_memory_mb()
+    memory.close()
+    reset_peak_memory()
+    after_reset = peak_memory_mb()
+    assert grown >= start + 60
+    assert after_reset < grown - 50
+    assert peak_memory_mb(children=True) >= after_reset
+
+
+def test_import_and_peak_memory_work_without_the_resource_module():
+    """Windows has no `resource`: importing the module must not need it, and peak
+    memory falls back to what the platform offers (NaN when nothing)."""
+    code = (
+        "import sys; sys.modules['resource'] = None\n"
+        "import builtins, math\n"
+        "real_open = builtins.open\n"
+        "def no_proc(path, *a, **k):\n"
+        "    if str(path).startswith('/proc/'): raise OSError('no /proc')\n"
+        "    return real_open(path, *a, **k)\n"
+        "from rtpy.engine.memory import peak_memory_mb, reset_peak_memory\n"
+        "builtins.open = no_proc\n"
+        "print(reset_peak_memory(), math.isnan(peak_memory_mb()), "
+        "math.isnan(peak_memory_mb(children=True)))\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split() == ["False", "True", "True"]
+
+
+REUSE_CHILD = """
+import resource, sys
+import numpy as np
+from rtpy.engine.memory import reuse_freed_memory
+
+if sys.argv[1] == "reuse" and not reuse_freed_memory():
+    print("unsupported")
+    sys.exit(0)
+np.ones(96 << 17)  # 96 MB, freed at once
+before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+np.ones(96 << 17)
+print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
+"""
+
+
+def child_says(code: str, mode: str) -> str:
+    """What a fresh process running `code` with argument `mode` prints (the settings
+    are process-wide), under glibc's and numpy's own defaults: no malloc thresholds or
+    huge-page choice taken from the environment."""
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if not k.startswith(("MALLOC_", "GLIBC_TUNABLES", "NUMPY_MADVISE_HUGEPAGE"))
+    }
+    return subprocess.run(
+        [sys.executable, "-c", code, mode], capture_output=True, text=True, check=True, env=env
+    ).stdout.strip()
+
+
+def faults_of_a_second_array(mode: str) -> str:
+    """The page faults of allocating and filling a 96 MB array a second time."""
+    return child_says(REUSE_CHILD, mode)
+
+
+def test_freed_memory_is_reused_without_faulting_it_in_again():
+    found = faults_of_a_second_array("reuse")
+    if found == "unsupported":
+        assert platform.libc_ver()[0] != "glibc"  # glibc has mallopt
+        pytest.skip("the C library keeps its own policy (not glibc)")
+    # 96 MB faulted in again would be 24,576 small pages or 48 huge ones; reused, a
+    # handful (the array's header, a page the heap grew by).
+    assert int(found) < 16
+    # The check can fail: without the setting glibc unmaps the freed block.
+    assert int(faults_of_a_second_array("default")) >= 16
+
+
+GIVE_BACK_CHILD = """
+import sys
+import numpy as np
+from rtpy.engine.memory import give_back_freed_memory, reuse_freed_memory
+
+def resident_mb():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * 4096 / 2**20
+
+if not reuse_freed_memory():
+    print("unsupported")
+    sys.exit(0)
+np.ones(96 << 17)  # 96 MB, freed at once and kept
+kept = resident_mb()
+if sys.argv[1] == "give back":
+    give_back_freed_memory()
+print(kept - resident_mb())
+"""
+
+
+def test_freed_memory_kept_for_reuse_is_given_back():
+    given_back = child_says(GIVE_BACK_CHILD, "give back")
+    if given_back == "unsupported":
+        assert platform.libc_ver()[0] != "glibc"  # glibc has mallopt and malloc_trim
+        pytest.skip("the C library keeps its own policy (not glibc)")
+    assert float(given_back) >= 90  # of the 96 MB freed
+    # The check can fail: kept, the freed block stays resident.
+    assert float(child_says(GIVE_BACK_CHILD, "keep")) < 5
+
+
+PAGES_CHILD = """
+import resource, sys
+import numpy as np
+from rtpy.engine.memory import avoid_huge_pages
+
+if sys.argv[1] == "small" and not avoid_huge_pages():
+    print("unsupported")
+    sys.exit(0)
+before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+np.ones(96 << 17)  # 96 MB, fresh
+print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
+"""
+SMALL_PAGES = (96 << 20) // 4096
+
+
+def huge_pages_on_request() -> bool:
+    """The kernel gives transparent huge pages to memory that asks for them only."""
+    try:
+        with open("/sys/kernel/mm/transparent_hugepage/enabled") as f:
+            return "[madvise]" in f.read()
+    except OSError:
+        return False
+
+
+def faults_of_a_fresh_array(mode: str) -> str:
+    """The page faults of allocating and filling a fresh 96 MB array."""
+    return child_says(PAGES_CHILD, mode)
+
+
+def test_numpy_arrays_get_small_pages():
+    """avoid_huge_pages: a fresh 96 MB array is faulted in by 4 kB pages, as many
+    faults as pages, not by 48 huge ones the kernel may compact memory to find."""
+    found = faults_of_a_fresh_array("small")
+    if found == "unsupported":
+        assert not sys.platform.startswith("linux")  # numpy asks for huge pages on Linux
+        pytest.skip("numpy asks for no huge pages here")
+    if not huge_pages_on_request():
+        pytest.skip("the kernel's huge pages are not given on request")
+    assert int(found) >= SMALL_PAGES  # numpy's default here: 49 faults (huge pages)
