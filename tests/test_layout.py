@@ -13,7 +13,8 @@ the modules.
   materials/ and integrators/: what a student reads, private `_` helpers included),
   the engine (engine/: the render loop, backends, workers, files, signals; and the
   vectorized twin numpy_backend/), the files (io/), the checks (testing/, grading/
-  and the front door `rtpy/__init__.py`) and the command line (cli/). A module imports from its own floor or below, anywhere in it except under
+  and the front door `rtpy/__init__.py`) and the command line (cli/). A module
+  imports from its own floor or below, anywhere in it except under
   `if TYPE_CHECKING:`, but for UPWARD_IMPORTS, each with why; and no modules import
   each other in a circle at import time (their module-level imports).
 
