@@ -69,6 +69,7 @@ if TYPE_CHECKING:
 _LAZY = {
     "RenderedImage": ".rendered_image",
     "Renderer": ".renderer",
+    "ladder": ".lecture_ladder",
     "mesh_from_obj": ".io.obj",
     "mesh_from_ply": ".io.ply",
 }
@@ -150,4 +151,5 @@ __all__ = [
     "load_plugin",
     "load_scene",
     "render",
+    "ladder",
 ]

@@ -113,6 +113,9 @@ def build_parser(prog: str = "rtpy", every_command: bool = True) -> argparse.Arg
 
     add_bench_parser(sub)
     add_assignment_commands(sub, seconds)
+    from .cli_ladder import add_ladder_parser
+
+    add_ladder_parser(sub)
     return parser
 
 
@@ -470,6 +473,10 @@ def _run_command(args: argparse.Namespace) -> int:
         from ..bench.command import command_bench
 
         return command_bench(args)
+    if args.command == "ladder":
+        from .cli_ladder import command_ladder
+
+        return command_ladder(args)
     if args.command in ("assignment", "grade"):
         from .cli_assignment import command_assignment
 
