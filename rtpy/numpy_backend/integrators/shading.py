@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..arrays import add_rows
+from ..sampler import first_hit_generator
 from .direct_lighting import light_sample_estimate
 from .integrator import BatchIntegrator
 
@@ -36,8 +37,9 @@ class ShadingIntegrator(BatchIntegrator):
         if ns.size == 0 or scene.lights.n == 0:
             return out
         part = hits if ns.size == h.size else hits.take(ns)
+        draw = first_hit_generator(rng, h[ns], 1)  # a sampler's first-hit numbers
         for k in range(scene.lights.n):
-            s = scene.lights.sample_chosen(part.point, np.full(ns.size, k), rng)
+            s = scene.lights.sample_chosen(part.point, np.full(ns.size, k), draw)
             light = light_sample_estimate(
                 scene, part, ids[ns], s, 1, mis=False, shadows=self.settings.shadows
             )
