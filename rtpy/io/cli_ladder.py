@@ -38,7 +38,7 @@ def add_ladder_parser(sub) -> None:
     p.add_argument(
         "-o", "--output", metavar="OUT.png", help="the strip (.png/.jpg); default SCENE_ladder.png"
     )
-    add_setting_options(p)
+    add_setting_options(p, hidden=("integrator",))  # each rung sets it
     p.set_defaults(time_limit=None)  # no --time: a limit per rung is --set time_limit=S
     cpus = min(available_cpus(), MAX_WORKERS)
     p.add_argument(
