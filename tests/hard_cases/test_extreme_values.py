@@ -122,7 +122,8 @@ def offset(p: list[float], v: list[float]) -> list[float]:
     out = []
     for a, b in zip(p, v, strict=True):
         inward = math.copysign(min(abs(b), MAX_COORD + abs(a)), a)
-        out.append(a + b if abs(a + b) <= MAX_COORD else a - inward)
+        c = a + b if abs(a + b) <= MAX_COORD else a - inward
+        out.append(min(max(c, -MAX_COORD), MAX_COORD))  # a - inward may round past the end
     return out
 
 
