@@ -85,14 +85,15 @@ def ladder_strip(images: list[RenderedImage], labels: list[str] | None = None) -
     width, height = images[0].width, images[0].height
     if any((im.width, im.height) != (width, height) for im in images):
         raise ValueError("images: expected images of one size")
-    n = len(images)
-    strip = Image.new("RGB", (n * width + (n - 1) * GAP, LABEL_HEIGHT + height), (24, 24, 24))
-    draw = ImageDraw.Draw(strip)
+    n, dark = len(images), (24, 24, 24)
+    strip = Image.new("RGB", (n * width + (n - 1) * GAP, LABEL_HEIGHT + height), dark)
     font = _font(LABEL_HEIGHT - 8)
     for k, (image, label) in enumerate(zip(images, labels, strict=True)):
         x = k * (width + GAP)
+        band = Image.new("RGB", (width, LABEL_HEIGHT), dark)  # a long label is cut at its panel
+        ImageDraw.Draw(band).text((4, 4), label, fill=(235, 235, 235), font=font)
+        strip.paste(band, (x, 0))
         strip.paste(image.pil, (x, LABEL_HEIGHT))
-        draw.text((x + 4, 4), label, fill=(235, 235, 235), font=font)
     return strip
 
 

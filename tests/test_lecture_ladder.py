@@ -62,6 +62,10 @@ def test_strip_places_each_image_under_its_label(images):
         np.testing.assert_array_equal(pixels[LABEL_HEIGHT:, x : x + w], np.asarray(image.pil))
         band = pixels[:LABEL_HEIGHT, x : x + w]
         assert (band > 128).any(), f"no label drawn over panel {k}"
+    # labels longer than a panel (these are 24 px wide) are cut at its edge: the gaps
+    # between panels stay dark
+    gaps = [pixels[:, k * (w + GAP) - GAP : k * (w + GAP)] for k in range(1, 5)]
+    assert all((gap == gaps[0][0, 0]).all() for gap in gaps) and gaps[0][0, 0].max() < 64
 
 
 def test_strip_refuses_mismatched_labels_and_sizes(images):
