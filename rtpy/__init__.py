@@ -70,6 +70,7 @@ if TYPE_CHECKING:
 _LAZY = {
     "RenderedImage": ".engine.rendered_image",
     "Renderer": ".engine.renderer",
+    "ladder": ".io.ladder",
     "mesh_from_obj": ".io.obj",
     "mesh_from_ply": ".io.ply",
 }
@@ -151,4 +152,5 @@ __all__ = [
     "load_plugin",
     "load_scene",
     "render",
+    "ladder",
 ]

@@ -47,7 +47,7 @@ __all__ = [
     "unknown_setting",
 ]
 
-INTEGRATOR_NAMES = ("center", "jittered", "direct", "whitted", "path")
+INTEGRATOR_NAMES = ("center", "jittered", "shading", "direct", "whitted", "path")
 
 # Sanity limits: larger values would exhaust memory or never finish.
 MAX_WIDTH = 16384
@@ -132,7 +132,8 @@ SETTINGS: dict[str, Setting] = {
             "choice",
             "path",
             '"center" (one ray per pixel centre, flat colours), "jittered" (spp random '
-            'rays per pixel, flat colours), "direct" (one bounce of direct light), '
+            'rays per pixel, flat colours), "shading" (local shading from every light, '
+            'shadow rays only with shadows = true), "direct" (one bounce of direct light), '
             '"whitted" (direct light, recursive mirrors and glass) or "path" (unbiased '
             "path tracing)",
             choices=INTEGRATOR_NAMES,
@@ -169,6 +170,29 @@ SETTINGS: dict[str, Setting] = {
             5,
             "segment index after which paths may end at random; 0 = off",
             NON_NEGATIVE,
+        ),
+        Setting(
+            "roulette",
+            "choice",
+            "throughput",
+            '"path": how Russian roulette picks the survival probability q: "throughput" '
+            '(q = min(0.95, max component of the path throughput)) or "fixed" (q = '
+            "roulette_probability, the lecture's p_RR); a survivor is divided by q",
+            choices=("throughput", "fixed"),
+        ),
+        Setting(
+            "roulette_probability",
+            "float",
+            0.8,
+            '"path" with roulette = "fixed": the probability q that a path goes on',
+            Range(0, 1, lo_open=True),
+        ),
+        Setting(
+            "shadows",
+            "bool",
+            False,
+            '"shading": false = every light reaches every point it faces (no shadow rays); '
+            "true = a shadow ray per light",
         ),
         Setting("seed", "int", 0, "random seed", SEED, flag=True),
         Setting(
@@ -258,6 +282,9 @@ class RenderSettings:
     max_depth: int = SETTINGS["max_depth"].default
     nee: bool = SETTINGS["nee"].default
     russian_roulette: int = SETTINGS["russian_roulette"].default
+    roulette: str = SETTINGS["roulette"].default
+    roulette_probability: float = SETTINGS["roulette_probability"].default
+    shadows: bool = SETTINGS["shadows"].default
     seed: int = SETTINGS["seed"].default
     gamma: float | str = SETTINGS["gamma"].default
     mis: bool = SETTINGS["mis"].default

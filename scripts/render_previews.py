@@ -17,7 +17,8 @@ from rtpy.io.bundled import bundled_scenes
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "scenes"
 
 # width, spp per scene; everything else comes from the scene file. Scenes listed in
-# NUMPY render with the numpy backend (rough glass needs many samples to look smooth).
+# NUMPY render with the numpy backend (rough glass needs many samples to look smooth;
+# week06_ladder's preview is made with its ladder strip, also on the numpy backend).
 SETTINGS = {
     "cornell": (160, 128),
     "rtiow_cover": (240, 16),
@@ -30,8 +31,9 @@ SETTINGS = {
     "material_gallery": (400, 32),
     "teapot": (320, 32),
     "week08_rough_glass": (320, 1024),
+    "week06_ladder": (320, 64),
 }
-NUMPY = {"week08_rough_glass"}
+NUMPY = {"week08_rough_glass", "week06_ladder"}
 
 
 def main() -> int:

@@ -68,13 +68,16 @@ def flag(name: str) -> str:
     return "--" + name.replace("_", "-")
 
 
-def add_setting_options(r: argparse.ArgumentParser) -> None:
+def add_setting_options(r: argparse.ArgumentParser, hidden: tuple[str, ...] = ()) -> None:
     """--NAME for the render settings that have a flag, and --set KEY=VALUE for all
-    of them (rtpy.render_settings.SETTINGS); the values are checked after parsing."""
+    of them (rtpy.render_settings.SETTINGS); the values are checked after parsing.
+    The flags of `hidden` are parsed but left out of the help (a command that refuses
+    them says so in one line)."""
     for name, setting in SETTINGS.items():
         if setting.flag:
             metavar = {"int": "N", "float": "X", "choice": "NAME"}.get(setting.kind)
-            r.add_argument(flag(name), dest=name, metavar=metavar, help=setting.help)
+            text = argparse.SUPPRESS if name in hidden else setting.help
+            r.add_argument(flag(name), dest=name, metavar=metavar, help=text)
     r.add_argument(
         "--set",
         action="append",
@@ -113,6 +116,9 @@ def build_parser(prog: str = "rtpy", every_command: bool = True) -> argparse.Arg
 
     add_bench_parser(sub)
     add_assignment_commands(sub, seconds)
+    from .ladder import add_ladder_parser
+
+    add_ladder_parser(sub)
     return parser
 
 
@@ -470,6 +476,10 @@ def _run_command(args: argparse.Namespace) -> int:
         from .bench.command import command_bench
 
         return command_bench(args)
+    if args.command == "ladder":
+        from .ladder import command_ladder
+
+        return command_ladder(args)
     if args.command in ("assignment", "grade"):
         from .assignment import command_assignment
 

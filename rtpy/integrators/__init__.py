@@ -6,11 +6,13 @@ from .direct import DirectIntegrator
 from .integrator import Integrator
 from .jittered import JitteredIntegrator
 from .path import PathIntegrator
+from .shading import ShadingIntegrator
 from .whitted import WhittedIntegrator
 
 INTEGRATORS: dict[str, type[Integrator]] = {
     "center": CenterIntegrator,
     "jittered": JitteredIntegrator,
+    "shading": ShadingIntegrator,
     "direct": DirectIntegrator,
     "whitted": WhittedIntegrator,
     "path": PathIntegrator,
@@ -28,6 +30,7 @@ __all__ = [
     "Integrator",
     "JitteredIntegrator",
     "PathIntegrator",
+    "ShadingIntegrator",
     "WhittedIntegrator",
     "make_integrator",
 ]

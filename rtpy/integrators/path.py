@@ -19,7 +19,7 @@ class PathIntegrator(Integrator):
     throughput `beta` by its weight BRDF * cos / pdf.
 
     max_depth counts ray segments, the camera ray included. After segment
-    `russian_roulette` a path survives with probability q = min(0.95, max(beta))
+    `russian_roulette` a path survives with probability q (survival_probability)
     and is then divided by q, which ends weak paths early without bias.
     With nee = False, area lights are found only by BRDF sampling (the course's
     week-5 "random scattering"); point lights can only be reached by sampling
@@ -70,10 +70,18 @@ class PathIntegrator(Integrator):
             prev_point, prev_pdf, prev_specular = hit.point, scatter.pdf, scatter.is_specular
             ray = scatter.scattered_ray
             if rr_start and segment >= rr_start:
-                survive = min(0.95, beta.max_component())
+                survive = self.survival_probability(beta)
                 if random_double() >= survive:
                     break
                 beta = beta / survive
             segment += 1
         return result
         # END SOLUTION
+
+    def survival_probability(self, beta: Color) -> float:
+        """Russian roulette's q for a path of throughput beta: min(0.95, max(beta))
+        (roulette = "throughput": weak paths end sooner), or the lecture's fixed p_RR
+        (roulette = "fixed": roulette_probability, whatever the path carries)."""
+        if self.settings.roulette == "fixed":
+            return self.settings.roulette_probability
+        return min(0.95, beta.max_component())

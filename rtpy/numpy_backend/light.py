@@ -95,6 +95,14 @@ class LightTable:
             return self.sample_single(p, rng)
         u = rng.random(n)
         choice = np.minimum((u * n_lights).astype(np.int64), n_lights - 1)
+        return self.sample_chosen(p, choice, rng)
+
+    def sample_chosen(
+        self, p: np.ndarray, choice: np.ndarray, rng: np.random.Generator
+    ) -> LightSamples:
+        """One light sample per receiving point p (N, 3) from the light choice (N,)
+        (an index into the lights: point lights first), a direction toward it."""
+        n = len(p)
         out = LightSamples(
             np.zeros((n, 3)),
             np.zeros(n),

@@ -208,7 +208,11 @@ class SceneMaker:
             "russian_roulette": r.randint(0, 3),
             "seed": r.randint(0, 2**32),
             "gamma": r.choice([1.0, 2.2]),
+            "shadows": r.random() < 0.5,
         }
+        if r.random() < 0.5:  # the lecture's fixed p_RR, in (0, 1]
+            table["roulette"] = "fixed"
+            table["roulette_probability"] = 1.0 - r.random()
         if r.random() < 0.5:
             table["sky"] = True
         else:

@@ -122,7 +122,8 @@ def offset(p: list[float], v: list[float]) -> list[float]:
     out = []
     for a, b in zip(p, v, strict=True):
         inward = math.copysign(min(abs(b), MAX_COORD + abs(a)), a)
-        out.append(a + b if abs(a + b) <= MAX_COORD else a - inward)
+        c = a + b if abs(a + b) <= MAX_COORD else a - inward
+        out.append(min(max(c, -MAX_COORD), MAX_COORD))  # a - inward may round past the end
     return out
 
 
@@ -227,7 +228,12 @@ def shapes(draw, anchor: list[float], material: str) -> dict:
             dv = across(du)
         edges = [scaled(du, draw(LENGTH)), scaled(dv, draw(LENGTH))]
         q, (u, v) = fit_edges(at, edges)
-        if kind == "quad" and norm(cross(u, v)) >= 2e-12 and min(norm(u), norm(v)) >= 1e-6:
+        lengths = (norm(u), norm(v))  # a unit direction times 1e6 may round past 1e6
+        if (
+            kind == "quad"
+            and norm(cross(u, v)) >= 2e-12
+            and 1e-6 <= min(lengths) <= max(lengths) <= 1e6
+        ):
             return {"type": "quad", "q": q, "u": u, "v": v, "material": material}
         a, b, c = q, add(q, u), add(q, v)
         if norm(cross(add(b, a, -1.0), add(c, a, -1.0))) >= 2e-12:

@@ -113,7 +113,7 @@ intensity = [{big}, {big}, {big}]
 """
 
 
-@pytest.mark.parametrize("integrator", ["path", "whitted", "direct"])
+@pytest.mark.parametrize("integrator", ["path", "whitted", "direct", "shading"])
 def test_largest_radiances_and_weights_sum_without_overflow(scene_dir, integrator):
     """Found while testing the fuzzer's limits: emit = 1e308 is finite and >= 0, as
     the contract asks, but the sum of two samples is inf, so the pixel was Inf (and

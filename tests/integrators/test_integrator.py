@@ -18,7 +18,7 @@ from rtpy.testing.analytic_scenes import (
 
 
 def test_every_integrator_is_registered_by_its_scene_name():
-    assert set(INTEGRATORS) == {"center", "jittered", "direct", "whitted", "path"}
+    assert set(INTEGRATORS) == {"center", "jittered", "shading", "direct", "whitted", "path"}
     for name, cls in INTEGRATORS.items():
         assert cls.name == name
         integrator = make_integrator(RenderSettings(integrator=name, max_depth=3))

@@ -6,12 +6,15 @@ from __future__ import annotations
 
 import contextlib
 import math
+import statistics
 
 import pytest
 
 import rtpy
 from rtpy import Camera, Color, RenderSettings, Scene, Sphere, Vec3
 from rtpy.integrators import make_integrator
+from rtpy.ray import Ray
+from rtpy.sampling import make_generator, use_generator
 from rtpy.testing.analytic_scenes import GlowingLambertian
 
 from .estimates import box_scene, per_ray_z, z_limit
@@ -98,3 +101,27 @@ def test_the_comparison_catches_light_counted_twice(
     args = (n_reference, n_planted, seed_reference, seed_planted, light_counted_twice)
     zs = per_ray_z(scene, rays, good, bad, *args)
     assert max(abs(z[0]) for z in zs) > z_limit(len(rays))
+
+
+@pytest.mark.parametrize("probability", [0.5, 0.9])
+def test_fixed_roulette_in_glowing_sphere_converges_to_le_over_one_minus_rho(probability):
+    """The lecture's fixed p_RR: inside the glowing sphere (L = Le / (1 - rho) = 1),
+    paths that survive with probability p from segment 2 on and are divided by p have
+    the exact mean, whatever p (z-test against the measured noise)."""
+    rho, le = 0.5, 0.5
+    sphere = Sphere(Vec3(0, 0, 0), 2.0, GlowingLambertian(Color(rho, rho, rho), Color(le, le, le)))
+    settings = RenderSettings(
+        integrator="path",
+        max_depth=500,
+        russian_roulette=2,
+        roulette="fixed",
+        roulette_probability=probability,
+    )
+    integrator = make_integrator(settings)
+    ray = Ray(Vec3(0.3, -0.2, 0.1), Vec3(0.0, 0.6, -0.8))
+    n = 3000
+    with use_generator(make_generator(17)):
+        samples = [integrator.compute_scattering(ray, Scene([sphere])).e0 for _ in range(n)]
+    mean, se = statistics.fmean(samples), statistics.stdev(samples) / math.sqrt(n)
+    assert se > 0
+    assert abs(mean - le / (1 - rho)) < z_limit(2) * se, f"mean {mean:.5f} +- {se:.5f}"

@@ -42,7 +42,7 @@ ALPHA = 1e-3
 WIDTH = 32
 SCENES = [name for name, _ in bundled_scenes()]
 # Scalar spp per integrator (the numpy backend uses NUMPY_FACTOR times more: it is cheap).
-SPP = {"jittered": 2, "direct": 3, "whitted": 2, "path": 3}
+SPP = {"jittered": 2, "shading": 2, "direct": 3, "whitted": 2, "path": 3}
 NUMPY_FACTOR = 4
 SEEDS = (11, 12, 13, 14)
 BACKENDS = ("scalar", "numpy")

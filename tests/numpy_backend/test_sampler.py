@@ -141,7 +141,8 @@ def test_first_hit_generator():
 @pytest.mark.parametrize(
     "sampler, integrator",
     slow_except(
-        [(s, i) for s in ("stratified", "sobol") for i in ("direct", "path")], ("sobol", "direct")
+        [(s, i) for s in ("stratified", "sobol") for i in ("shading", "direct", "path")],
+        ("sobol", "direct"),
     ),
 )
 def test_images_agree_with_the_independent_sampler(sampler, integrator):

@@ -17,7 +17,7 @@ from ...testing.analytic_scenes import ANALYTIC_SCENES
 from ...testing.reference import DEFAULT_REFERENCE_SPP
 from .report import format_sampler_efficiency, format_series, format_table, plot, write_outputs
 from .run import DEFAULT_SPP, run_bench
-from .scenes import BACKENDS, VARIANTS
+from .scenes import ALL_VARIANTS, BACKENDS, VARIANTS
 
 QUICK = {"width": 16, "spp": (1, 4, 16), "repeats": 2}
 
@@ -41,7 +41,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
     b.add_argument(
         "--integrators",
         default=None,
-        help=f"comma-separated variants: {','.join(VARIANTS)} (default all)",
+        help=f"comma-separated variants: {','.join(ALL_VARIANTS)} (default "
+        f"{','.join(VARIANTS)}; the last three compare stop criteria: docs/bench.md)",
     )
     b.add_argument(
         "--samplers",
@@ -126,7 +127,7 @@ def _options(args: argparse.Namespace) -> dict:
     return {
         "scenes": scenes,
         "backends": _split(args.backends, BACKENDS, "backends") or ["numpy"],
-        "variants": _split(args.integrators, tuple(VARIANTS), "integrators") or list(VARIANTS),
+        "variants": _split(args.integrators, tuple(ALL_VARIANTS), "integrators") or list(VARIANTS),
         "samplers": _split(args.samplers, tuple(SAMPLERS), "samplers") or ["independent"],
         "spps": _spp_list(args.spp) if args.spp else (QUICK["spp"] if args.quick else DEFAULT_SPP),
         "budget": args.budget,

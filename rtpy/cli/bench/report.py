@@ -22,7 +22,7 @@ from .convergence import (
     series_key,
     series_name,
 )
-from .scenes import VARIANTS
+from .scenes import ALL_VARIANTS
 
 TABLE_COLUMNS = (
     ("scene", "scene", "{}"),
@@ -152,7 +152,7 @@ def write_outputs(result: BenchResult, out: Path) -> list[Path]:
 
 def _other_reference(integrator: str) -> bool:
     """The variant estimates another image than full paths (direct: depth 2)."""
-    return VARIANTS[integrator]["integrator"] == "direct"
+    return ALL_VARIANTS[integrator]["integrator"] == "direct"
 
 
 def rel_mse_se(level: Level) -> float:
@@ -219,7 +219,7 @@ def draw(result: BenchResult, quick: bool = False):
                 series.setdefault((lv.backend, lv.integrator, lv.sampler), []).append(lv)
         for (backend, integrator, sampler), lvs in series.items():
             other = _other_reference(integrator)
-            k = list(VARIANTS).index(integrator) * len(SAMPLERS) + list(SAMPLERS).index(sampler)
+            k = list(ALL_VARIANTS).index(integrator) * len(SAMPLERS) + list(SAMPLERS).index(sampler)
             color = f"C{k % 10}"
             named = integrator if sampler == "independent" else f"{integrator}, {sampler}"
             style = {
@@ -366,7 +366,7 @@ def format_efficiency(result: BenchResult) -> str:
     not ranked; scenes without error (exact) are left out."""
     best: dict[tuple[str, str], list[tuple[float, str]]] = {}
     for f, last in zip(result.fits, _last_levels(result), strict=True):
-        same_image = VARIANTS[f.integrator]["integrator"] == "path"
+        same_image = ALL_VARIANTS[f.integrator]["integrator"] == "path"
         named = f.integrator if f.sampler == "independent" else f"{f.integrator}+{f.sampler}"
         if same_image and f.slope is not None and math.isfinite(last.efficiency):
             best.setdefault((f.scene, f.backend), []).append((last.efficiency, named))

@@ -25,7 +25,7 @@ from .convergence import (
     z_score,
 )
 from .machine import machine
-from .scenes import VARIANTS, BenchScene, effective_depth, load_bench_scene
+from .scenes import ALL_VARIANTS, VARIANTS, BenchScene, effective_depth, load_bench_scene
 
 DEFAULT_SPP = (1, 4, 16, 64)
 MAX_BUDGET_SPP = 1 << 16
@@ -51,11 +51,14 @@ def render_once(
         backend=backend,
         spp=spp,
         seed=seed,
-        max_depth=bs.max_depth,
-        russian_roulette=bs.russian_roulette,
         workers=workers,
         sampler=sampler,
-        **VARIANTS[variant],
+        # the variant's own depth or roulette, else the scene's
+        **{
+            "max_depth": bs.max_depth,
+            "russian_roulette": bs.russian_roulette,
+            **ALL_VARIANTS[variant],
+        },
     )
     seconds = time.perf_counter() - start
     if image.interrupted:  # Ctrl-C inside the render: a partial image is no measurement

@@ -19,6 +19,16 @@ VARIANTS: dict[str, dict] = {
     "path-mis": {"integrator": "path", "nee": True, "mis": True},  # both, power heuristic
     "direct": {"integrator": "direct", "nee": True, "mis": True},  # one bounce (depth 2)
 }
+# The lecture's stop criteria, path-mis otherwise, measured only when asked for: a depth
+# cap alone (path-cap3 shows the energy it loses: its bias against the scene's depth),
+# the cap at the scene's depth without roulette, and the lecture's fixed p_RR (noisier
+# than path-mis, whose roulette is throughput-based).
+STOP_VARIANTS: dict[str, dict] = {
+    "path-cap3": {"integrator": "path", "max_depth": 3, "russian_roulette": 0},
+    "path-no-rr": {"integrator": "path", "russian_roulette": 0},
+    "path-fixed-rr": {"integrator": "path", "roulette": "fixed"},
+}
+ALL_VARIANTS: dict[str, dict] = {**VARIANTS, **STOP_VARIANTS}
 BACKENDS = ("numpy", "scalar")
 
 
@@ -71,4 +81,4 @@ def load_bench_scene(
 
 def effective_depth(variant: str, max_depth: int) -> int:
     """The max_depth whose image the variant estimates ("direct" is depth 2)."""
-    return 2 if VARIANTS[variant]["integrator"] == "direct" else max_depth
+    return 2 if ALL_VARIANTS[variant]["integrator"] == "direct" else max_depth

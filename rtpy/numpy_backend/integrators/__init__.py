@@ -6,6 +6,7 @@ from .direct import DirectIntegrator
 from .integrator import BatchIntegrator
 from .jittered import JitteredIntegrator
 from .path import PathIntegrator
+from .shading import ShadingIntegrator
 from .whitted import WhittedIntegrator
 
 INTEGRATORS: dict[str, type[BatchIntegrator]] = {
@@ -13,6 +14,7 @@ INTEGRATORS: dict[str, type[BatchIntegrator]] = {
     for cls in (
         CenterIntegrator,
         JitteredIntegrator,
+        ShadingIntegrator,
         DirectIntegrator,
         WhittedIntegrator,
         PathIntegrator,

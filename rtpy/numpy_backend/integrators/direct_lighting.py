@@ -14,6 +14,7 @@ import numpy as np
 
 from ..arrays import add_rows, dot, max3, put_rows, rows, scale
 from ..hit_info import HitBatch
+from ..light import LightSamples
 from ..ray import offset_scale, spawn_origins
 from ..sampling import power_heuristic
 from ..scene import BatchScene
@@ -32,10 +33,26 @@ def sample_one_light(
     without include_area): f_r L cos(theta_i) / pdf, times the MIS weight for area
     lights (with mis = False the weight is 1: light sampling alone). ids are the
     hits' material ids."""
-    n = len(hits)
-    out = np.zeros((n, 3))
     n_lights = scene.lights.count(include_area)
     s = scene.lights.sample(hits.point, rng, include_area)
+    return light_sample_estimate(scene, hits, ids, s, n_lights, mis)
+
+
+def light_sample_estimate(
+    scene: BatchScene,
+    hits: HitBatch,
+    ids: np.ndarray,
+    s: LightSamples,
+    n_lights: int,
+    mis: bool = True,
+    shadows: bool = True,
+) -> np.ndarray:
+    """The estimate (N, 3) of the light samples s, each its light picked with
+    probability 1 / n_lights: f_r L cos(theta_i) / pdf times n_lights and the MIS
+    weight of area lights (1 without mis), 0 where a shadow ray is blocked (no shadow
+    rays without shadows: the "shading" integrator's first rung)."""
+    n = len(hits)
+    out = np.zeros((n, 3))
     cos = dot(hits.normal, s.direction)
     cos_i = np.abs(cos)  # behind the surface: BRDF 0 unless glass
     ok = s.valid & (max3(s.radiance) > 0.0) & (cos_i > 0.0)
@@ -57,16 +74,8 @@ def sample_one_light(
     if keep.size < idx.size:
         idx, wi, f, part = idx.take(keep), rows(wi, keep), rows(f, keep), part.take(keep)
         brdf_pdf = None if brdf_pdf is None else brdf_pdf.take(keep)
-    offset = offset_scale(part.point)
-    origin = spawn_origins(part.point, part.normal, wi, offset, cos.take(idx))
-    # Stop the shadow ray just short of the light's surface, and let the light
-    # itself not block it: the spawned origin is off the point the light was
-    # sampled from, so the shadow ray can meet the light's surface a little
-    # before `distance` (by far more than the offsets where it arrives at a
-    # slant), and a convex light cannot hide its own sampled point.
-    t_max = s.distance.take(idx) - offset_scale(rows(s.point, idx)) - offset
-    blocked = scene.find_occlusion(origin, wi, t_max, ignore=s.obj.take(idx))
-    if blocked.any():
+    blocked = shadowed(scene, part, wi, cos.take(idx), s, idx) if shadows else None
+    if blocked is not None and blocked.any():
         keep = np.flatnonzero(~blocked)
         idx, f = idx.take(keep), rows(f, keep)
         brdf_pdf = None if brdf_pdf is None else brdf_pdf.take(keep)
@@ -78,6 +87,20 @@ def sample_one_light(
     contrib = scale(f * rows(s.radiance, idx), cos_i.take(idx) * weight / pdf)
     put_rows(out, idx, contrib)
     return out
+
+
+def shadowed(scene: BatchScene, part: HitBatch, wi, cos, s: LightSamples, idx) -> np.ndarray:
+    """(M,) bool: the shadow ray from each hit of part toward rows idx of the light
+    samples s (directions wi, cosines cos with the normals) is blocked."""
+    offset = offset_scale(part.point)
+    origin = spawn_origins(part.point, part.normal, wi, offset, cos)
+    # Stop the shadow ray just short of the light's surface, and let the light
+    # itself not block it: the spawned origin is off the point the light was
+    # sampled from, so the shadow ray can meet the light's surface a little
+    # before `distance` (by far more than the offsets where it arrives at a
+    # slant), and a convex light cannot hide its own sampled point.
+    t_max = s.distance.take(idx) - offset_scale(rows(s.point, idx)) - offset
+    return scene.find_occlusion(origin, wi, t_max, ignore=s.obj.take(idx))
 
 
 @dataclass

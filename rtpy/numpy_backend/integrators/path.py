@@ -19,7 +19,8 @@ class PathIntegrator(BatchIntegrator):
     hits, then continue along the direction scattering() samples, multiplying the
     path throughput `beta` by its weight BRDF * cos / pdf. max_depth counts ray
     segments, the camera ray included; after segment `russian_roulette` a path
-    survives with probability min(0.95, max(beta)) and is divided by it. nee = False
+    survives with probability q and is divided by it: min(0.95, max(beta)), or
+    roulette_probability with roulette = "fixed". nee = False
     samples only point lights; mis = False adds area lights by light sampling alone.
 
     All live paths advance one segment per iteration; `paths` holds the camera ray
@@ -31,6 +32,13 @@ class PathIntegrator(BatchIntegrator):
     def _limits(self) -> tuple[int, int, bool]:
         s = self.settings
         return s.max_depth, s.russian_roulette, s.nee
+
+    def _survival(self, bmax: np.ndarray) -> np.ndarray:
+        """Russian roulette's q per path from its throughput's largest component
+        (PathIntegrator.survival_probability)."""
+        if self.settings.roulette == "fixed":
+            return np.full(bmax.shape, self.settings.roulette_probability)
+        return np.minimum(0.95, bmax)
 
     def compute_scattering(self, o, d, scene, rng):
         max_depth, rr_start, nee = self._limits()
@@ -77,7 +85,7 @@ class PathIntegrator(BatchIntegrator):
             alive = sc.alive & (bmax > 0.0)
             roulette = bool(rr_start and segment >= rr_start)
             if roulette:
-                survive = np.minimum(0.95, bmax)
+                survive = self._survival(bmax)
                 alive &= rng.random(paths.size) < survive
             a = np.flatnonzero(alive)
             if a.size == paths.size:  # nothing ended: no compaction

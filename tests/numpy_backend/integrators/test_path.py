@@ -12,6 +12,7 @@ import pytest
 import rtpy
 from rtpy import Color, DiffuseLight, Lambertian, Scene, Sphere, Vec3
 from rtpy.integrators import make_integrator as make_scalar
+from rtpy.numpy_backend.integrators import path as path_module
 from rtpy.ray import Ray
 from rtpy.render_settings import RenderSettings
 from rtpy.sampling import make_generator, use_generator
@@ -23,6 +24,7 @@ from rtpy.testing.analytic_scenes import (
     GlowingLambertian,
     plane_sphere_light,
 )
+from rtpy.testing.statistics import BlockTest, block_z_test
 
 from .integrator_checks import batched_radiance, camera_rays, scalar_radiance, z_score
 
@@ -119,3 +121,61 @@ def test_nee_only_matches_scalar_and_the_exact_irradiance():
         assert abs(m_np - m_sc) < limit * math.hypot(se_np, se_sc), (k, m_np, m_sc)
         assert abs(m_np - want) < limit * se_np, (k, m_np, want)
         assert abs(m_sc - want) < limit * se_sc, (k, m_sc, want)
+
+
+# The lecture's stop criteria on one scene: no roulette, fixed p_RR, throughput-based.
+ROULETTES = {
+    "none": {"russian_roulette": 0},
+    "fixed": {"russian_roulette": 2, "roulette": "fixed", "roulette_probability": 0.6},
+    "throughput": {"russian_roulette": 2},
+}
+ROULETTE_SEEDS = range(21, 27)
+
+
+def roulette_renders(kind: str) -> np.ndarray:
+    """(R, H, W, 3): cornell, 32 pixels wide, rendered with one seed each of
+    ROULETTE_SEEDS and the stop criterion `kind`, in this process."""
+    scene = rtpy.load_scene("cornell")
+    return np.stack(
+        [
+            rtpy.render(
+                scene,
+                backend="numpy",
+                workers=1,
+                width=32,
+                spp=8,
+                max_depth=10,
+                seed=seed,
+                **ROULETTES[kind],
+            ).linear
+            for seed in ROULETTE_SEEDS
+        ]
+    )
+
+
+def same_image(a: np.ndarray, b: np.ndarray) -> BlockTest:
+    """block_z_test of two stacks of independent renders, each pixel's mean with the
+    variance measured from its own stack (the estimators' variances differ)."""
+    var_a, var_b = a.var(axis=0, ddof=1) / len(a), b.var(axis=0, ddof=1) / len(b)
+    return block_z_test(a.mean(axis=0), var_a, b.mean(axis=0), var_b, alpha=1e-3)
+
+
+def test_fixed_roulette_converges_to_the_image_without_roulette_and_throughputs():
+    """Fixed p_RR = 0.6 from segment 2 on, throughput roulette and no roulette at all
+    (the same depth cap) estimate one image: the block means agree (z-test on blocks,
+    Bonferroni over blocks and channels); fixed p_RR ends paths, so it is noisier."""
+    fixed = roulette_renders("fixed")
+    for other in ("none", "throughput"):
+        test = same_image(fixed, roulette_renders(other))
+        assert test.passed, f"fixed p_RR against {other}: " + test.worst(other)
+    assert fixed.var(axis=0).mean() > roulette_renders("none").var(axis=0).mean()
+
+
+def test_fixed_roulette_without_dividing_by_p_is_flagged(monkeypatch):
+    """The planted mistake: survivors not divided by p_RR lose the energy of the paths
+    roulette ended, and the z-test on blocks says so."""
+    reference = roulette_renders("none")
+    monkeypatch.setattr(path_module, "divide", lambda beta, survive: beta)
+    test = same_image(roulette_renders("fixed"), reference)
+    assert not test.passed
+    assert (test.z > test.threshold).any(axis=1).sum() > 1  # many blocks, not one
