@@ -302,7 +302,7 @@ class Child:
                 pass
         self.stop()
         if status is None:
-            return "the grading process broke the protocol, and was stopped"
+            return f"the grading process broke the protocol ({what}), and was stopped"
         if status < 0:
             name = signal.Signals(-status).name if -status in signal.valid_signals() else status
             return f"the grading process was ended by signal {name} (the memory ran out?)"

@@ -141,7 +141,9 @@ def as_user(ids, *args, **options) -> subprocess.Popen:
     )  # fmt: skip
 
 
-def test_every_process_of_the_user_is_killed_by_the_judge_itself(user, open_tmp):
+def test_every_process_of_the_user_is_killed_by_the_judge_itself(user, open_tmp, monkeypatch):
+    """Processes that hide, leave the session and stop every process they may are all
+    killed, and by this process: no helper is forked (it could become one they stop)."""
     marks = open_tmp / "marks"
     marks.mkdir()
     os.chmod(marks, 0o777)
@@ -152,7 +154,15 @@ def test_every_process_of_the_user_is_killed_by_the_judge_itself(user, open_tmp)
     assert len(list(marks.iterdir())) == 4, "the stoppers did not start"
     assert len(user_processes(user[0])) >= 4  # undumpable ones included
     start = time.monotonic()
-    assert kill_user(user[0], seconds=10.0)
+
+    def no_helper(*args):
+        raise AssertionError("kill_user started a process to do its work")
+
+    with monkeypatch.context() as patched:
+        for name in ("fork", "setuid", "setresuid", "posix_spawn"):
+            patched.setattr(os, name, no_helper, raising=False)
+        patched.setattr(subprocess, "Popen", no_helper)
+        assert kill_user(user[0], seconds=10.0)
     assert time.monotonic() - start < 10.0
     first.wait(timeout=10)
     assert user_processes(user[0]) == []
