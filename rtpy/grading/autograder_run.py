@@ -57,6 +57,7 @@ from .sandbox import SANDBOX_USER, Child, Isolation, sandbox_ids
 
 CONFIG_FILE = "autograder.json"
 LEFT_OUT = (HIDDEN, "reference")  # folders of assignments/weekNN the child never sees
+TEMP_PLACES = ("/tmp", "/var/tmp", "/dev/shm")  # for the judge's folder when TMPDIR is closed
 
 
 @dataclass
@@ -283,7 +284,7 @@ def reachable_temp(user: str | None) -> str | None:
     sandbox user."""
     if sandbox_ids(user) is None:
         return None
-    for candidate in (tempfile.gettempdir(), "/tmp", "/var/tmp", "/dev/shm"):
+    for candidate in (tempfile.gettempdir(), *TEMP_PLACES):
         path = Path(os.path.realpath(candidate))
         try:
             if path.is_dir() and all(os.stat(p).st_mode & 0o001 for p in [path, *path.parents]):

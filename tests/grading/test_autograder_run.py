@@ -8,6 +8,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 
 def test_a_broken_autograder_still_writes_results(tmp_path):
@@ -21,3 +22,40 @@ def test_a_broken_autograder_still_writes_results(tmp_path):
     assert proc.returncode == 0
     results = json.loads((tmp_path / "results" / "results.json").read_text())
     assert results["score"] == 0 and "not your code" in results["output"]
+
+
+def test_a_stub_put_back_is_readable_by_the_sandbox(tmp_path):
+    """A task file put back to its stub is readable by every user (the sandbox's
+    included), whatever the mode of the file it replaces."""
+    from rtpy.grading.autograder_run import _restore
+
+    stub, target = tmp_path / "stub.py", tmp_path / "light.py"
+    stub.write_text("STUB = 1\n")
+    target.write_text("broken(\n")
+    target.chmod(0o600)
+    _restore(stub, target)
+    assert target.read_text() == "STUB = 1\n"
+    assert target.stat().st_mode & 0o777 == 0o644
+
+
+def test_the_judges_folder_is_one_the_sandbox_can_reach(tmp_path, monkeypatch):
+    """A private TMPDIR (0700) is passed over for a folder every user may pass through;
+    with none, the autograder's own failure, never the student's."""
+    import tempfile
+
+    import pytest
+
+    from rtpy.grading import autograder_run as run
+
+    private = tmp_path / "private"
+    private.mkdir(mode=0o700)
+    monkeypatch.setattr(tempfile, "tempdir", str(private))
+    monkeypatch.setattr(run, "sandbox_ids", lambda user: (12345, 12345))
+    chosen = run.reachable_temp("someone")
+    assert chosen != str(private)
+    assert all(os.stat(p).st_mode & 0o001 for p in [chosen, *map(str, Path(chosen).parents)])
+    monkeypatch.setattr(run, "TEMP_PLACES", (str(private),))
+    with pytest.raises(run.Unconfined, match="no temporary folder"):
+        run.reachable_temp("someone")
+    monkeypatch.setattr(run, "sandbox_ids", lambda user: None)
+    assert run.reachable_temp(None) is None  # no sandbox user: this Python's default
