@@ -332,6 +332,7 @@ def new_child(run: Run) -> Child:
     config["import_timeout"] = timeout
     child = Child(run.work, config, run.isolation, log=run.log, start_timeout=timeout)
     child.deadline = run.deadline
+    child.config_dir = run.scratch  # the judge's, reachable (TMPDIR may be closed to the child)
     return child
 
 

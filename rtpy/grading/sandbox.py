@@ -189,6 +189,7 @@ class Child:
     log: list[str] = field(default_factory=list)  # for the instructor
     start_timeout: float = START_TIMEOUT  # seconds to import rtpy and the probes
     deadline: float | None = None  # time.monotonic() past which no call waits
+    config_dir: Path | None = None  # where its configuration is written (the judge's, readable)
     _proc: subprocess.Popen | None = None
     _replies: Replies | None = None
     _output: list[bytes] = field(default_factory=list)
@@ -200,7 +201,7 @@ class Child:
         home = self.isolation.home
         # A file of the judge's own, never in the child's folders: as root the judge
         # would follow a link the student's code left there.
-        fd, name = tempfile.mkstemp(prefix="rtpy-child-", suffix=".json")
+        fd, name = tempfile.mkstemp(prefix="rtpy-child-", suffix=".json", dir=self.config_dir)
         os.close(fd)
         config_path = self._config_file = Path(name)
         os.chmod(config_path, 0o644)

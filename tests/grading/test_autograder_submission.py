@@ -146,7 +146,7 @@ def test_paths_the_child_prints_are_text_never_looked_up(tmp_path):
     loop.parent.mkdir()
     loop.symlink_to(loop)
     text = (
-        'Traceback (most recent call last):\n'
+        "Traceback (most recent call last):\n"
         f'  File "{loop}/rtpy/light.py", line 3, in <module>\n'
         f'  File "{work}/rtpy/../rtpy/light.py", line 2, in <module>\n'
         "ZeroDivisionError: division by zero\n"
