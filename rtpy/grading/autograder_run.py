@@ -35,6 +35,7 @@ import shutil
 import signal
 import stat
 import subprocess
+import sys
 import tempfile
 import time
 import traceback
@@ -154,7 +155,18 @@ def main() -> int:
     results["execution_time"] = round(time.monotonic() - start, 2)
     write_results(results_path, results)
     print(f"rtpy autograder: score {results['score']:g}, results in {results_path}")
+    print(f"rtpy autograder: the judge's peak memory {peak_memory() / 2**20:.0f} MiB")
     return 0
+
+
+def peak_memory() -> int:
+    """The judge's own peak resident memory in bytes (0 where not known)."""
+    try:
+        import resource
+    except ImportError:  # Windows
+        return 0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak if sys.platform == "darwin" else peak * 1024
 
 
 def _stop(signum, frame) -> None:
@@ -179,10 +191,14 @@ def isolation(root: Path, log: list[str]) -> Isolation:
     """How the child is confined here: as root, by a user of this run's own (so that
     ending every process of the user ends this run's alone, even beside other runs
     on the machine), else by SANDBOX_USER (made by setup.sh), with the autograder's
-    folders closed to both; without root, not by a user."""
+    folders closed to both; without root, not by a user. Either way without network
+    where the socket filter can be installed (the log says so once where not)."""
+    socket_filter, why = network_closed(sys.executable)
+    if socket_filter is None:
+        log.append(f"the student's code can reach the network: {why}")
     if not hasattr(os, "geteuid") or os.geteuid() != 0:
         log.append("not root: the student's code runs as this user (no user isolation)")
-        return Isolation()
+        return Isolation(socket_filter=socket_filter)
     user = f"{SANDBOX_USER}-{secrets.token_hex(4)}"
     if not make_user(user):
         user = SANDBOX_USER
@@ -191,11 +207,6 @@ def isolation(root: Path, log: list[str]) -> Isolation:
     ids = sandbox_ids(user)
     remove_user_files(*ids)  # an earlier run's user may have had this uid
     close(root)
-    import sys
-
-    socket_filter, why = network_closed(sys.executable)
-    if socket_filter is None:
-        log.append(f"the student's code can reach the network: {why}")
     return Isolation(user=user, socket_filter=socket_filter)
 
 
@@ -339,8 +350,6 @@ def new_child(run: Run) -> Child:
 def prepare(run: Run, submission: Path, scratch: Path) -> None:
     """Put the usable task files over the work copy; run.problems and run.notes say
     what was taken and what could not be used."""
-    import sys
-
     seal(run.work, run.home, run.isolation)
     problem = python_problem(run.isolation, sys.executable, run.work, run.home)
     if problem:  # the student's code never runs as root
