@@ -154,8 +154,8 @@ def read_body(stream, size: int, limit: int = MAX_FRAME, values: int | None = No
 
 def most_values(schema: Schema | None, items: int | None) -> int:
     """The commas a reply of this form may hold: its JSON values (`items`: the number
-    of cases asked, the length of a list whose form leaves it open), plus TEXT_SLACK
-    for text; MAX_VALUES where the form bounds nothing."""
+    of cases asked, the length of the answer when it is a list whose form leaves it
+    open), plus TEXT_SLACK for text; MAX_VALUES where the form bounds nothing."""
     found = _values(schema, items) if schema is not None else None
     return TEXT_SLACK + (MAX_VALUES if found is None else min(found, MAX_VALUES))
 
@@ -170,11 +170,11 @@ def _values(schema: Schema, items: int | None) -> int | None:
                 return None
             total *= n + 1
         return total
-    if isinstance(schema, List):
-        one, length = _values(schema.item, items), schema.length or items
+    if isinstance(schema, List):  # `items` is the outermost list's length alone
+        one, length = _values(schema.item, None), schema.length or items
         return None if one is None or length is None else length * (one + 1)
     if isinstance(schema, Record):
-        parts = [_values(s, items) for s in schema.fields.values()]
+        parts = [_values(s, None) for s in schema.fields.values()]
         return None if None in parts else sum(parts) + len(parts)
     if isinstance(schema, Maybe):
         return _values(schema.item, items)

@@ -120,3 +120,12 @@ def test_a_reply_is_read_only_up_to_what_its_form_allows():
     assert p.most_values(p.List(p.Float), None) == p.TEXT_SLACK + p.MAX_VALUES  # open
     with pytest.raises(p.ProtocolError, match="announced"):
         p.read_frame(io.BytesIO(p.encode(answer)), limit=100)
+
+
+def test_only_the_answer_itself_is_as_long_as_the_cases():
+    """An inner list of open length (samples of each case) is not bounded by the number
+    of cases: 2 cases of 5000 samples each are read."""
+    form = p.List(p.List(p.Vec))
+    answer = [[[0.0, 0.0, 1.0]] * 5000] * 2
+    got = p.read_frame(io.BytesIO(p.encode(answer)), values=p.most_values(form, 2))
+    assert len(got) == 2 and len(got[0]) == 5000
