@@ -59,3 +59,20 @@ def test_the_judges_folder_is_one_the_sandbox_can_reach(tmp_path, monkeypatch):
         run.reachable_temp("someone")
     monkeypatch.setattr(run, "sandbox_ids", lambda user: None)
     assert run.reachable_temp(None) is None  # no sandbox user: this Python's default
+
+
+def test_where_the_network_stays_open_the_instructor_is_told_once(tmp_path, monkeypatch):
+    from rtpy.grading import autograder_run as run
+
+    monkeypatch.setattr(run, "network_closed", lambda python: (None, "no socket filter here"))
+    monkeypatch.setattr(os, "geteuid", lambda: 1000, raising=False)  # not root: no user made
+    log: list[str] = []
+    confined = run.isolation(tmp_path, log)
+    assert confined.socket_filter is None and confined.user is None
+    assert [ln for ln in log if "network" in ln] == [
+        "the student's code can reach the network: no socket filter here"
+    ]
+    monkeypatch.setattr(run, "network_closed", lambda python: ("a filter", ""))
+    log.clear()
+    assert run.isolation(tmp_path, log).socket_filter == "a filter"
+    assert not [ln for ln in log if "network" in ln]
