@@ -39,17 +39,20 @@ MAX_UNZIPPED_BYTES = 500_000_000
 MAX_DEPTH = 3  # how far below the submission folder the repository may be
 SKIPPED_FOLDERS = {"__MACOSX", ".git", "__pycache__", ".venv", "venv", "node_modules"}
 FRAME = re.compile(r'File "([^"]+)", line (\d+)')
-COMPILE_SECONDS = 30.0  # to compile one task file
+COMPILE_SECONDS = 30.0  # to compile the task files
 COMPILE_MEMORY = 2 * 2**30  # bytes the compiling process may take
+# Arguments: the files; prints [None | [line, message] | text] in their order.
 COMPILE = """import json, sys
-source = open(sys.argv[1], encoding="utf-8").read()
-try:
-    compile(source, sys.argv[2], "exec", dont_inherit=True)
-    print(json.dumps(None))
-except SyntaxError as err:
-    print(json.dumps([err.lineno, err.msg]))
-except ValueError as err:
-    print(json.dumps(str(err)))
+found = []
+for path in sys.argv[1:]:
+    try:
+        compile(open(path, encoding="utf-8").read(), path, "exec", dont_inherit=True)
+        found.append(None)
+    except SyntaxError as err:
+        found.append([err.lineno, err.msg])
+    except ValueError as err:
+        found.append(str(err))
+print(json.dumps(found))
 """
 
 
@@ -190,11 +193,15 @@ def _unusable(source: Path | None, base: Path) -> str | None:
 
 
 def compile_errors(work: Path, files: list[str]) -> dict[str, str]:
-    """task file -> its SyntaxError (line and message), for those that do not compile;
-    each is compiled by a process of its own (COMPILE_SECONDS, COMPILE_MEMORY)."""
+    """task file -> its SyntaxError (line and message), for those that do not compile.
+    They are compiled by a process of their own (COMPILE_SECONDS, COMPILE_MEMORY), and
+    one by one when that process fails (a file too much for the compiler)."""
     errors = {}
-    for rel in files:
-        found = _compiled(work / rel, rel)
+    together = _compiled([work / rel for rel in files])
+    if not isinstance(together, list) or len(together) != len(files):
+        together = [_compiled([work / rel]) for rel in files]
+        together = [f[0] if isinstance(f, list) and len(f) == 1 else f for f in together]
+    for rel, found in zip(files, together, strict=True):
         if found is None:
             continue
         if isinstance(found, list) and len(found) == 2:
@@ -212,15 +219,17 @@ def compile_errors(work: Path, files: list[str]) -> dict[str, str]:
     return errors
 
 
-def _compiled(path: Path, rel: str):
-    """None when path compiles; [line, message] of its SyntaxError; else why not."""
+def _compiled(paths: list[Path]):
+    """For each path: None when it compiles, [line, message] of its SyntaxError, or
+    why not; a text alone when the compiling process failed."""
     options: dict = {}
     if os.name == "posix":
         options["preexec_fn"] = _compile_limits
     try:
         proc = subprocess.run(
-            [sys.executable, "-I", "-S", "-c", COMPILE, str(path), rel], capture_output=True,
-            text=True, timeout=COMPILE_SECONDS, cwd=path.parent, **options,
+            [sys.executable, "-I", "-S", "-c", COMPILE, *map(str, paths)], capture_output=True,
+            text=True, timeout=COMPILE_SECONDS, cwd=paths[0].parent if paths else None,
+            **options,
         )  # fmt: skip
     except subprocess.TimeoutExpired:
         return f"Python's compiler did not finish within {COMPILE_SECONDS:g} s"
