@@ -266,6 +266,8 @@ class Child:
         the student's code raised, ChildFailure when the child did not answer. The
         reply may be as large as an answer of the form `returns` (for as many cases
         or seeds as inputs holds) can be."""
+        if self.deadline is not None and time.monotonic() >= self.deadline:
+            raise ChildFailure("not asked: the time limit for the whole submission was reached")
         deadline = time.monotonic() + seconds + GRACE
         if self._proc is None:
             self.start()

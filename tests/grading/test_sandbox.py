@@ -168,6 +168,8 @@ def test_no_call_outlives_the_childs_deadline(child):
     with pytest.raises(ChildFailure, match="did not finish"):
         child.call("spin", {}, 30.0)
     assert time.monotonic() - start < 4.0
+    with pytest.raises(ChildFailure, match="not asked: the time limit"):
+        child.call("double", {"x": 1}, 30.0)
 
 
 BOMB = """
