@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import secrets
 import shutil
 import signal
@@ -58,6 +59,7 @@ from .sandbox import SANDBOX_USER, Child, Isolation, sandbox_ids
 
 CONFIG_FILE = "autograder.json"
 LEFT_OUT = (HIDDEN, "reference")  # folders of assignments/weekNN the child never sees
+JUDGE_PATH = re.compile(r"""[^\s'"]*rtpy-(?:judge|child)-[^\s'":]*""")  # its own files
 TEMP_PLACES = ("/tmp", "/var/tmp", "/dev/shm")  # for the judge's folder when TMPDIR is closed
 
 
@@ -147,9 +149,10 @@ def main() -> int:
         results = grade_submission(root, config, results_path)
     except Exception as err:  # the autograder's own failure: say so, score 0
         traceback.print_exc()
+        text = JUDGE_PATH.sub("<grading folder>", repr(err))  # in full on stdout above
         results = {
             "score": 0,
-            "output": f"The autograder failed (not your code; tell your instructor): {err!r}",
+            "output": f"The autograder failed (not your code; tell your instructor): {text}",
             "tests": [],
         }
     results["execution_time"] = round(time.monotonic() - start, 2)

@@ -76,3 +76,22 @@ def test_where_the_network_stays_open_the_instructor_is_told_once(tmp_path, monk
     log.clear()
     assert run.isolation(tmp_path, log).socket_filter == "a filter"
     assert not [ln for ln in log if "network" in ln]
+
+
+def test_the_autograders_own_failure_hides_its_folders(tmp_path, monkeypatch, capsys):
+    from rtpy.grading import autograder_run as run
+
+    (tmp_path / "source").mkdir()
+    (tmp_path / "source" / "autograder.json").write_text('{"week": "05"}')
+    monkeypatch.setenv("AUTOGRADER_ROOT", str(tmp_path))
+    secret = "/tmp/rtpy-judge-abc123/repo/rtpy/light.py"
+
+    def fail(*args):
+        raise run.Unconfined(f"cannot read {secret}: closed")
+
+    monkeypatch.setattr(run, "grade_submission", fail)
+    assert run.main() == 0
+    results = json.loads((tmp_path / "results" / "results.json").read_text())
+    assert results["output"].startswith("The autograder failed (not your code; tell your")
+    assert "cannot read <grading folder>: closed" in results["output"]
+    assert secret in capsys.readouterr().err  # the instructor's log has it all
