@@ -30,6 +30,14 @@ in pytest's tmp folder (0700, which alone would stop the sandbox user from reach
 anything). Runs go two at a time: as root the judge makes a user for each run, so
 ending every process of that user ends that run's alone.
 
+Issue 44's attacks have checks of their own: a child that stops reading its requests
+and a child that stops every newer process (a helper of the judge's) end within the
+run's time limit; files written to /tmp, /var/tmp, /dev/shm and /run/lock do not
+outlive the run; a connection to a listener on 127.0.0.1 is refused and the listener
+gets nothing; reply bombs (200 MiB and 32 MiB of `[{},{},...]`) leave the judge's peak
+memory, which it prints, under 1 GiB; a symbolic link loop named in a fake traceback
+is not the autograder's failure.
+
 Week 05 gets every attack; the other weeks the patching (all at once), forging and leaking
 ones. All are slow but week 05's pytest patch. Known holes are xfail(strict) with the
 hole as the reason, so that closing one turns its test into a failure to remove the
