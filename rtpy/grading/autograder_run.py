@@ -52,7 +52,7 @@ from .autograder_submission import (
     take_task_files,
     unpack,
 )
-from .confinement import kill_user, network_closed, remove_user_files
+from .confinement import kill_user, network_closed, remove_user_files, remove_user_ipc
 from .graders import HIDDEN, PROBES_FILE, child_config
 from .results import gradescope_results, scrub, write_results
 from .sandbox import SANDBOX_USER, Child, Isolation, sandbox_ids
@@ -209,6 +209,7 @@ def isolation(root: Path, log: list[str]) -> Isolation:
             raise Unconfined(f"could not make the user {SANDBOX_USER} (useradd failed)")
     ids = sandbox_ids(user)
     remove_user_files(*ids)  # an earlier run's user may have had this uid
+    remove_user_ipc(ids[0])
     close(root)
     return Isolation(user=user, socket_filter=socket_filter)
 
@@ -231,7 +232,7 @@ def remove_user(user: str | None, log: list[str]) -> None:
         return
     if not kill_user(ids[0]):
         log.append(f"some processes of {user} could not be ended")
-    removed = remove_user_files(*ids)
+    removed = remove_user_files(*ids) + [f"{kind} {n}" for kind, n in remove_user_ipc(ids[0])]
     if removed:
         log.append(f"removed what the student's code left: {', '.join(removed[:10])}")
     if user != SANDBOX_USER:

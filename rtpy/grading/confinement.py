@@ -12,7 +12,8 @@
   is never hit.
 - `remove_user_files`: after its processes are gone, every file the user owns in the
   folders any user may write (TMP_PLACES) is removed, so nothing a run wrote survives
-  for a later run's user, which may get the same uid.
+  for a later run's user, which may get the same uid; `remove_user_ipc` does the same
+  for its System V shared memory, message queues and semaphores.
 """
 
 from __future__ import annotations
@@ -250,4 +251,48 @@ def remove_user_files(
         except OSError:
             continue
         _sweep(place, uid, gid, depth, removed)
+    return removed
+
+
+# --- removing the user's System V IPC objects -------------------------------------------------
+IPC_KINDS = {"shm": ("shmid", "shmctl"), "msg": ("msqid", "msgctl"), "sem": ("semid", "semctl")}
+IPC_RMID = 0
+
+
+def user_ipc(uid: int) -> list[tuple[str, int]]:
+    """(kind, id) of each System V IPC object owned by uid (Linux's /proc/sysvipc)."""
+    found = []
+    for kind, (id_column, _) in IPC_KINDS.items():
+        try:
+            lines = Path(f"/proc/sysvipc/{kind}").read_text().splitlines()
+        except OSError:
+            continue
+        if not lines:
+            continue
+        header = lines[0].split()
+        for line in lines[1:]:
+            row = dict(zip(header, line.split(), strict=False))
+            try:
+                if int(row["uid"]) == uid:
+                    found.append((kind, int(row[id_column])))
+            except (KeyError, ValueError):
+                continue
+    return found
+
+
+def remove_user_ipc(uid: int) -> list[tuple[str, int]]:
+    """Remove every System V shared memory segment, message queue and semaphore set
+    owned by uid; those removed. (Nothing where there is no /proc/sysvipc.)"""
+    if uid == 0:
+        raise ValueError("uid: the judge never removes root's objects")
+    found = user_ipc(uid)
+    if not found:
+        return []
+    libc = ctypes.CDLL(None, use_errno=True)
+    removed = []
+    for kind, ipc_id in found:
+        control = getattr(libc, IPC_KINDS[kind][1])
+        args = (ipc_id, 0, IPC_RMID) if kind == "sem" else (ipc_id, IPC_RMID, None)
+        if control(*args) == 0:
+            removed.append((kind, ipc_id))
     return removed

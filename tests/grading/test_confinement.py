@@ -20,6 +20,8 @@ from rtpy.grading.confinement import (
     kill_user,
     network_closed,
     remove_user_files,
+    remove_user_ipc,
+    user_ipc,
     user_processes,
 )
 
@@ -95,6 +97,7 @@ def user():
     yield entry.pw_uid, entry.pw_gid
     kill_user(entry.pw_uid)
     remove_user_files(entry.pw_uid, entry.pw_gid)
+    remove_user_ipc(entry.pw_uid)
     subprocess.run(["userdel", name], capture_output=True)
 
 
@@ -199,8 +202,29 @@ os.chmod(os.path.join(base, "closed", "open"), 0o777)
     assert theirs.read_text() == "root's"  # the link was removed, not what it names
 
 
+IPC = """import ctypes
+libc = ctypes.CDLL(None, use_errno=True)
+assert libc.shmget(0, 4096, 0o1600) >= 0  # IPC_PRIVATE, IPC_CREAT | 0600
+assert libc.msgget(0, 0o1600) >= 0
+assert libc.semget(0, 1, 0o1600) >= 0
+"""
+
+
+def test_the_users_ipc_objects_are_removed(user):
+    """Shared memory, a message queue and a semaphore set made by the user outlive its
+    processes until they are removed; root's are left."""
+    assert as_user(user, "-c", IPC).wait(timeout=60) == 0
+    assert sorted(kind for kind, _ in user_ipc(user[0])) == ["msg", "sem", "shm"]
+    roots = user_ipc(0)
+    assert sorted(kind for kind, _ in remove_user_ipc(user[0])) == ["msg", "sem", "shm"]
+    assert user_ipc(user[0]) == []
+    assert user_ipc(0) == roots
+
+
 def test_root_is_never_the_target():
     with pytest.raises(ValueError, match="uid"):
         kill_user(0)
     with pytest.raises(ValueError, match="uid"):
         remove_user_files(0)
+    with pytest.raises(ValueError, match="uid"):
+        remove_user_ipc(0)
