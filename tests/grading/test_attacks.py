@@ -765,6 +765,10 @@ for _folder in ("/tmp", "/var/tmp", "/dev/shm", "/run/lock"):
         _attack_mark("@NAME@-wrote")
     except OSError:
         pass
+import ctypes
+_shm = ctypes.CDLL(None).shmget(0, 4096, 0o1600)  # System V shared memory: kept by the kernel
+if _shm >= 0:
+    _attack_mark("@NAME@-shm-%d" % _shm)
 """
 NETWORK = """
 import socket
@@ -1029,6 +1033,11 @@ def nothing_left(outcome: Outcome, ctx: Context) -> None:
         if path.exists()
     ]
     assert not left, f"the sandbox's files outlived the run: {left}"
+    made = {m.split("-shm-")[1].rsplit("-", 1)[0] for m in outcome.marks if "-shm-" in m}
+    assert made, "no shared memory was made"
+    lines = Path("/proc/sysvipc/shm").read_text().splitlines()
+    kept = {line.split()[1] for line in lines[1:]} & made
+    assert not kept, f"the sandbox's shared memory outlived the run: {kept}"
 
 
 def no_connection(outcome: Outcome, ctx: Context) -> None:
