@@ -8,7 +8,9 @@ copy of the assignment. A task file that cannot be used is put back to the
 assignment's stub and the reason is kept for the report:
 
 - missing from the submission, a symbolic link (or below one), too large or not text;
-- not valid Python (`compile_errors`: the SyntaxError's line);
+- not valid Python (`compile_errors`: the SyntaxError's line), or more than Python's
+  compiler can take (it compiles in a process of its own, with limits, so that such
+  a file costs its own tasks and never the judge);
 - importing it fails or hangs (`import_problem`, in the sandboxed child process
   (rtpy.grading.sandbox) with a time limit: the exception and the line in the
   student's file).
@@ -20,8 +22,12 @@ student learns that those edits do not count.
 from __future__ import annotations
 
 import filecmp
+import json
+import os
 import re
 import shutil
+import subprocess
+import sys
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +39,21 @@ MAX_UNZIPPED_BYTES = 500_000_000
 MAX_DEPTH = 3  # how far below the submission folder the repository may be
 SKIPPED_FOLDERS = {"__MACOSX", ".git", "__pycache__", ".venv", "venv", "node_modules"}
 FRAME = re.compile(r'File "([^"]+)", line (\d+)')
+COMPILE_SECONDS = 30.0  # to compile the task files
+COMPILE_MEMORY = 2 * 2**30  # bytes the compiling process may take
+# Arguments: the files; prints [None | [line, message] | text] in their order.
+COMPILE = """import json, sys
+found = []
+for path in sys.argv[1:]:
+    try:
+        compile(open(path, encoding="utf-8").read(), path, "exec", dont_inherit=True)
+        found.append(None)
+    except SyntaxError as err:
+        found.append([err.lineno, err.msg])
+    except ValueError as err:
+        found.append(str(err))
+print(json.dumps(found))
+"""
 
 
 class SubmissionError(Exception):
@@ -172,20 +193,59 @@ def _unusable(source: Path | None, base: Path) -> str | None:
 
 
 def compile_errors(work: Path, files: list[str]) -> dict[str, str]:
-    """task file -> its SyntaxError (line and message), for those that do not compile."""
+    """task file -> its SyntaxError (line and message), for those that do not compile.
+    They are compiled by a process of their own (COMPILE_SECONDS, COMPILE_MEMORY), and
+    one by one when that process fails (a file too much for the compiler)."""
     errors = {}
-    for rel in files:
-        text = (work / rel).read_text(encoding="utf-8")
-        try:
-            compile(text, rel, "exec", dont_inherit=True)
-        except SyntaxError as err:
-            lines = text.splitlines()
-            line = lines[err.lineno - 1].strip() if err.lineno and err.lineno <= len(lines) else ""
-            shown = f": {line}" if line else ""
-            errors[rel] = f"line {err.lineno}: SyntaxError: {err.msg}{shown}"
-        except ValueError as err:  # a NUL byte
-            errors[rel] = f"cannot be compiled: {err}"
+    together = _compiled([work / rel for rel in files])
+    if not isinstance(together, list) or len(together) != len(files):
+        together = [_compiled([work / rel]) for rel in files]
+        together = [f[0] if isinstance(f, list) and len(f) == 1 else f for f in together]
+    for rel, found in zip(files, together, strict=True):
+        if found is None:
+            continue
+        if isinstance(found, list) and len(found) == 2:
+            lineno, msg = found
+            lines = (work / rel).read_text(encoding="utf-8").splitlines()
+            line = (
+                lines[lineno - 1].strip()
+                if isinstance(lineno, int) and 0 < lineno <= len(lines)
+                else ""
+            )
+            shown = f": {printable(line, 200)}" if line else ""
+            errors[rel] = f"line {lineno}: SyntaxError: {printable(str(msg), 200)}{shown}"
+        else:
+            errors[rel] = f"cannot be compiled: {printable(str(found), 300)}"
     return errors
+
+
+def _compiled(paths: list[Path]):
+    """For each path: None when it compiles, [line, message] of its SyntaxError, or
+    why not; a text alone when the compiling process failed."""
+    options: dict = {}
+    if os.name == "posix":
+        options["preexec_fn"] = _compile_limits
+    try:
+        proc = subprocess.run(
+            [sys.executable, "-I", "-S", "-c", COMPILE, *map(str, paths)], capture_output=True,
+            text=True, timeout=COMPILE_SECONDS, cwd=paths[0].parent if paths else None,
+            **options,
+        )  # fmt: skip
+    except subprocess.TimeoutExpired:
+        return f"Python's compiler did not finish within {COMPILE_SECONDS:g} s"
+    try:
+        if proc.returncode == 0:
+            return json.loads(proc.stdout)
+    except ValueError:
+        pass
+    return "the file is too large or too deeply nested for Python's compiler"
+
+
+def _compile_limits() -> None:
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (COMPILE_MEMORY, COMPILE_MEMORY))
+    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
 
 
 def import_problem(child, files: list[str], work: Path) -> tuple[str | None, str] | None:
@@ -221,10 +281,14 @@ def import_problem(child, files: list[str], work: Path) -> tuple[str | None, str
 
 
 def _relative(path: str, base: Path) -> str | None:
-    try:
-        return Path(path).resolve().relative_to(base.resolve()).as_posix()
-    except (ValueError, OSError):
-        return None
+    """path (as the child printed it: text, never looked up) relative to base, in
+    posix form; None outside it."""
+    text = os.path.normpath(path)
+    for root in {str(base), os.path.realpath(base)}:
+        prefix = os.path.join(os.path.normpath(root), "")
+        if text.startswith(prefix):
+            return Path(text[len(prefix) :]).as_posix()
+    return None
 
 
 def ignored_changes(repository: Path | None, pristine: Path, task_files: list[str]) -> list[str]:

@@ -56,7 +56,7 @@ def relative(filename: str, base: Path) -> str | None:
     """filename relative to base as a posix path, or None outside it."""
     try:
         return Path(filename).resolve().relative_to(base).as_posix()
-    except (ValueError, OSError):
+    except (ValueError, OSError, RuntimeError):  # RuntimeError: a symlink loop
         return None
 
 

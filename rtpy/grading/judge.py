@@ -10,8 +10,9 @@ copy).
 
 `Judge` is the pytest plugin: it collects each test's points, task, name and whether
 it is a hidden check; gives each test `test_timeout` seconds (its probes get what is
-left) and stops starting tests once `total_timeout` is spent; and records an Outcome
-per test with the message the student reads. `judge()` runs it.
+left, and never more than what is left of `total_timeout`), stops starting tests once
+`total_timeout` is spent (they are marked not run); and records an Outcome per test
+with the message the student reads. `judge()` runs it.
 """
 
 from __future__ import annotations
@@ -91,6 +92,7 @@ class Judge:
     total_timeout: float = 1e9
     collect_only: bool = False
     progress: object = None  # called after each test's outcome (results saved as they come)
+    started: float | None = None  # time.monotonic() the total time counts from (else now)
     tests: dict[str, Graded] = field(default_factory=dict)
     errors: list[str] = field(default_factory=list)  # graders that could not be loaded
     log: list[str] = field(default_factory=list)  # for the instructor
@@ -100,15 +102,16 @@ class Judge:
 
     def pytest_configure(self, config) -> None:
         config.addinivalue_line("markers", "points(n, task): points a grader test is worth")
-        self._total_deadline = time.monotonic() + self.total_timeout
+        started = self.started if self.started is not None else time.monotonic()
+        self._total_deadline = started + self.total_timeout
 
     def ask(self, nodeid: str, found, inputs: dict):
         seconds = self._deadline - time.monotonic()
         if seconds <= 0.0:
-            raise ChildFailure(f"did not finish within {self.test_timeout:g} s")
+            raise ChildFailure(self.late())
         if found.renders:
             self.renders.add(nodeid)
-        value = self.runner.call(found.name, inputs, seconds)
+        value = self.runner.call(found.name, inputs, seconds, found.returns)
         where = f"the answer of the probe {found.name}"
         for many in ("cases", "seeds"):  # one answer per case, one render per seed
             asked = inputs.get(many)
@@ -145,14 +148,19 @@ class Judge:
     @pytest.hookimpl(tryfirst=True)
     def pytest_runtest_protocol(self, item, nextitem):
         if time.monotonic() > self._total_deadline:
-            self.tests[item.nodeid].outcome = Outcome(
-                False,
-                f"not run: the time limit of {self.total_timeout:g} s for the whole "
-                "submission was reached",
-            )
+            self.tests[item.nodeid].outcome = Outcome(False, f"not run: {self.total_limit()}")
             return True  # not run
-        self._deadline = time.monotonic() + self.test_timeout
+        self._deadline = min(time.monotonic() + self.test_timeout, self._total_deadline)
         return None
+
+    def total_limit(self) -> str:
+        return f"the time limit of {self.total_timeout:g} s for the whole submission was reached"
+
+    def late(self) -> str:
+        """Why a test's probe is not asked: its time or the submission's is spent."""
+        if time.monotonic() >= self._total_deadline:
+            return f"stopped: {self.total_limit()}"
+        return f"did not finish within {self.test_timeout:g} s"
 
     @pytest.hookimpl(hookwrapper=True)
     def pytest_runtest_makereport(self, item, call):

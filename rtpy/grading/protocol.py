@@ -26,6 +26,9 @@ from types import SimpleNamespace
 import numpy as np
 
 MAX_FRAME = 256 * 1024 * 1024  # bytes of one message
+REPLY_FRAME = 64 * 1024 * 1024  # bytes of one reply (a probe's largest answer is far smaller)
+MAX_VALUES = 2**20  # JSON values of a reply whose form does not bound them
+TEXT_SLACK = 10_000  # commas a reply may hold in its text (an exception's message, traceback)
 MAX_DEPTH = 32  # nesting of lists and dicts
 MAX_TEXT = 500  # characters of a string the judge shows (a student's exception message)
 NUMERIC = "biuf"  # the dtype kinds an array may have: bool, int, unsigned, float
@@ -115,23 +118,67 @@ def write_frame(stream, frame: bytes) -> None:
     stream.flush()
 
 
-def _exactly(stream, size: int) -> bytes:
-    data = bytearray()
-    while len(data) < size:
-        chunk = stream.read(size - len(data))
-        if not chunk:
+def _exactly(stream, size: int) -> bytearray:
+    data = bytearray(size)
+    view, got = memoryview(data), 0
+    while got < size:
+        n = stream.readinto(view[got:])
+        if not n:
             raise ProtocolError("the other side closed the connection")
-        data += chunk
-    return bytes(data)
+        got += n
+    return data
 
 
-def read_frame(stream):
+def read_frame(stream, limit: int = MAX_FRAME, values: int | None = None):
     """The data of the next frame of a binary stream (blocking); ProtocolError when the
     stream ends or the frame is not valid."""
-    (size,) = struct.unpack(">I", _exactly(stream, 4))
-    if size > MAX_FRAME:
-        raise ProtocolError(f"a message of {size:,} bytes announced, at most {MAX_FRAME:,}")
-    return decode(_exactly(stream, size))
+    return read_body(stream, read_size(stream), limit, values)
+
+
+def read_size(stream) -> int:
+    """The size a frame announces (blocking until it comes)."""
+    return struct.unpack(">I", _exactly(stream, 4))[0]
+
+
+def read_body(stream, size: int, limit: int = MAX_FRAME, values: int | None = None):
+    """The data of a frame's body of `size` bytes. A frame announcing more than `limit`
+    bytes is refused unread; one holding more than `values` commas (JSON values, plus
+    text) is refused before it is parsed."""
+    if size > limit:
+        raise ProtocolError(f"a message of {size:,} bytes announced, at most {limit:,}")
+    body = _exactly(stream, size)
+    if values is not None and body.count(b",") > values:
+        raise ProtocolError(f"a message holding more than the {values:,} values asked for")
+    return decode(body)
+
+
+def most_values(schema: Schema | None, items: int | None) -> int:
+    """The commas a reply of this form may hold: its JSON values (`items`: the number
+    of cases asked, the length of the answer when it is a list whose form leaves it
+    open), plus TEXT_SLACK for text; MAX_VALUES where the form bounds nothing."""
+    found = _values(schema, items) if schema is not None else None
+    return TEXT_SLACK + (MAX_VALUES if found is None else min(found, MAX_VALUES))
+
+
+def _values(schema: Schema, items: int | None) -> int | None:
+    if isinstance(schema, _Float | _Int | _Bool | _Text):
+        return 1
+    if isinstance(schema, Array):  # base64 (no comma), or nested lists of the shape
+        total = 1
+        for n in schema.shape:
+            if n is None:
+                return None
+            total *= n + 1
+        return total
+    if isinstance(schema, List):  # `items` is the outermost list's length alone
+        one, length = _values(schema.item, None), schema.length or items
+        return None if one is None or length is None else length * (one + 1)
+    if isinstance(schema, Record):
+        parts = [_values(s, None) for s in schema.fields.values()]
+        return None if None in parts else sum(parts) + len(parts)
+    if isinstance(schema, Maybe):
+        return _values(schema.item, items)
+    return None
 
 
 # --- what an answer must look like --------------------------------------------------

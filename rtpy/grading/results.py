@@ -84,6 +84,22 @@ def gradescope_results(
     return results
 
 
+def scrub(results: dict, paths: dict[str, str]) -> dict:
+    """results with each of `paths` (the judge's own folders, as any process may print
+    them) replaced by what the student reads instead, in every text shown."""
+    order = sorted(paths, key=len, reverse=True)  # a folder's children before itself
+
+    def clean(text: str) -> str:
+        for path in order:
+            text = text.replace(path, paths[path])
+        return text
+
+    results["output"] = clean(results.get("output", ""))
+    for test in results.get("tests", []):
+        test["name"], test["output"] = clean(test["name"]), clean(test["output"])
+    return results
+
+
 def explain(outcome: Outcome, problems: dict, task_functions: list, failed_components) -> str:
     """A failed test's output, with the file problem that explains a stub's error and,
     for a render, the component graders that failed."""

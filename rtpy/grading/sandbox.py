@@ -1,19 +1,24 @@
 """The judge's side of the process that runs a student's code (rtpy.grading.child).
 
-`Child` starts that process, sends it one request at a time and reads its reply, with
-a deadline: a child that is late, dies, closes the pipe or breaks the protocol is
+`Child` starts that process, sends it one request at a time and reads its reply, each
+with a deadline (a child that stops reading its requests cannot block the judge
+either): a child that is late, dies, closes the pipe or breaks the protocol is
 stopped (its whole process group, and on Linux as root every process of the sandbox
-user), and the call raises ChildFailure; the next call starts a new child. Only plain
-data crosses (rtpy.grading.protocol). The child's own output is read into a bounded
-buffer for the instructor's log, so printing cannot flood or block anything.
+user, killed by the judge itself: rtpy.grading.confinement), and the call raises
+ChildFailure; the next call starts a new child. Only plain data crosses
+(rtpy.grading.protocol), and a reply is read only up to the size its request's form
+implies. The child's own output is read into a bounded buffer for the instructor's
+log, so printing cannot flood or block anything.
 
 Isolation (`Isolation`): as root (Gradescope), the child runs as an unprivileged user
 (SANDBOX_USER) in a work copy it can read but not change, with its own temporary
 folder, limits on CPU time, memory, file size and processes (setrlimit), a scrubbed
 environment, Python's isolated mode, and its own session. Such a child cannot signal
 the judge, read what is readable by root alone (the autograder's source: graders,
-hidden checks, references; results/) or write anything outside its folder. Without
-root (a laptop) the same protocol, limits and session, but the user is the judge's:
+hidden checks, references; results/) or write anything outside its folder and the
+shared temporary folders (emptied of its files at the end). On Linux a seccomp filter
+refuses it every socket but a local one (no network). Without root (a laptop) the
+same protocol, limits, filter and session, but the user is the judge's:
 docs/instructors.md says what that leaves open.
 
 `InProcess` runs the probes in the judge's own process, through the same codec: for
@@ -36,7 +41,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .child import BOOT, ProbeTimeout, error_reply, load_probes, serve
-from .protocol import ProtocolError, decode, encode, printable, read_frame, write_frame
+from .confinement import kill_user
+from .protocol import (
+    REPLY_FRAME,
+    ProtocolError,
+    Schema,
+    decode,
+    encode,
+    most_values,
+    printable,
+    read_body,
+    read_size,
+)
 
 SANDBOX_USER = "rtpy-sandbox"
 GRACE = 5.0  # seconds past a probe's own time limit before the child is killed
@@ -70,6 +86,7 @@ class Isolation:
     file_mb: int | None = 64
     processes: int | None = 16
     home: Path | None = None  # the child's HOME and TMPDIR (its user's, when it has one)
+    socket_filter: object = None  # a confinement.SocketFilter installed before Python starts
 
     def preexec(self):
         """The function subprocess runs in the child before it starts Python."""
@@ -83,11 +100,14 @@ class Isolation:
         ]
         if self.user is not None:  # per user: meaningful only for a user of its own
             limits.append((resource.RLIMIT_NPROC, self.processes))
+        socket_filter = self.socket_filter
 
         def apply() -> None:
             for kind, value in limits:
                 if value is not None:
                     resource.setrlimit(kind, (value, value))
+            if socket_filter is not None:
+                socket_filter.install()
 
         return apply
 
@@ -128,17 +148,20 @@ def child_environment(work: Path, home: Path | None) -> dict[str, str]:
 
 class Replies:
     """The child's replies, read by a thread into a queue (portable: no select on
-    pipes), so the judge can wait for one with a deadline."""
+    pipes), so the judge can wait for one with a deadline. Each is read only up to
+    `limit` bytes and `values` commas (set for the request it answers)."""
 
     def __init__(self, stream) -> None:
         self.queue: queue.Queue = queue.Queue()
+        self.limit, self.values = REPLY_FRAME, most_values(None, None)
         threading.Thread(target=self._read, args=(stream,), daemon=True).start()
 
     def _read(self, stream) -> None:
         while True:
             try:
-                self.queue.put(read_frame(stream))
-            except (ProtocolError, OSError, ValueError) as err:
+                size = read_size(stream)  # then the limits of the request it answers
+                self.queue.put(read_body(stream, size, self.limit, self.values))
+            except (ProtocolError, OSError, ValueError, MemoryError) as err:
                 self.queue.put(ProtocolError(str(err)))
                 return
 
@@ -165,6 +188,8 @@ class Child:
     python: str = sys.executable
     log: list[str] = field(default_factory=list)  # for the instructor
     start_timeout: float = START_TIMEOUT  # seconds to import rtpy and the probes
+    deadline: float | None = None  # time.monotonic() past which no call waits
+    config_dir: Path | None = None  # where its configuration is written (the judge's, readable)
     _proc: subprocess.Popen | None = None
     _replies: Replies | None = None
     _output: list[bytes] = field(default_factory=list)
@@ -176,7 +201,7 @@ class Child:
         home = self.isolation.home
         # A file of the judge's own, never in the child's folders: as root the judge
         # would follow a link the student's code left there.
-        fd, name = tempfile.mkstemp(prefix="rtpy-child-", suffix=".json")
+        fd, name = tempfile.mkstemp(prefix="rtpy-child-", suffix=".json", dir=self.config_dir)
         os.close(fd)
         config_path = self._config_file = Path(name)
         os.chmod(config_path, 0o644)
@@ -218,15 +243,16 @@ class Child:
         return b"".join(self._output).decode("utf-8", errors="replace")
 
     def stop(self) -> None:
-        """End the child and everything it started."""
+        """End the child and everything it started (killed first: closing a pipe it does
+        not read could block)."""
         proc, self._proc = self._proc, None
         if proc is None:
             return
+        kill_tree(proc, self.isolation.user)
         try:
             proc.stdin.close()
         except OSError:
             pass
-        kill_tree(proc, self.isolation.user)
         if self._config_file is not None:
             self._config_file.unlink(missing_ok=True)
             self._config_file = None
@@ -235,19 +261,30 @@ class Child:
             self.log.append(f"the student's process printed:\n{output[-4000:]}")
 
     # --- one request ----------------------------------------------------------------
-    def call(self, probe: str, inputs: dict, seconds: float):
+    def call(self, probe: str, inputs: dict, seconds: float, returns: Schema | None = None):
         """The probe's value for inputs, computed within `seconds`; StudentError when
-        the student's code raised, ChildFailure when the child did not answer."""
+        the student's code raised, ChildFailure when the child did not answer. The
+        reply may be as large as an answer of the form `returns` (for as many cases
+        or seeds as inputs holds) can be."""
+        if self.deadline is not None and time.monotonic() >= self.deadline:
+            raise ChildFailure("not asked: the time limit for the whole submission was reached")
         deadline = time.monotonic() + seconds + GRACE
         if self._proc is None:
             self.start()
             deadline += self.start_timeout
+        if self.deadline is not None:
+            deadline = min(deadline, self.deadline)
         self._next_id += 1
         request = {"id": self._next_id, "probe": probe, "inputs": inputs, "seconds": seconds}
+        asked = [len(v) for k, v in inputs.items() if k in ("cases", "seeds") and is_list(v)]
+        self._replies.values = most_values(returns, max(asked) if asked else None)
         try:
-            write_frame(self._proc.stdin, encode(request))
+            sent = send_within(self._proc.stdin, encode(request), deadline)
         except OSError:
             raise ChildFailure(self._ended("before it was asked anything")) from None
+        if not sent:
+            self.stop()
+            raise ChildFailure(f"did not read what it was asked within {seconds:g} s: stopped")
         try:
             reply = self._replies.get(deadline)
         except TimeoutError:
@@ -268,7 +305,7 @@ class Child:
                 pass
         self.stop()
         if status is None:
-            return "the grading process broke the protocol, and was stopped"
+            return f"the grading process broke the protocol ({what}), and was stopped"
         if status < 0:
             name = signal.Signals(-status).name if -status in signal.valid_signals() else status
             return f"the grading process was ended by signal {name} (the memory ran out?)"
@@ -339,9 +376,36 @@ def student_error(error, task_files) -> Exception:
     return error_
 
 
+def is_list(value) -> bool:
+    return isinstance(value, list | tuple)
+
+
+def send_within(stream, frame: bytes, deadline: float) -> bool:
+    """Write frame to the child's request pipe by a thread of its own (unbuffered: the
+    pipe's buffered writer is never used, so closing it cannot block); whether it was
+    all written by the deadline. OSError when the pipe is closed."""
+    fd = stream.fileno()
+    failed: list[OSError] = []
+
+    def write() -> None:
+        view = memoryview(frame)
+        try:
+            while view:
+                view = view[os.write(fd, view) :]
+        except OSError as err:
+            failed.append(err)
+
+    writer = threading.Thread(target=write, daemon=True)
+    writer.start()
+    writer.join(max(0.0, deadline - time.monotonic()))
+    if failed:
+        raise failed[0]
+    return not writer.is_alive()
+
+
 def kill_tree(proc: subprocess.Popen, user: str | None) -> None:
     """Kill proc's process group, then, as root with a sandbox user, every process of
-    that user (a descendant that left the group), and reap proc."""
+    that user (a descendant that left the group), from this process, and reap proc."""
     try:
         os.killpg(proc.pid, signal.SIGKILL)
     except (ProcessLookupError, PermissionError, AttributeError):
@@ -350,39 +414,6 @@ def kill_tree(proc: subprocess.Popen, user: str | None) -> None:
     if ids is not None:
         kill_user(ids[0])
     proc.wait()
-
-
-def kill_user(uid: int) -> None:
-    """Kill every process of uid: a helper that becomes uid and signals -1 (all the
-    processes it may signal, that is its own user's), until none is left."""
-    for _ in range(5):
-        pid = os.fork()
-        if pid == 0:  # the helper
-            try:
-                os.setgid(os.getgid())
-                os.setuid(uid)
-                os.kill(-1, signal.SIGKILL)
-            finally:
-                os._exit(0)
-        os.waitpid(pid, 0)
-        if not user_processes(uid):
-            return
-
-
-def user_processes(uid: int) -> list[int]:
-    """The processes of uid (Linux's /proc; [] elsewhere)."""
-    found = []
-    proc = Path("/proc")
-    if not proc.is_dir():
-        return found
-    for entry in proc.iterdir():
-        if entry.name.isdigit():
-            try:
-                if entry.stat().st_uid == uid:
-                    found.append(int(entry.name))
-            except OSError:
-                continue
-    return found
 
 
 @dataclass
@@ -395,7 +426,7 @@ class InProcess:
     log: list[str] = field(default_factory=list)
     _probes: dict | None = None
 
-    def call(self, probe: str, inputs: dict, seconds: float):
+    def call(self, probe: str, inputs: dict, seconds: float, returns: Schema | None = None):
         if self._probes is None:
             self._probes = load_probes(self.config.get("probe_modules", []))
         request = decode(

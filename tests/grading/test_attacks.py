@@ -30,6 +30,14 @@ in pytest's tmp folder (0700, which alone would stop the sandbox user from reach
 anything). Runs go two at a time: as root the judge makes a user for each run, so
 ending every process of that user ends that run's alone.
 
+Issue 44's attacks have checks of their own: a child that stops reading its requests
+and a child that stops every newer process (a helper of the judge's) end within the
+run's time limit; files written to /tmp, /var/tmp, /dev/shm and /run/lock do not
+outlive the run; a connection to a listener on 127.0.0.1 is refused and the listener
+gets nothing; reply bombs (200 MiB and 32 MiB of `[{},{},...]`) leave the judge's peak
+memory, which it prints, under 1 GiB; a symbolic link loop named in a fake traceback
+is not the autograder's failure.
+
 Week 05 gets every attack; the other weeks the patching (all at once), forging and leaking
 ones. All are slow but week 05's pytest patch. Known holes are xfail(strict) with the
 hole as the reason, so that closing one turns its test into a failure to remove the
@@ -38,6 +46,7 @@ mark. test_inflated_noise_cannot_pass_a_wrong_render attacks the render verdict 
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
@@ -91,6 +100,12 @@ class Context:
     marks: Path  # world-writable: the attack's code leaves a file here when it runs
     task_files: list[str]
     task_functions: list[dict]
+    port: int = 0  # of LISTENER, on 127.0.0.1
+
+    @property
+    def left(self) -> str:
+        """The name of what this run's attack leaves in the shared temporary folders."""
+        return f"rtpy-attack-left-{self.root.parent.name}"
 
     @property
     def hidden(self) -> Path:
@@ -113,6 +128,8 @@ class Context:
             "@WEEK@": repr(self.week),
             "@RESULTS@": repr(str(self.root / "results" / "results.json")),
             "@SOURCE@": repr(str(self.root / "source" / "repo")),
+            "@PORT@": str(self.port),
+            "@LEFT@": repr(self.left),
         }
 
 
@@ -683,6 +700,143 @@ _attack_on_probe(_eat)
 """
 
 
+# --- the time limit, the machine, the judge's memory and paths (issue 44) ------------------
+STOP_READING = """
+import fcntl, glob, os, time
+
+
+def _deaf(request):
+    if glob.glob(os.path.join(@MARKS@, "@NAME@-deaf-*")):
+        return None  # once per run
+    import rtpy.grading.protocol as protocol
+
+    _attack_mark("@NAME@-deaf")
+    try:
+        fcntl.fcntl(0, 1031, 4096)  # F_SETPIPE_SZ: the smallest request pipe
+    except OSError:
+        pass
+    protocol._exactly = lambda stream, size: time.sleep(10**6)  # never reads again
+    return None
+
+
+_attack_on_probe(_deaf)
+"""
+STOP_THE_KILLER = """
+import glob, os, signal, time
+
+
+def _stopper():
+    if glob.glob(os.path.join(@MARKS@, "@NAME@-stopper-*")) or os.fork() != 0:
+        return  # one group per run
+    os.setsid()
+    for _ in range(6):  # six of them, each in a session of its own
+        if os.fork() == 0:
+            os.setsid()
+            break
+    else:
+        os._exit(0)
+    _attack_mark("@NAME@-stopper")
+    me = os.getpid()
+    end = time.monotonic() + 300
+    while time.monotonic() < end:  # stop every newer process of this user but the children
+        for pid in range(me + 1, me + 300):
+            try:
+                with open("/proc/%d/cmdline" % pid, "rb") as f:
+                    if b"rtpy.grading.child" in f.read():
+                        continue
+                os.kill(pid, signal.SIGSTOP)
+            except OSError:
+                pass
+    os._exit(0)
+
+
+_stopper()
+"""
+WRITE_EVERYWHERE = """
+import os
+for _folder in ("/tmp", "/var/tmp", "/dev/shm", "/run/lock"):
+    _path = os.path.join(_folder, @LEFT@)
+    try:
+        os.makedirs(_path, exist_ok=True)
+        with open(os.path.join(_path, "kept"), "w") as f:
+            f.write("for the next run's user, who may get this uid")
+        with open(_path + ".txt", "w") as f:
+            f.write("and a file")
+        _attack_mark("@NAME@-wrote")
+    except OSError:
+        pass
+import ctypes
+_shm = ctypes.CDLL(None).shmget(0, 4096, 0o1600)  # System V shared memory: kept by the kernel
+if _shm >= 0:
+    _attack_mark("@NAME@-shm-%d" % _shm)
+"""
+NETWORK = """
+import socket
+
+
+def _connect(request=None):
+    try:
+        s = socket.create_connection(("127.0.0.1", @PORT@), timeout=2)
+        s.sendall(repr(request).encode()[:1000])
+        s.close()
+        _attack_mark("@NAME@-connected")
+    except PermissionError:
+        _attack_mark("@NAME@-refused")
+    except OSError:
+        _attack_mark("@NAME@-failed")
+
+
+_connect()
+_attack_on_probe(_connect)
+"""
+REPLY_BOMB = """
+import glob, os, struct, sys
+
+
+def _replies():
+    frame = sys._getframe()
+    while frame is not None:
+        found = frame.f_locals.get("replies")
+        if hasattr(found, "write"):
+            return found
+        frame = frame.f_back
+
+
+def _bomb(request):
+    done = len(glob.glob(os.path.join(@MARKS@, "@NAME@-bombed-*")))
+    out = _replies()
+    if done >= 2 or out is None:
+        return None
+    _attack_mark("@NAME@-bombed")
+    size = (200 if done == 0 else 32) * 2**20  # past the frame limit, then within it
+    body = b"[" + b"{}," * (size // 3) + b"{}]"
+    fd = out.fileno()
+    os.write(fd, struct.pack(">I", len(body)))
+    view = memoryview(body)
+    while view:
+        view = view[os.write(fd, view):]
+    os._exit(0)
+
+
+_attack_on_probe(_bomb)
+"""
+LOOP_IN_TRACEBACK = """
+import os, sys
+_loop = os.path.join(os.environ.get("HOME", "/tmp"), "loop")
+try:
+    os.symlink(_loop, _loop)
+except OSError:
+    pass
+sys.stderr.write(
+    'Traceback (most recent call last):\\n  File "%s/rtpy/light.py", line 3, in <module>\\n'
+    "ZeroDivisionError: division by zero\\n" % _loop
+)
+sys.stderr.flush()
+_attack_mark("@NAME@-printed")
+os._exit(1)
+"""
+
+
 def evil_objects(repo: Path, ctx: Context, name: str = "") -> None:
     functions = [(f["path"], f["function"]) for f in ctx.task_functions]
     body = EVIL_OBJECTS.replace("@FUNCTIONS@", repr(functions))
@@ -861,6 +1015,51 @@ def tree_memory_bounded(outcome: Outcome, ctx: Context) -> None:
     assert len(holding) < 2, f"{len(holding)} processes held 2.5 GiB each: no limit in all"
 
 
+def in_time(outcome: Outcome, ctx: Context) -> None:
+    assert outcome.seconds < TOTAL_TIMEOUT + 10, f"the run took {outcome.seconds:.0f} s"
+
+
+def stopped_nothing(outcome: Outcome, ctx: Context) -> None:
+    assert [m for m in outcome.marks if "-stopper-" in m], "the stoppers never ran"
+    in_time(outcome, ctx)
+
+
+def nothing_left(outcome: Outcome, ctx: Context) -> None:
+    assert [m for m in outcome.marks if "-wrote-" in m], "nothing was written"
+    left = [
+        path
+        for folder in ("/tmp", "/var/tmp", "/dev/shm", "/run/lock")
+        for path in (Path(folder) / ctx.left, Path(folder) / f"{ctx.left}.txt")
+        if path.exists()
+    ]
+    assert not left, f"the sandbox's files outlived the run: {left}"
+    made = {m.split("-shm-")[1].rsplit("-", 1)[0] for m in outcome.marks if "-shm-" in m}
+    assert made, "no shared memory was made"
+    lines = Path("/proc/sysvipc/shm").read_text().splitlines()
+    kept = {line.split()[1] for line in lines[1:]} & made
+    assert not kept, f"the sandbox's shared memory outlived the run: {kept}"
+
+
+def no_connection(outcome: Outcome, ctx: Context) -> None:
+    assert not [m for m in outcome.marks if "-connected-" in m], "a connection was made"
+    assert [m for m in outcome.marks if "-refused-" in m], outcome.marks
+    got = listener().received
+    assert not got, f"the listener got: {got[:3]}"
+
+
+def judge_memory_bounded(outcome: Outcome, ctx: Context) -> None:
+    assert len([m for m in outcome.marks if "-bombed-" in m]) == 2, outcome.marks
+    peak = [ln for ln in outcome.stdout.splitlines() if "the judge's peak memory" in ln]
+    assert peak, outcome.stdout[-2000:]
+    mib = float(peak[-1].split()[-2])
+    assert mib < 1024, f"the judge took {mib:.0f} MiB"
+    in_time(outcome, ctx)
+
+
+def the_judge_stood(outcome: Outcome, ctx: Context) -> None:
+    assert "autograder failed" not in outcome.results["output"], outcome.results["output"]
+
+
 ATTACKS = [
     Attack("patch_pytest", append_code(PATCH_PYTEST), fast=True),
     Attack("patch_graders", append_code(PATCH_GRADERS)),
@@ -906,6 +1105,12 @@ ATTACKS = [
         hole="the memory limit is per process (RLIMIT_AS 4 GiB) and 16 processes are "
         "allowed: a process tree can take more than 4 GiB (a cgroup would bound it)",
     ),
+    Attack("stop_reading", append_code(STOP_READING), check=in_time),
+    Attack("stop_the_killer", append_code(STOP_THE_KILLER), needs_user=True, check=stopped_nothing),
+    Attack("write_everywhere", append_code(WRITE_EVERYWHERE), needs_user=True, check=nothing_left),
+    Attack("network", append_code(NETWORK), check=no_connection),
+    Attack("reply_bomb", append_code(REPLY_BOMB), check=judge_memory_bounded),
+    Attack("loop_in_traceback", append_code(LOOP_IN_TRACEBACK), check=the_judge_stood),
     Attack("extra_files", extra_files, runs_code=False, check=extras_never_ran),
     Attack("symlinked_task_files", symlinked, runs_code=False, check=links_refused),
     Attack("zip_with_links_and_escapes", zipped, runs_code=False, check=zip_contained),
@@ -987,6 +1192,7 @@ class Bench:
             os.chmod(folder / sub, 0o777 if sub == "marks" else 0o755)
         root = folder / "autograder"
         ctx = Context(week, root, folder / "marks", config["task_files"], config["task_functions"])
+        ctx.port = listener().port
         extract(zip_path, root / "source")
         ctx.metadata.write_text(json.dumps(METADATA))  # as Gradescope puts it, 0644
         submission = root / "submission"
@@ -1024,6 +1230,36 @@ class Bench:
                 if ours([pid], self.base):
                     os.kill(pid, signal.SIGKILL)
         shutil.rmtree(self.base, ignore_errors=True)
+
+
+class Listener:
+    """A server on 127.0.0.1 that records whatever reaches it (nothing should)."""
+
+    def __init__(self) -> None:
+        import socket
+
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port = self.server.getsockname()[1]
+        self.received: list[bytes] = []
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self) -> None:
+        while True:
+            try:
+                conn, _ = self.server.accept()
+            except OSError:
+                return
+            with conn:
+                conn.settimeout(2)
+                try:
+                    self.received.append(conn.recv(1000) or b"(connected)")
+                except OSError:
+                    self.received.append(b"(connected)")
+
+
+@functools.cache
+def listener() -> Listener:
+    return Listener()
 
 
 METADATA_MARK = f"metadata-{uuid.uuid4().hex}@example.edu"

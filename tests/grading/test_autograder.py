@@ -374,3 +374,55 @@ def test_as_root_a_students_code_never_runs_as_root(built, tmp_path):
     results = run_autograder(zip_path, student, tmp_path, PYTHON=str(python))[0]
     assert results["score"] == 0 and results["tests"] == []
     assert "only as an unprivileged user" in results["output"]
+
+
+# --- one honest mistake ----------------------------------------------------------------
+TYPOS = {  # a line appended to the reference's rtpy/light.py (week 05)
+    "fails at import": "import rtpy_no_such_module\n",
+    "hangs at import": "while True:\n    pass\n",
+    "overwhelms the compiler": "x = " + "+".join(["1"] * 300_000) + "\n",
+    "ends the process silently": "import os\nos._exit(3)\n",  # no line to blame: found
+}
+
+
+def shown(results: dict) -> str:
+    return "\n".join([results["output"], *(t["output"] for t in results["tests"])])
+
+
+@needs_judge_python
+@pytest.mark.slow
+@pytest.mark.parametrize("typo", list(TYPOS))
+def test_a_typo_costs_only_its_files_tasks(built, tmp_path, typo):
+    """The reference with one bad line in rtpy/light.py scores what its other files
+    earn: the same as with light.py left as the stub, more than 0; the file is named
+    and the judge's folders are not."""
+    zip_path, student = built("05")
+    stubbed = with_reference(student, tmp_path / "stubbed", "05")
+    shutil.copyfile(student / "rtpy" / "light.py", stubbed / "rtpy" / "light.py")
+    expected, _ = run_autograder(zip_path, stubbed, tmp_path)
+    assert 0 < expected["score"] < expected["max_score"]
+    broken = with_reference(student, tmp_path / "broken", "05")
+    light = broken / "rtpy" / "light.py"
+    light.write_text(light.read_text() + TYPOS[typo])
+    results, _ = run_autograder(
+        zip_path, broken, tmp_path, RTPY_AUTOGRADER_IMPORT_TIMEOUT=3,
+        RTPY_AUTOGRADER_TOTAL_TIMEOUT=TOTAL_TIMEOUT,
+    )  # fmt: skip
+    assert results["score"] == expected["score"], results["output"]
+    assert "rtpy/light.py: " in results["output"]
+    assert "rtpy-judge-" not in shown(results)
+
+
+@needs_judge_python
+@pytest.mark.slow
+@pytest.mark.skipif(not ROOT_USER, reason="the sandbox's user exists only as root")
+def test_a_private_temporary_folder_costs_no_marks(built, tmp_path):
+    """TMPDIR closed to the sandbox's user (0700): the judge makes its folder where that
+    user can reach it, and the reference scores full marks."""
+    zip_path, student = built("05")
+    private = tmp_path / "private"
+    private.mkdir(mode=0o700)
+    reference = with_reference(student, tmp_path / "reference", "05")
+    results, _ = run_autograder(zip_path, reference, tmp_path, TMPDIR=str(private))
+    assert results["score"] == results.get("max_score") > 0, results["output"]
+    assert list(private.iterdir()) == []

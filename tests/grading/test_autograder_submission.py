@@ -125,3 +125,49 @@ def test_a_symlinked_task_file_is_refused(tmp_path):
     assert taken.problems == {"rtpy/light.py": refused}
     assert (work / "rtpy" / "light.py").read_text() == "LIGHT = 1\n"  # the stub stays
     assert taken.files == ["rtpy/scene.py"]
+
+
+def test_a_file_too_much_for_the_compiler_costs_only_itself(tmp_path):
+    """A file whose compiling exhausts the compiler's recursion (and would take the
+    judge with it if compiled there) is named; the other file compiles."""
+    repository(tmp_path, light="x = " + "+".join(["1"] * 300_000) + "\n")
+    assert compile_errors(tmp_path, TASKS) == {
+        "rtpy/light.py": "cannot be compiled: the file is too large or too deeply nested "
+        "for Python's compiler"
+    }
+
+
+def test_paths_the_child_prints_are_text_never_looked_up(tmp_path):
+    """A traceback line naming a symbolic link loop in the child's folders (the
+    student's to make) is read as text: blamed when it lies in the work copy, else
+    ignored, and never resolved."""
+    work = repository(tmp_path / "work")
+    loop = tmp_path / "home" / "loop"
+    loop.parent.mkdir()
+    loop.symlink_to(loop)
+    text = (
+        "Traceback (most recent call last):\n"
+        f'  File "{loop}/rtpy/light.py", line 3, in <module>\n'
+        f'  File "{work}/rtpy/../rtpy/light.py", line 2, in <module>\n'
+        "ZeroDivisionError: division by zero\n"
+    )
+
+    class Printed:  # a child that failed to start and printed `text`
+        config: dict = {}
+        start_timeout = 1.0
+
+        def call(self, *args):
+            from rtpy.grading.sandbox import ChildFailure
+
+            raise ChildFailure("the grading process ended with exit status 3")
+
+        def output(self):
+            return text
+
+        def stop(self):
+            pass
+
+    assert import_problem(Printed(), TASKS, work) == (
+        "rtpy/light.py",
+        "line 2: ZeroDivisionError: division by zero",
+    )

@@ -5,6 +5,7 @@ starting tests when the whole run's time is spent."""
 from __future__ import annotations
 
 import textwrap
+import time
 
 from rtpy.grading.judge import Judge, judge, probe_registry
 from rtpy.grading.sandbox import InProcess
@@ -58,11 +59,11 @@ def test_slow(probe, n):
 '''
 
 
-def run(tmp_path, **limits) -> Judge:
+def run(tmp_path, name: str = "test_judged.py", **limits) -> Judge:
     folder = tmp_path / "assignments" / "week05"
     folder.mkdir(parents=True)
     (folder / "probes.py").write_text(PROBES)
-    (folder / "test_judged.py").write_text(textwrap.dedent(GRADERS))
+    (folder / name).write_text(textwrap.dedent(GRADERS))
     (folder / "conftest.py").write_text("from rtpy.grading.judge import probe  # noqa: F401\n")
     registry = probe_registry([folder / "probes.py"])
     runner = InProcess({"probe_modules": [str(folder / "probes.py")]}, tmp_path)
@@ -82,3 +83,14 @@ def test_outcomes_are_worded_by_the_judge(tmp_path):
     assert "did not finish within its time limit" in slow  # the probe's own timer, 1 s
     assert out["test_slow[2]"].outcome.output.startswith("not run: the time limit of 0.5 s")
     assert out["test_slow[1]"].name == "slow[1]"
+
+
+def test_a_test_under_way_ends_with_the_total_time(tmp_path):
+    """The whole run's time bounds the test under way too: its probe gets what is left
+    of it, and the tests after it are marked not run."""
+    start = time.monotonic()
+    plugin = run(tmp_path, "test_judged_total.py", test_timeout=30.0, total_timeout=2.0)
+    assert time.monotonic() - start < 2.0 + 1.0  # the slow test alone would take 3 s
+    out = {g.nodeid.split("::")[-1]: g.outcome for g in plugin.tests.values()}
+    assert "did not finish" in out["test_slow[1]"].output, out
+    assert out["test_slow[2]"].output.startswith("not run: the time limit of 2 s")

@@ -50,6 +50,12 @@ def npy_of(array: np.ndarray, allow_pickle: bool = False) -> str:
     return base64.b64encode(buffer.getvalue()).decode()
 
 
+def npy_lying_about_its_shape() -> str:
+    """A .npy whose header declares 10**12 float64 and holds 8 bytes."""
+    raw = base64.b64decode(npy_of(np.zeros(1)))
+    return base64.b64encode(raw.replace(b"(1,)", b"(1000000000000,)")).decode()
+
+
 @pytest.mark.parametrize(
     "body",
     [
@@ -59,6 +65,7 @@ def npy_of(array: np.ndarray, allow_pickle: bool = False) -> str:
         json.dumps({"$npy": base64.b64encode(pickle.dumps(print)).decode()}).encode(),
         json.dumps({"$npy": npy_of(np.array(["abc"]))}).encode(),
         json.dumps({"$npy": "!!!not base64"}).encode(),
+        json.dumps({"$npy": npy_lying_about_its_shape()}).encode(),
     ],
 )
 def test_malformed_or_code_carrying_messages_are_refused(body):
@@ -97,3 +104,28 @@ def test_answers_are_checked_against_their_form():
 def test_text_shown_to_students_is_bounded_and_printable():
     text = p.check(p.Text, "a\x1b[2Jb" + "x" * 2000)
     assert len(text) == p.MAX_TEXT and "\x1b" not in text and text.endswith("...")
+
+
+def test_a_reply_is_read_only_up_to_what_its_form_allows():
+    """A reply with more values than the form asked for (for that many cases) is
+    refused before it is parsed; one within it is read."""
+    form = p.List(p.Maybe(p.Record(t=p.Float, n=p.Vec)))
+    answer = [{"t": 1.5, "n": [0.0, 0.0, 1.0]}] * 50
+    values = p.most_values(form, 50)
+    assert p.read_frame(io.BytesIO(p.encode(answer)), values=values) == answer
+    assert p.read_frame(io.BytesIO(p.encode(answer * 20)), values=p.most_values(form, 1000))
+    with pytest.raises(p.ProtocolError, match="values asked for"):
+        p.read_frame(io.BytesIO(p.encode(answer * 1000)), values=values)
+    assert p.most_values(p.Float, None) == p.TEXT_SLACK + 1
+    assert p.most_values(p.List(p.Float), None) == p.TEXT_SLACK + p.MAX_VALUES  # open
+    with pytest.raises(p.ProtocolError, match="announced"):
+        p.read_frame(io.BytesIO(p.encode(answer)), limit=100)
+
+
+def test_only_the_answer_itself_is_as_long_as_the_cases():
+    """An inner list of open length (samples of each case) is not bounded by the number
+    of cases: 2 cases of 5000 samples each are read."""
+    form = p.List(p.List(p.Vec))
+    answer = [[[0.0, 0.0, 1.0]] * 5000] * 2
+    got = p.read_frame(io.BytesIO(p.encode(answer)), values=p.most_values(form, 2))
+    assert len(got) == 2 and len(got[0]) == 5000

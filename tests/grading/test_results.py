@@ -79,3 +79,22 @@ def test_the_table_groups_tests_by_task_with_subtotals():
     assert any(line.startswith("5.4 Direct lighting") and line.endswith("0/5") for line in lines)
     assert any(line.strip().startswith("5.4.1 render") for line in lines)
     assert lines[-1].startswith("total") and lines[-1].endswith("2/13")
+
+
+def test_the_judges_folders_are_taken_out_of_what_the_student_reads():
+    from rtpy.grading.results import scrub
+
+    work = "/tmp/rtpy-judge-abc/repo"
+    results = {
+        "output": f"rtpy/light.py: line 3: FileNotFoundError: '{work}/rtpy/x.npy'",
+        "tests": [{"name": "t", "output": f"in {work} and /tmp/rtpy-judge-abc/home/f"}],
+    }
+    paths = {
+        f"{work}/": "",
+        work: ".",
+        "/tmp/rtpy-judge-abc/home/": "<temporary folder>/",
+        "/tmp/rtpy-judge-abc": "<grading folder>",
+    }
+    shown = scrub(results, paths)
+    assert shown["output"] == "rtpy/light.py: line 3: FileNotFoundError: 'rtpy/x.npy'"
+    assert shown["tests"][0]["output"] == "in . and <temporary folder>/f"

@@ -11,12 +11,12 @@ from pathlib import Path
 
 import pytest
 
-from rtpy.grading.sandbox import Child, ChildFailure, Isolation, StudentError
+from rtpy.grading.sandbox import GRACE, Child, ChildFailure, Isolation, StudentError
 
 ROOT = Path(__file__).resolve().parents[2]
 
 PROBES = """
-import os, sys
+import os, sys, time
 from rtpy.grading.probes import probe
 from rtpy.grading.protocol import Float, Plain, encode
 from rtpy import loop
@@ -59,6 +59,32 @@ def lie():
             os.write(fd, frame)
         except OSError:
             pass
+    return 1.0
+
+@probe(returns=Float)
+def deaf():
+    # shrink the request pipe to a page and never read it again
+    import fcntl
+    import rtpy.grading.protocol as protocol
+
+    fcntl.fcntl(0, 1031, 4096)  # F_SETPIPE_SZ
+    protocol._exactly = lambda stream, size: time.sleep(10**6)
+    return 1.0
+
+@probe(returns=Float)
+def bomb(size):
+    # a reply of `size` bytes of [{},{},...] on the replies' channel
+    import struct
+
+    frame = sys._getframe()
+    while "replies" not in frame.f_locals:
+        frame = frame.f_back
+    fd = frame.f_locals["replies"].fileno()
+    body = b"[" + b"{}," * ((size - 2) // 3) + b"{}]"
+    os.write(fd, struct.pack(">I", len(body)))
+    view = memoryview(body)
+    while view:
+        view = view[os.write(fd, view):]
     return 1.0
 
 @probe(returns=Float)
@@ -121,3 +147,71 @@ def test_a_flood_of_output_is_bounded_and_memory_is_limited(child):
     assert len(child.output()) <= 70_000  # 40 MB printed, 64 KiB kept
     with pytest.raises(StudentError, match="MemoryError"):
         child.call("hog", {}, 30)
+
+
+def test_a_child_that_stops_reading_cannot_block_the_judge(child):
+    """After its answer the child shrinks its request pipe and stops reading: the next,
+    larger request is not written by its deadline, and the child is stopped."""
+    assert child.call("deaf", {}, 30) == 1.0
+    start = time.monotonic()
+    child.deadline = start + 2.0
+    with pytest.raises(ChildFailure, match="did not read what it was asked within 30 s"):
+        child.call("double", {"x": 1.0, "padding": "x" * 1_000_000}, 30.0)
+    assert time.monotonic() - start < 2.0 + 3.0
+    child.deadline = None
+    assert child.call("double", {"x": 4}, 30) == 8.0  # a new child
+
+
+def test_no_call_outlives_the_childs_deadline(child):
+    child.deadline = time.monotonic() + 2.0
+    start = time.monotonic()
+    with pytest.raises(ChildFailure, match="did not finish"):
+        child.call("spin", {}, 30.0)
+    assert time.monotonic() - start < 4.0
+    with pytest.raises(ChildFailure, match="not asked: the time limit"):
+        child.call("double", {"x": 1}, 30.0)
+
+
+BOMB = """
+import json, resource, sys, time
+from pathlib import Path
+from rtpy.grading.protocol import Float
+from rtpy.grading.sandbox import Child, ChildFailure, Isolation
+
+repo = Path(sys.argv[1])
+config = {"task_files": ["rtpy/loop.py"], "probe_modules": [str(repo / "probes.py")]}
+child = Child(repo, config, Isolation(memory_mb=2048))
+start = time.monotonic()
+try:
+    child.call("bomb", {"size": int(sys.argv[2])}, 60, Float)
+    outcome = "answered"
+except ChildFailure as err:
+    outcome = str(err)
+finally:
+    child.stop()
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+print(json.dumps([outcome, time.monotonic() - start, peak]))
+"""
+
+
+@pytest.mark.parametrize(
+    "size, refused",
+    [(200 * 2**20, "bytes announced"), (8 * 2**20, "more than the 10,001 values asked for")],
+)
+def test_a_reply_far_larger_than_asked_is_refused_cheaply(child, size, refused):
+    """A reply of [{},{},...] (200 MiB, beyond any answer; 8 MiB, within the frame
+    limit) to a request for one number: refused before it is parsed, fast, the judge's
+    memory barely touched."""
+    import json
+    import subprocess
+    import sys
+
+    proc = subprocess.run(
+        [sys.executable, "-c", BOMB, str(child.work), str(size)], capture_output=True,
+        text=True, timeout=120, cwd=ROOT,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    outcome, seconds, peak = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert refused in outcome
+    assert seconds < 1.0 + GRACE  # read, refused, the child stopped (2 s to see it exit)
+    assert peak < size + 200 * 2**20, f"the judge took {peak / 2**20:.0f} MiB"
