@@ -153,6 +153,31 @@ def path_counts_light_twice(mp):
     )
 
 
+def path_right_on_average(mp):
+    """compute_scattering times a random factor of mean 1: 0, or 50 with probability
+    1/50. Unbiased and never negative, but with a huge variance."""
+    from rtpy.sampling import generator
+
+    def change(self, value, *args):
+        return value * (50.0 if generator().random() < 0.02 else 0.0)
+
+    cls = path_module.PathIntegrator
+    mp.setattr(cls, "compute_scattering", wrap(cls, "compute_scattering", change))
+
+
+def path_zero_mean_noise(mp):
+    """compute_scattering plus zero-mean noise of standard deviation 30."""
+    from rtpy.sampling import generator
+    from rtpy.vec3 import Color
+
+    def change(self, value, *args):
+        noise = 30.0 * (1.0 if generator().random() < 0.5 else -1.0)
+        return value + Color(noise, noise, noise)
+
+    cls = path_module.PathIntegrator
+    mp.setattr(cls, "compute_scattering", wrap(cls, "compute_scattering", change))
+
+
 def albedo_as_brdf(mp):
     mp.setattr(Lambertian, "BRDF", wrap(Lambertian, "BRDF", lambda self, f, *a: f * math.pi))
 
@@ -514,6 +539,16 @@ PLANTED = [
     ("08.4", path_counts_light_twice, ["test_path_render_matches_reference", "test_path_furnace"]),
     ("08.4", roulette_not_divided, ["test_path_furnace"]),
     (
+        "08.4",
+        path_right_on_average,
+        [
+            "test_path_render_matches_reference",
+            "test_path_furnace",
+            "hidden/test_path_furnace_at_new_seeds",
+        ],
+    ),
+    ("08.4", path_zero_mean_noise, ["test_path_furnace", "hidden/test_path_furnace_at_new_seeds"]),
+    (
         "08.5",
         source("ward_without_jacobian"),
         ["test_pdf[ward]", "test_sampling_follows_pdf[ward]"],
@@ -527,10 +562,23 @@ def probe_of(week: str):
     return local_probe(week, ROOT, in_process=True)
 
 
+@cache
+def hidden_grader(week: str):
+    path = ROOT / "assignments" / f"week{week}" / "hidden" / f"test_week{week}_hidden.py"
+    spec = importlib.util.spec_from_file_location(f"hidden_grader_week{week}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def run_grader_test(week: str, name: str) -> None:
-    """Call one grader test function (name[param] for a parametrized one)."""
+    """Call one grader test function (name[param] for a parametrized one; hidden/name
+    for a hidden check)."""
     base, _, param = name.partition("[")
-    fn = getattr(grader(week), base)
+    module = grader(week)
+    if base.startswith("hidden/"):
+        module, base = hidden_grader(week), base.removeprefix("hidden/")
+    fn = getattr(module, base)
     if param:
         fn(param.rstrip("]"), probe=probe_of(week))
     else:
@@ -566,7 +614,7 @@ def plant_problems(planted, weeks, graders_of) -> list[str]:
     tasks = {t.id for w in weeks for t in w.tasks}
     for task, mistake, names in planted:
         graders = graders_of(task[:2])
-        missing = [n for n in names if n not in graders]
+        missing = [n for n in names if n not in graders and not n.startswith("hidden/")]
         if task not in tasks or missing:
             problems.append(f"{task} {mistake.__name__}: no such task or graders {missing}")
         elif not any(graders[n] == task for n in names):
