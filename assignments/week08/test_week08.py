@@ -367,7 +367,7 @@ def test_pdf(name, probe):
 
 
 def scatters_as_the_reference(result, name, spec, theta, what):
-    """"" if the share of draws that scattered (result: a Chi2Result) agrees with the
+    """ "" if the share of draws that scattered (result: a Chi2Result) agrees with the
     model's (reference_integrals) within 5 binomial standard errors and the
     quadrature's 3e-3, else why not: a check of sampling needs samples, as many as
     the model makes."""
@@ -399,7 +399,7 @@ SAMPLING_HINTS["cook_torrance_beckmann"] = SAMPLING_HINTS["cook_torrance_ggx"]
 
 
 def sampling_problem(subject, name, spec, theta, alpha, seed, what):
-    """"" if scattering() draws with density pdf() (chi-square at alpha, 10,000 draws)
+    """ "" if scattering() draws with density pdf() (chi-square at alpha, 10,000 draws)
     and scatters as often as the model does, else what is wrong. what: Class.method
     (file) for the message."""
     result = rt.chi2_test(subject, theta, n_samples=10_000, theta_bins=8, phi_bins=16, seed=seed)
@@ -413,7 +413,7 @@ def sampling_problem(subject, name, spec, theta, alpha, seed, what):
 
 
 def weight_problem(subject, name, spec, theta, n, seed, what):
-    """"" if every weight of n draws is the draw's BRDF() * cos / pdf() and, for a
+    """ "" if every weight of n draws is the draw's BRDF() * cos / pdf() and, for a
     graded model, the model's own BRDF * cos / pdf at that direction, else what is
     wrong (what: Class.method (file) for the message)."""
     samples = subject.draw(theta, n, seed=seed)
@@ -447,7 +447,7 @@ def weight_problem(subject, name, spec, theta, n, seed, what):
 
 
 def energy_problem(subject, name, spec, theta, seed):
-    """"" if the directional albedo, by quadrature of BRDF() * cos and by the mean
+    """ "" if the directional albedo, by quadrature of BRDF() * cos and by the mean
     weight of 10,000 draws of scattering(), is the model's, else what is wrong and
     which method to look at (BRDF() when the quadrature is off, else scattering())."""
     a = rt.directional_albedo(subject, theta, n_samples=10_000, seed=seed)
@@ -554,7 +554,9 @@ FURNACE_Z = 4.5
 
 def make_furnace_spread(probe):
     seeds = list(SPREAD["seeds"])
-    stack = probe.render(scene="week08_furnace", params=FURNACE_PARAMS, seeds=seeds, settings=FURNACE)
+    stack = probe.render(
+        scene="week08_furnace", params=FURNACE_PARAMS, seeds=seeds, settings=FURNACE
+    )
     per_le = []
     for rho in SPREAD_RHOS:
         params = {"albedo": [rho] * 3, "emit": [1.0] * 3, "eye": [0, 0, 0], "look_at": [0, 0, -1]}
@@ -587,7 +589,7 @@ def furnace_spread(rho=None, le=None):
 
 
 def furnace_problem(values, rho, le, spread, what):
-    """"" if the furnace's pixel values have the mean Le / (1 - rho) and a spread no
+    """ "" if the furnace's pixel values have the mean Le / (1 - rho) and a spread no
     larger than NOISE_RATIO times `spread` (a correct path tracer's), else what is
     wrong. The z-test's standard error is the reference's spread over sqrt(pixels):
     the submission's own noise never widens it."""
@@ -621,7 +623,9 @@ def furnace_problem(values, rho, le, spread, what):
 def test_path_furnace(probe):
     """path integrator: inside a glowing sphere L = Le / (1 - albedo)"""
     material = FURNACE_PARAMS["material"]
-    stack = probe.render(scene="week08_furnace", params=FURNACE_PARAMS, seeds=[1, 2], settings=FURNACE)
+    stack = probe.render(
+        scene="week08_furnace", params=FURNACE_PARAMS, seeds=[1, 2], settings=FURNACE
+    )
     values = stack[..., 0].ravel()
     assert values.size == 2 * 8 * 8, f"the furnace has {values.size} pixel values, expected 128"
     problem = furnace_problem(

@@ -395,8 +395,9 @@ def chi2_test(
     outright (p = 0), as does a pdf() value that is negative or not finite, or
     a pdf() whose integral over the sphere exceeds 1 by more than the
     quadrature's uncertainty, and so does a draw too small to test (every bin
-    pooled into one: nothing scattered, or almost nothing). inside: the viewer is inside the material (the hit
-    on its back face). material: an rtpy Material or a MaterialSubject.
+    pooled into one: nothing scattered, or almost nothing). inside: the viewer is
+    inside the material (the hit on its back face). material: an rtpy Material or
+    a MaterialSubject.
     """
     if theta_bins < 2 or theta_bins % 2 or phi_bins < 1:
         raise ValueError("theta_bins must be even and >= 2, phi_bins >= 1")

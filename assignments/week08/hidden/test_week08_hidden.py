@@ -18,10 +18,8 @@ two-sided normal tail of 7e-6, far below 1e-3 even where the approximation is of
 Together: below 2e-4 per submission.
 """
 
-import math
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import rtpy.testing as rt
