@@ -47,6 +47,7 @@ from rtpy import (
 from rtpy.grading import compare, summarize
 from rtpy.grading.assignment import WEEKS
 from rtpy.grading.graders import collect_graders, local_probe
+from rtpy.grading.sandbox import StudentError
 from rtpy.grading.tasks import load_weeks
 from rtpy.io.cli import main
 from rtpy.materials import BlinnPhong, CookTorrance, Lambertian, Metal, Phong, Ward
@@ -126,6 +127,26 @@ def two_blockers_needed(mp):
         return hits > 1  # the course's "shadowed only if more than one object is hit"
 
     mp.setattr(Scene, "find_occlusion", find_occlusion)
+
+
+def occlusion_by_the_bvh(mp):
+    """find_occlusion answered by the given BVH's any_hit (the code above the stub)."""
+
+    def find_occlusion(self, ray, interval, ignore=None):
+        return self.bvh().any_hit(ray, interval.min, interval.max, ignore)
+
+    mp.setattr(Scene, "find_occlusion", find_occlusion)
+
+
+def lambertian_as_oren_nayar(mp):
+    """Lambertian's three methods answered by the given OrenNayar with sigma = 0."""
+    from rtpy.materials import OrenNayar
+
+    def delegate(name):
+        return lambda self, *args: getattr(OrenNayar(self.albedo, 0.0), name)(*args)
+
+    for name in ("BRDF", "pdf", "scattering"):
+        mp.setattr(Lambertian, name, delegate(name))
 
 
 def cosine_with_unnormalised_vector(mp):
@@ -464,7 +485,9 @@ PLANTED = [
     ("05.1", no_falloff, ["test_point_light_sample", "test_direct_light_on_a_plane_is_exact"]),
     ("05.1", unnormalised_light_vector, ["test_point_light_sample"]),
     ("05.2", two_blockers_needed, ["test_shadow_rays", "test_direct_light_on_a_plane_is_exact"]),
+    ("05.2", occlusion_by_the_bvh, ["test_shadow_rays"]),
     ("05.3", albedo_as_brdf, ["test_lambertian_brdf_and_sampling"]),
+    ("05.3", lambertian_as_oren_nayar, ["test_lambertian_brdf_and_sampling"]),
     ("05.3", lambertian_no_pdf, ["test_lambertian_brdf_and_sampling"]),
     ("05.3", source("lambertian_pdf_uniform"), ["test_lambertian_brdf_and_sampling"]),
     (
@@ -592,7 +615,7 @@ def run_grader_test(week: str, name: str) -> None:
 def test_a_planted_mistake_fails_its_graders(monkeypatch, task, mistake, graders):
     mistake(monkeypatch)
     for name in graders:
-        with pytest.raises(AssertionError) as info:
+        with pytest.raises((AssertionError, StudentError)) as info:  # a verdict or a refusal
             run_grader_test(task[:2], name)
         message = str(info.value)
         # where to look: a file, a Class.method or a function of rtpy, or the integrator
