@@ -18,6 +18,7 @@ from rtpy.grading import (
     assert_renders_match,
     points,
     reference_summary,
+    scene_uses,
 )
 from rtpy.grading.remote_material import RemoteMaterial
 
@@ -237,6 +238,7 @@ def make_reference_summary(probe):
 
 
 @points(4, task="05.4")
+@scene_uses("05.1", "05.2", "05.3")
 def test_direct_render_matches_reference(probe):
     """render with an area and a point light matches the reference (light counted once)"""
     assert_renders_match(

@@ -27,6 +27,7 @@ from rtpy.grading import (
     assert_renders_match,
     points,
     reference_summary,
+    scene_uses,
 )
 from rtpy.grading.remote_material import RemoteMaterial
 
@@ -520,6 +521,7 @@ def make_reference_summary(probe):
 
 
 @points(4, task="08.4")
+@scene_uses("08.1", "08.2", "08.3")
 def test_path_render_matches_reference(probe):
     """path integrator: three glossy balls under a quad light match the reference"""
     assert_renders_match(
@@ -620,6 +622,7 @@ def furnace_problem(values, rho, le, spread, what):
 
 
 @points(4, task="08.4")
+@scene_uses()  # one glowing diffuse material, given code
 def test_path_furnace(probe):
     """path integrator: inside a glowing sphere L = Le / (1 - albedo)"""
     material = FURNACE_PARAMS["material"]

@@ -56,6 +56,29 @@ def points(n: float, task: str | None = None):
     return pytest.mark.points(n, task=task)
 
 
+# (grader file name, test function) -> the tasks whose methods its scene uses
+SCENE_TASKS: dict[tuple[str, str], tuple[str, ...]] = {}
+
+
+def scene_uses(*tasks: str):
+    """Decorator of a grader that renders: besides its own task's, its scene uses the
+    methods of these tasks (ids of the week's map). When it fails, its feedback names
+    the failed graders of those tasks and of its own, and no others
+    (rtpy.grading.results)."""
+
+    def register(function):
+        SCENE_TASKS[(Path(function.__code__.co_filename).name, function.__name__)] = tasks
+        return function
+
+    return register
+
+
+def scene_tasks(nodeid: str) -> tuple[str, ...]:
+    """The tasks registered with scene_uses for a test's node id (none if unregistered)."""
+    file, _, rest = nodeid.partition("::")
+    return SCENE_TASKS.get((Path(file).name, rest.partition("[")[0]), ())
+
+
 # --- render comparison ----------------------------------------------------------------
 def summarize(stack: np.ndarray, spp: int) -> dict[str, np.ndarray]:
     """What a comparison needs of R renders at spp: the mean image, each pixel's

@@ -126,3 +126,57 @@ def test_the_submissions_replace_the_methods(monkeypatch):
     patch_week(monkeypatch, "03", constant)
     first = vec3.cross(Vec3(1, 0, 0), Vec3(0, 1, 0))
     assert vec3.cross(Vec3(0, 1, 0), Vec3(0, 0, 1)) == first == Vec3(0, 0, 1)
+
+
+def stub(qualified: str):
+    def raises(*args, **kwargs):
+        raise NotImplementedError(f"week08 task: {qualified}")
+
+    return raises
+
+
+@pytest.mark.slow
+def test_a_stub_costs_its_own_task_and_feedback_names_what_the_check_uses(monkeypatch):
+    """Week 08 with Blinn-Phong still a stub and a sampling mistake in Phong.scattering
+    (the highlight drawn around the normal): Cook-Torrance keeps every point, visible
+    and hidden; the hidden Blinn-Phong cases fail alone; the failed render names every
+    failed grader of the models in its scene and the furnace (one given material) none;
+    Phong's mistake is blamed on scattering(), its BRDF keeps its points."""
+    from rtpy.materials import BlinnPhong
+
+    from .test_graders import source
+
+    for name in ("BRDF", "pdf", "scattering"):
+        monkeypatch.setattr(BlinnPhong, name, stub(f"BlinnPhong.{name}"))
+    source("phong_highlight_around_the_normal")(monkeypatch)
+    results = grade("08", ROOT, in_process=True, hidden=True)
+    tests = {t["number"]: t for t in results["tests"]}
+    by_name = {t["name"]: t for t in results["tests"]}
+    task = {
+        n: sum(t["score"] for t in results["tests"] if t["number"].startswith(n + "."))
+        for n in ("8.1", "8.2", "8.3")
+    }
+    assert task["8.2"] == 0 and task["8.3"] == 14, task
+    hidden = {
+        n.rpartition("[")[2].rstrip("]"): t for n, t in by_name.items() if "new parameters" in n
+    }
+    assert {k: t["score"] > 0 for k, t in hidden.items() if "CookTorrance" in k} == {
+        "CookTorrance": True
+    }
+    assert all(t["score"] == 0 for n, t in by_name.items() if n.endswith("[BlinnPhong]"))
+    assert (
+        by_name["Phong: Phong.BRDF: kd albedo / pi + ks (n + 2) / (2 pi) max(0, r . wo)^n"]["score"]
+        == 3
+    )
+    for t in results["tests"]:
+        if t["number"].startswith("8.1.") and t["status"] == "failed":
+            assert "Phong.scattering" in t["output"] and "Phong.BRDF" not in t["output"], t
+    render = next(t for t in results["tests"] if "three glossy balls" in t["name"])
+    failed_82 = [n for n, t in tests.items() if n.startswith("8.2.") and t["status"] == "failed"]
+    assert render["status"] == "failed" and len(failed_82) == 5
+    for number in failed_82:
+        assert number in render["output"]
+    assert "8.1 Phong (Phong.BRDF, Phong.pdf, Phong.scattering)" in render["output"]
+    assert "8.3" not in render["output"].partition("fix those first")[2]  # Cook-Torrance is right
+    furnace = next(t for t in results["tests"] if t["name"].endswith("L = Le / (1 - albedo)"))
+    assert furnace["status"] == "passed"
