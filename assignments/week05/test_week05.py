@@ -20,6 +20,7 @@ from rtpy.grading import (
     reference_summary,
     scene_uses,
 )
+from rtpy.grading.graders import chi2_picture_note
 from rtpy.grading.remote_material import RemoteMaterial
 
 HERE = Path(__file__).parent
@@ -103,8 +104,11 @@ def test_lambertian_brdf_and_sampling(probe):
             f"cosine sampling) and pdf = cos / pi: {weights.detail}"
         )
         chi2 = rt.chi2_test(material, theta, n_samples=20_000, theta_bins=8, phi_bins=8, seed=5)
-        assert chi2.passed(rt.sidak_alpha(0.01, 2)), (
-            f"Lambertian.scattering: directions do not follow pdf = cos / pi: {chi2.summary()}"
+        passed = chi2.passed(rt.sidak_alpha(0.01, 2))
+        picture = f"week05-Lambertian-{theta:g}deg"
+        assert passed, (
+            f"Lambertian.scattering: directions do not follow pdf = cos / pi: {chi2.summary()}."
+            + chi2_picture_note(chi2, theta, material, picture, "Lambertian.scattering", "05")
         )
 
 

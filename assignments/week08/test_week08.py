@@ -29,6 +29,7 @@ from rtpy.grading import (
     reference_summary,
     scene_uses,
 )
+from rtpy.grading.graders import chi2_picture_note
 from rtpy.grading.remote_material import RemoteMaterial
 
 HERE = Path(__file__).parent
@@ -399,16 +400,20 @@ SAMPLING_HINTS = {
 SAMPLING_HINTS["cook_torrance_beckmann"] = SAMPLING_HINTS["cook_torrance_ggx"]
 
 
-def sampling_problem(subject, name, spec, theta, alpha, seed, what):
-    """ "" if scattering() draws with density pdf() (chi-square at alpha, 10,000 draws)
-    and scatters as often as the model does, else what is wrong. what: Class.method
-    (file) for the message."""
+def sampling_problem(subject, name, spec, theta, alpha, seed, what, picture=True):
+    """Nothing ("") if scattering() draws with density pdf() (chi-square at alpha,
+    10,000 draws) and scatters as often as the model does, else what is wrong. what:
+    Class.method (file) for the message; picture: draw a failed check
+    (rtpy.grading.graders.chi2_picture_note), not for checks a student cannot run."""
     result = rt.chi2_test(subject, theta, n_samples=10_000, theta_bins=8, phi_bins=16, seed=seed)
     at = f"{what} at {theta:.3g} degrees"
     if not result.passed(alpha):
+        file = f"week08-{spec['type']}-{theta:.3g}deg".replace(".", "_")
+        note = chi2_picture_note(result, theta, subject, file, what, "08") if picture else ""
         return (
             f"{at} draws directions that do not follow pdf() (p = {result.p_value:.2g}): "
-            f"{result.summary()}. Check the lobe sampling and its density: {SAMPLING_HINTS[name]}"
+            f"{result.summary()}. Check the lobe sampling and its density: "
+            f"{SAMPLING_HINTS[name]}.{note}"
         )
     return scatters_as_the_reference(result, name, spec, theta, at)
 

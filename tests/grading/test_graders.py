@@ -726,3 +726,19 @@ def test_shadow_acne_is_blamed_on_the_missing_spawn_ray(monkeypatch):
     source("shadow_ray_without_offset")(monkeypatch)
     with pytest.raises(AssertionError, match=r"spawn_ray\(hit.point, hit.normal, direction\)"):
         run_grader_test("05", "test_direct_render_matches_reference")
+
+
+def test_a_failed_chi_square_grader_draws_its_picture_locally(monkeypatch, tmp_path):
+    """Phong's highlight drawn around the normal: in a local run (PICTURES set by
+    grade()) the sampling grader draws the check and names the file; elsewhere (the
+    autograder, plain pytest) its message says how to get the picture."""
+    import rtpy.grading.graders as graders
+
+    source("phong_highlight_around_the_normal")(monkeypatch)
+    with pytest.raises(AssertionError, match=r"python -m rtpy grade 08.* rtpy-checks/week08"):
+        run_grader_test("08", "test_sampling_follows_pdf[phong]")
+    monkeypatch.setattr(graders, "PICTURES", tmp_path / "rtpy-checks")
+    with pytest.raises(AssertionError) as info:
+        run_grader_test("08", "test_sampling_follows_pdf[phong]")
+    drawn = list((tmp_path / "rtpy-checks").glob("week08-Phong-*.png"))
+    assert len(drawn) == 1 and f"Picture of this check: {drawn[0].as_posix()}" in str(info.value)

@@ -107,6 +107,7 @@ def test_sampling_follows_pdf_at_new_parameters(k, probe):
         alpha,
         grading_seed(810 + k),
         f"{described(spec)}.scattering",
+        picture=False,
     )
     assert not problem, problem
 
