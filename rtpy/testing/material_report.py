@@ -160,9 +160,7 @@ def check_material(
     across the surface too, with `ior` the index of refraction inside over outside
     (default: the material's own `ior`). inside=True or False forces checking
     from inside, or not. picture: a PNG file to draw the first failed chi2 check in
-    (observed and expected histograms, their difference, BRDF * cos and pdf in the
-    plane of incidence: rtpy.testing.chi_square_picture); nothing is written when
-    every chi2 check passes.
+    (rtpy.testing.chi_square_picture); nothing is written when every one passes.
     """
     start = time.perf_counter()
     name = material_name(material)
@@ -211,11 +209,16 @@ def check_material(
         )
     report = MaterialReport(name, checks, a, time.perf_counter() - start)
     if picture is not None and options["failed_chi2"]:
-        from .chi_square_picture import chi2_picture
-
-        result, theta, side = options["failed_chi2"][0]
-        report.picture = chi2_picture(result, picture, theta, material, inside=side, title=name)
+        report.picture = _picture(picture, options["failed_chi2"][0], material, name)
     return report
+
+
+def _picture(path: str | Path, failed: tuple, material: MaterialSubject, name: str) -> Path:
+    """The picture of a failed chi2 check (its Chi2Result, angle and side) at path."""
+    from .chi_square_picture import chi2_picture
+
+    result, theta, side = failed
+    return chi2_picture(result, path, theta, material, inside=side, title=name)
 
 
 def _draw(subject: MaterialSubject, theta: float, n: int, seed: int, inside: bool):
