@@ -302,6 +302,15 @@ def first_hit_not_closest(mp):
     mp.setattr(Scene, "find_intersection", find_intersection)
 
 
+def closest_hit_by_the_bvh(mp):
+    """find_intersection answered by the given BVH (the code above the stub)."""
+
+    def find_intersection(self, ray, interval):
+        return self.bvh().find_intersection(ray, interval)
+
+    mp.setattr(Scene, "find_intersection", find_intersection)
+
+
 def reflect_wrong_sign(mp):
     def reflect(v, n):
         k = 2.0 * vec3.dot(v, n)
@@ -482,6 +491,7 @@ PLANTED = [
     ("04.2", quad_no_interior_test, ["test_quad_hit", "test_center_render_matches_reference"]),
     ("04.3", source("triangle_as_parallelogram"), ["test_triangle_hit"]),
     ("04.4", first_hit_not_closest, ["test_closest_hit", "test_center_render_matches_reference"]),
+    ("04.4", closest_hit_by_the_bvh, ["test_closest_hit"]),
     ("05.1", no_falloff, ["test_point_light_sample", "test_direct_light_on_a_plane_is_exact"]),
     ("05.1", unnormalised_light_vector, ["test_point_light_sample"]),
     ("05.2", two_blockers_needed, ["test_shadow_rays", "test_direct_light_on_a_plane_is_exact"]),

@@ -105,7 +105,8 @@ def earned(results: dict) -> list[str]:
 @pytest.mark.slow
 @pytest.mark.parametrize("make", [nothing, constant], ids=["nothing", "constant"])
 @pytest.mark.parametrize("week", sorted(WEEKS))
-def test_a_week_not_done_scores_zero(monkeypatch, week, make):
+def test_a_week_not_done_scores_zero(monkeypatch, tmp_path, week, make):
+    monkeypatch.chdir(tmp_path)  # grade() draws failed chi-square checks here
     patch_week(monkeypatch, week, make)
     results = grade(week, ROOT, in_process=True, hidden=True)
     assert results["score"] == 0, f"week {week}, {make.__name__}: points for {earned(results)}"
@@ -136,7 +137,7 @@ def stub(qualified: str):
 
 
 @pytest.mark.slow
-def test_a_stub_costs_its_own_task_and_feedback_names_what_the_check_uses(monkeypatch):
+def test_a_stub_costs_its_own_task_and_feedback_names_what_the_check_uses(monkeypatch, tmp_path):
     """Week 08 with Blinn-Phong still a stub and a sampling mistake in Phong.scattering
     (the highlight drawn around the normal): Cook-Torrance keeps every point, visible
     and hidden; the hidden Blinn-Phong cases fail alone; the failed render names every
@@ -149,6 +150,7 @@ def test_a_stub_costs_its_own_task_and_feedback_names_what_the_check_uses(monkey
     for name in ("BRDF", "pdf", "scattering"):
         monkeypatch.setattr(BlinnPhong, name, stub(f"BlinnPhong.{name}"))
     source("phong_highlight_around_the_normal")(monkeypatch)
+    monkeypatch.chdir(tmp_path)  # grade() draws failed chi-square checks here
     results = grade("08", ROOT, in_process=True, hidden=True)
     tests = {t["number"]: t for t in results["tests"]}
     by_name = {t["name"]: t for t in results["tests"]}
