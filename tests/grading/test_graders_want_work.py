@@ -182,3 +182,38 @@ def test_a_stub_costs_its_own_task_and_feedback_names_what_the_check_uses(monkey
     assert "8.3" not in render["output"].partition("fix those first")[2]  # Cook-Torrance is right
     furnace = next(t for t in results["tests"] if t["name"].endswith("L = Le / (1 - albedo)"))
     assert furnace["status"] == "passed"
+
+
+# (week, the task whose methods are stubs, hidden cases that keep their points, those lost)
+ONE_STUB = [
+    ("03", "03.2", ["[vectors]"], ["[intervals]"]),
+    ("04", "04.3", ["[Quad]"], ["[Triangle]"]),
+    ("06", "06.2", ["[reflect]"], ["[refract]"]),
+    ("08", "08.2", ["[Phong]", "[CookTorrance]"], ["[BlinnPhong]"]),
+]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("week,task,kept,lost", ONE_STUB, ids=[t for _, t, _, _ in ONE_STUB])
+def test_a_stub_costs_no_hidden_points_of_another_task(
+    monkeypatch, tmp_path, week, task, kept, lost
+):
+    """Hidden checks are per task: with one task's methods stubs (NotImplementedError),
+    the hidden cases of the other tasks keep their points."""
+    monkeypatch.chdir(tmp_path)
+    for name in WEEKS[week].task(task).methods:
+        owner, attribute = owner_of(name)
+        monkeypatch.setattr(owner, attribute, stub(name))
+        if inspect.ismodule(owner):  # and where other rtpy modules imported it by name
+            for module_name, module in list(sys.modules.items()):
+                found = getattr(module, attribute, None) if module_name.startswith("rtpy") else None
+                if callable(found) and getattr(found, "__module__", "") == owner.__name__:
+                    monkeypatch.setattr(module, attribute, stub(name))
+    results = grade(week, ROOT, in_process=True, hidden=True)
+    hidden = {t["name"]: t for t in results["tests"] if t["visibility"] != "visible"}
+    for case in kept:
+        scores = [t["score"] for n, t in hidden.items() if n.endswith(case)]
+        assert scores and all(x > 0 for x in scores), (case, scores)
+    for case in lost:
+        scores = [t["score"] for n, t in hidden.items() if n.endswith(case)]
+        assert scores and not any(scores), (case, scores)
