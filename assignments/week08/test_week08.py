@@ -444,11 +444,22 @@ def weight_problem(subject, name, spec, theta, n, seed, what):
     if not bad.any():
         return ""
     k = int(np.argmax(bad))
+    own_f = subject.brdf(wo[k : k + 1], wi[k : k + 1])[0]
+    own_p = subject.pdf(wo[k : k + 1], wi[k : k + 1])[0]
+    wrong = [
+        method
+        for method, own, model in (
+            ("BRDF()", own_f, reference_brdf(name, m, wo[k], wi[k])),
+            ("pdf()", own_p, pdf[k]),
+        )
+        if not np.allclose(own, model, rtol=1e-6, atol=1e-12)
+    ] or ["BRDF() or pdf()"]
     return (
         f"{at}: {int(bad.sum())} of {len(idx)} weights are not the model's BRDF * cos / pdf, "
         f"e.g. wi = {wi[k].round(4)}: {got[k].round(6)}, the model's {expected[k].round(6)}. "
-        "The weights agree with your own BRDF() and pdf(), so those differ from the model "
-        "there: fix them first (their checks above say how)"
+        f"The weights agree with your own BRDF() and pdf(); your {' and '.join(wrong)} "
+        f"{'differ' if len(wrong) > 1 else 'differs'} from the model there: fix that first "
+        "(its check above says how)"
     )
 
 

@@ -752,3 +752,20 @@ def test_a_failed_chi_square_grader_draws_its_picture_locally(monkeypatch, tmp_p
         run_grader_test("08", "test_sampling_follows_pdf[phong]")
     drawn = list((tmp_path / "rtpy-checks").glob("week08-Phong-*.png"))
     assert len(drawn) == 1 and f"Picture of this check: {drawn[0].as_posix()}" in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "label,blamed,spared",
+    [
+        ("phong_pdf_around_the_normal", "pdf()", "BRDF()"),
+        ("phong_wrong_normalisation", "BRDF()", "pdf()"),
+    ],
+)
+def test_a_wrong_weight_names_the_method_that_makes_it_wrong(monkeypatch, label, blamed, spared):
+    """The weights of weighted_sample are BRDF * cos / pdf of the student's own methods:
+    when they differ from the model's, the message names the one that differs there."""
+    source(label)(monkeypatch)
+    with pytest.raises(AssertionError) as info:
+        run_grader_test("08", "test_weight_is_brdf_cos_over_pdf[phong]")
+    message = str(info.value)
+    assert f"your {blamed} differs from the model" in message and f"your {spared}" not in message
