@@ -3,7 +3,8 @@
 Every grader module `assignments/weekNN/test_weekNN.py` with a render defines REFERENCE
 and either make_reference_summary(probe), written to `reference/<REFERENCE["name"]>.npz`
 (mean image, per-sample variance, sample count), or make_reference_image(probe),
-written to `.npy`; the probe is answered in this process, by rtpy's solution.
+written to `.npy`, and each of MORE_REFERENCES {name: function(probe) -> arrays},
+written to `reference/<name>.npz`; the probe is answered in this process, by rtpy's solution.
 Run after changing a graded scene or the physics:
     python scripts/make_assignment_references.py [WEEK ...]
 """
@@ -40,6 +41,10 @@ def main(weeks: list[str]) -> None:
             out = name.with_suffix(".npy")
             np.save(out, module.make_reference_image(probe))
         print(f"wrote {out.relative_to(ROOT)}")
+        for more, make in getattr(module, "MORE_REFERENCES", {}).items():
+            out = folder / "reference" / f"{more}.npz"
+            save_reference(out, make(probe))
+            print(f"wrote {out.relative_to(ROOT)}")
 
 
 if __name__ == "__main__":

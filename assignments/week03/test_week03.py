@@ -15,6 +15,7 @@ from rtpy.grading import (
     assert_renders_match,
     points,
     reference_summary,
+    scene_uses,
 )
 from rtpy.testing import chi2_sf
 
@@ -185,6 +186,7 @@ def make_reference_summary(probe):
 
 
 @points(2, task="03.5")
+@scene_uses("03.1", "03.3")
 def test_sky_render_matches_reference(probe):
     """jittered render of the sky matches the reference (camera rays and pixel jitter)"""
     assert_renders_match(

@@ -4,7 +4,7 @@ plain data, calls the week's task methods and returns plain data; the verdicts a
 the graders'."""
 
 from rtpy import Camera, Color, Interval, Lambertian, Quad, Ray, Scene, Sphere, Triangle, Vec3
-from rtpy.grading.probes import floats, probe, scene_builder, vec
+from rtpy.grading.probes import floats, given_code_unused, probe, scene_builder, vec
 from rtpy.grading.protocol import Bool, Float, Int, List, Maybe, Record, Vec
 
 M = Lambertian()
@@ -62,12 +62,15 @@ def scene_closest_hit(cases: list):
     """Scene(spheres).find_intersection(Ray(origin, direction), Interval(lo, hi)) for
     each case {"spheres": [[center, radius], ...], "origin", "direction", "interval":
     [lo, hi]}: None, or the hit's t and the index in `spheres` of the object it names
-    (hit.obj; -1 when it names none of them)."""
+    (hit.obj; -1 when it names none of them). The BVH's code is watched: it answers
+    the task."""
     out = []
     for c in cases:
         spheres = [Sphere(vec(center), float(r), M) for center, r in c["spheres"]]
         lo, hi = c["interval"]
-        hit = Scene(spheres).find_intersection(make_ray(c), Interval(float(lo), float(hi)))
+        scene, ray, interval = Scene(spheres), make_ray(c), Interval(float(lo), float(hi))
+        with given_code_unused(("rtpy.bvh",), "Scene.find_intersection (rtpy/scene.py)"):
+            hit = scene.find_intersection(ray, interval)
         if hit is None:
             out.append(None)
             continue

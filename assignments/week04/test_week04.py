@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rtpy.grading import assert_image_matches, points
+from rtpy.grading import assert_image_matches, points, scene_uses
 
 HERE = Path(__file__).parent
 
@@ -175,6 +175,7 @@ def make_reference_image(probe):
 
 
 @points(2, task="04.4")
+@scene_uses("04.1", "04.2", "04.3")
 def test_center_render_matches_reference(probe):
     """center integrator render of spheres, a quad and a triangle matches the reference"""
     image = probe.render(scene="week04_shapes", seeds=[0], settings=CENTER)[0]

@@ -18,7 +18,9 @@ from rtpy.grading import (
     assert_renders_match,
     points,
     reference_summary,
+    scene_uses,
 )
+from rtpy.grading.graders import chi2_picture_note
 from rtpy.grading.remote_material import RemoteMaterial
 
 HERE = Path(__file__).parent
@@ -102,8 +104,11 @@ def test_lambertian_brdf_and_sampling(probe):
             f"cosine sampling) and pdf = cos / pi: {weights.detail}"
         )
         chi2 = rt.chi2_test(material, theta, n_samples=20_000, theta_bins=8, phi_bins=8, seed=5)
-        assert chi2.passed(rt.sidak_alpha(0.01, 2)), (
-            f"Lambertian.scattering: directions do not follow pdf = cos / pi: {chi2.summary()}"
+        passed = chi2.passed(rt.sidak_alpha(0.01, 2))
+        picture = f"week05-Lambertian-{theta:g}deg"
+        assert passed, (
+            f"Lambertian.scattering: directions do not follow pdf = cos / pi: {chi2.summary()}."
+            + chi2_picture_note(chi2, theta, material, picture, "Lambertian.scattering", "05")
         )
 
 
@@ -237,6 +242,7 @@ def make_reference_summary(probe):
 
 
 @points(4, task="05.4")
+@scene_uses("05.1", "05.2", "05.3")
 def test_direct_render_matches_reference(probe):
     """render with an area and a point light matches the reference (light counted once)"""
     assert_renders_match(

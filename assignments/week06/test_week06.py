@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rtpy.grading import assert_image_matches, points
+from rtpy.grading import assert_image_matches, points, scene_uses
 
 HERE = Path(__file__).parent
 
@@ -201,6 +201,7 @@ def make_reference_image(probe):
 
 
 @points(3, task="06.3")
+@scene_uses("06.1", "06.2")
 def test_whitted_render_matches_reference(probe):
     """whitted render of a glass and a mirror ball matches the reference"""
     image = render_optics(probe)

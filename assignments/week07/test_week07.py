@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rtpy.grading import assert_image_matches, points
+from rtpy.grading import assert_image_matches, points, scene_uses
 
 HERE = Path(__file__).parent
 
@@ -174,6 +174,7 @@ def make_reference_image(probe):
 
 
 @points(2, task="07.2")
+@scene_uses("07.1")
 def test_texture_render_matches_reference(probe):
     """center render of checker and image textures matches the reference"""
     image = render_textures(probe)

@@ -13,6 +13,7 @@ from .graders import (
     points,
     reference_summary,
     save_reference,
+    scene_uses,
     summarize,
 )
 
@@ -26,5 +27,6 @@ __all__ = [
     "points",
     "reference_summary",
     "save_reference",
+    "scene_uses",
     "summarize",
 ]

@@ -45,6 +45,10 @@ ALPHA = 1e-3
 # submission that spreads its light unevenly over its renders cannot widen the test.
 NOISE_CAP = 4.0
 PROBES_FILE = "probes.py"  # assignments/weekNN/probes.py: the week's probes
+# Where a local run (grade()) draws the failed chi-square checks; None elsewhere (the
+# autograder, plain pytest): the message then says how to get the picture.
+PICTURES: Path | None = None
+PICTURES_FOLDER = "rtpy-checks"
 HIDDEN = "hidden"  # assignments/weekNN/hidden/: the checks only the autograder holds
 
 
@@ -54,6 +58,29 @@ def points(n: float, task: str | None = None):
     import pytest
 
     return pytest.mark.points(n, task=task)
+
+
+# (grader file name, test function) -> the tasks whose methods its scene uses
+SCENE_TASKS: dict[tuple[str, str], tuple[str, ...]] = {}
+
+
+def scene_uses(*tasks: str):
+    """Decorator of a grader that renders: besides its own task's, its scene uses the
+    methods of these tasks (ids of the week's map). When it fails, its feedback names
+    the failed graders of those tasks and of its own, and no others
+    (rtpy.grading.results)."""
+
+    def register(function):
+        SCENE_TASKS[(Path(function.__code__.co_filename).name, function.__name__)] = tasks
+        return function
+
+    return register
+
+
+def scene_tasks(nodeid: str) -> tuple[str, ...]:
+    """The tasks registered with scene_uses for a test's node id (none if unregistered)."""
+    file, _, rest = nodeid.partition("::")
+    return SCENE_TASKS.get((Path(file).name, rest.partition("[")[0]), ())
 
 
 # --- render comparison ----------------------------------------------------------------
@@ -148,6 +175,25 @@ def assert_image_matches(
     )
 
 
+def chi2_picture_note(result, incident_deg: float, subject, name: str, what: str, week: str) -> str:
+    """What a failed chi-square grader adds to its message: the picture of the check it
+    drew (rtpy.testing.chi_square_picture) in a local run, else how to get one.
+    name: the file's name (no suffix); what: the method checked, for the title."""
+    if PICTURES is None:
+        return (
+            f" To see this check as a picture, run `python -m rtpy grade {week}` in your "
+            f"repository: it draws it in {PICTURES_FOLDER}/{name}.png."
+        )
+    from ..testing.chi_square_picture import chi2_picture
+
+    path = PICTURES / f"{name}.png"
+    try:
+        chi2_picture(result, path, incident_deg, subject=subject, title=what)
+    except OSError as err:
+        return f" (The picture of this check could not be written to {path}: {err.strerror}.)"
+    return f" Picture of this check: {path.as_posix()}"
+
+
 # --- running graders here -------------------------------------------------------------
 def grader_dir(week: str, root: Path | None = None) -> Path:
     """assignments/weekNN under the current directory, else next to the rtpy package."""
@@ -215,16 +261,22 @@ def grade(
     """Run week's graders here, the student's code in a child process (or, for rtpy's
     own tests, in_process); the results dictionary (rtpy.grading.results). The hidden
     checks (the folder's hidden/, in rtpy's own repository only) are the autograder's:
-    they run only with hidden=True."""
+    they run only with hidden=True. A failed chi-square grader draws its picture in
+    PICTURES_FOLDER of the current directory."""
     from .results import gradescope_results
     from .tasks import TASKS_FILE, load_week
 
+    global PICTURES
     folder = grader_dir(week, root)
     start = time.perf_counter()
     paths = [str(p) for p in sorted(folder.glob("test_*.py"))]
     if hidden:
         paths += [str(p) for p in sorted((folder / HIDDEN).glob("test_*.py"))]
-    plugin = run_graders(folder, paths, local_runner(folder, in_process))
+    PICTURES = Path(PICTURES_FOLDER)  # relative: the student's own folder, named as such
+    try:
+        plugin = run_graders(folder, paths, local_runner(folder, in_process))
+    finally:
+        PICTURES = None
     week_map = load_week(folder) if (folder / TASKS_FILE).is_file() else None
     results = gradescope_results(list(plugin.tests.values()), week_map)
     results["execution_time"] = round(time.perf_counter() - start, 2)

@@ -24,7 +24,9 @@ component graders that failed.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import contextlib
+import sys
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,12 +34,14 @@ import numpy as np
 from .protocol import Array, Bool, List, Schema, Vec
 
 __all__ = [
+    "GIVEN_ANSWERS",
     "MATERIALS",
     "PROBES",
     "SCENES",
     "Probe",
     "color",
     "floats",
+    "given_code_unused",
     "make_material",
     "probe",
     "scene_builder",
@@ -149,6 +153,74 @@ def make_material(spec: dict):
     return cls(**params)
 
 
+# --- a task is answered by the student's code -----------------------------------------
+class GivenCodeUsed(Exception):
+    """A task's method ran given code that answers the task for it."""
+
+
+def _code_files(module_name: str) -> set[str]:
+    """The file names the code objects of a module's functions carry."""
+    import importlib
+    import inspect
+
+    module = importlib.import_module(module_name)
+    files = {module.__file__}
+    for value in vars(module).values():
+        if getattr(value, "__module__", None) != module_name:
+            continue  # imported there, not given there
+        members = vars(value).values() if inspect.isclass(value) else [value]
+        for member in members:
+            code = getattr(inspect.unwrap(getattr(member, "__func__", member)), "__code__", None)
+            if code is not None:
+                files.add(code.co_filename)
+    return files
+
+
+@contextlib.contextmanager
+def given_code_unused(modules: tuple[str, ...], task: str) -> Iterator[None]:
+    """Run the block watching the given modules' code (rtpy.bvh for a shadow ray, the
+    Oren-Nayar model for Lambertian): GivenCodeUsed after the block if any of their
+    functions ran. task: what is graded, "Class.method (file)", for the message.
+
+    The watch is a profile function (sys.setprofile): it sees a call however the
+    function was reached (an attribute, a reference kept at import, a subclass)."""
+    owners = {file: name for name in modules for file in _code_files(name)}
+    used: list[str] = []
+
+    def watch(frame, event, arg) -> None:
+        if event == "call" and not used:
+            module = owners.get(frame.f_code.co_filename)
+            if module is not None:
+                used.append(f"{module}.{frame.f_code.co_qualname}")
+
+    previous = sys.getprofile()
+    sys.setprofile(watch)
+    try:
+        yield
+    finally:
+        sys.setprofile(previous)
+    if used:
+        raise GivenCodeUsed(
+            f"{task} called {used[0]}: that given code answers the task, so it does not "
+            "count. Write the task's code yourself (the task's text says what it needs)"
+        )
+
+
+# Material type -> the given modules whose code answers its task (a special case of it).
+GIVEN_ANSWERS: dict[str, tuple[tuple[str, ...], str]] = {
+    "Lambertian": (
+        ("rtpy.materials.oren_nayar",),
+        "Lambertian (rtpy/materials/lambertian.py)",
+    ),
+}
+
+
+def _material_watch(spec: dict):
+    """The watch of given code for the material of a spec (none for most)."""
+    given = GIVEN_ANSWERS.get(spec.get("type"))
+    return given_code_unused(*given) if given else contextlib.nullcontext()
+
+
 # --- probes every week may use ---------------------------------------------------------
 @probe(returns=Array((None, None, None, 3)), renders=True)
 def render(scene: str, seeds: list, settings: dict, params: dict | None = None):
@@ -178,10 +250,11 @@ def material_draw(
     """n draws of scattering() in the test setup of rtpy.testing (see its subject.py)."""
     from ..testing.subject import LocalMaterial
 
-    s = LocalMaterial(make_material(material)).draw(
-        float(incident_deg), int(n), seed=int(seed), phi_deg=float(phi_deg),
-        inside=bool(inside), tag=int(tag),
-    )  # fmt: skip
+    with _material_watch(material):
+        s = LocalMaterial(make_material(material)).draw(
+            float(incident_deg), int(n), seed=int(seed), phi_deg=float(phi_deg),
+            inside=bool(inside), tag=int(tag),
+        )  # fmt: skip
     return np.column_stack([s.directions, s.weights, s.pdfs, s.status.astype(float)])
 
 
@@ -190,7 +263,9 @@ def material_brdf(material: dict, wo, wi, inside: bool):
     from ..testing.subject import LocalMaterial
 
     m = LocalMaterial(make_material(material))
-    return np.asarray(m.brdf(np.asarray(wo), np.asarray(wi), inside=bool(inside)), dtype=float)
+    with _material_watch(material):
+        f = m.brdf(np.asarray(wo), np.asarray(wi), inside=bool(inside))
+    return np.asarray(f, dtype=float)
 
 
 @probe(returns=Array((None,)))
@@ -198,7 +273,9 @@ def material_pdf(material: dict, wo, wi, inside: bool):
     from ..testing.subject import LocalMaterial
 
     m = LocalMaterial(make_material(material))
-    return np.asarray(m.pdf(np.asarray(wo), np.asarray(wi), inside=bool(inside)), dtype=float)
+    with _material_watch(material):
+        p = m.pdf(np.asarray(wo), np.asarray(wi), inside=bool(inside))
+    return np.asarray(p, dtype=float)
 
 
 @probe(returns=List(Vec))

@@ -7,7 +7,8 @@ map; the hidden checks come last, as the group "Hidden checks" (numbered after t
 last task), visible after the due date. An extension task's tests are worth 0 points:
 they show passed or failed and leave the score alone. A test's output is the judge's
 message; when a task file could not be used (it is graded as its stub) the message
-says so, and a failed render names the component graders that failed.
+says so, and a failed render names the failed graders of the tasks its scene uses
+(rtpy.grading.graders.scene_uses), all of them.
 """
 
 from __future__ import annotations
@@ -40,14 +41,8 @@ def gradescope_results(
         tests,
         key=lambda g: (g.hidden, order.index(g.task) if g.task in tasks else len(order)),
     )
-    failed_components = [
-        g.name
-        for g in ranked
-        if not g.hidden and g.outcome is not None and not g.outcome.passed and not g.outcome.renders
-    ]
-    entries, counts = [], {}
+    groups, counts = [], {}
     for g in ranked:
-        outcome = g.outcome or Outcome(False, "not run yet" if partial else not_run)
         task = tasks.get(g.task)
         group = (
             (task.number, task.title)
@@ -55,14 +50,21 @@ def gradescope_results(
             else (f"{week_number}.{len(order) + 1}", HIDDEN_TITLE if g.hidden else "Other")
         )
         counts[group] = counts.get(group, 0) + 1
+        groups.append((group, f"{group[0]}.{counts[group]}"))
+    entries = []
+    for g, (group, number) in zip(ranked, groups, strict=True):
+        outcome = g.outcome or Outcome(False, "not run yet" if partial else not_run)
+        text = explain(outcome, problems or {}, task_functions or [])
+        if outcome.renders and not outcome.passed:
+            text += failed_in_scene(g, ranked, groups, tasks)
         entries.append(
             {
                 "name": f"{group[1]}: {g.name}",
-                "number": f"{group[0]}.{counts[group]}",
+                "number": number,
                 "score": g.max_score if outcome.passed else 0.0,
                 "max_score": g.max_score,
                 "status": "passed" if outcome.passed else "failed",
-                "output": explain(outcome, problems or {}, task_functions or [], failed_components),
+                "output": text,
                 "visibility": "after_due_date" if g.hidden else "visible",
             }
         )
@@ -100,9 +102,8 @@ def scrub(results: dict, paths: dict[str, str]) -> dict:
     return results
 
 
-def explain(outcome: Outcome, problems: dict, task_functions: list, failed_components) -> str:
-    """A failed test's output, with the file problem that explains a stub's error and,
-    for a render, the component graders that failed."""
+def explain(outcome: Outcome, problems: dict, task_functions: list) -> str:
+    """A failed test's output, with the file problem that explains a stub's error."""
     if outcome.passed:
         return ""
     text = outcome.output
@@ -111,13 +112,44 @@ def explain(outcome: Outcome, problems: dict, task_functions: list, failed_compo
         if rel in problems and f"task: {task['function']}" in text:
             text = f"{rel} was not used ({problems[rel]}), so this counts as not done. {text}"
             break
-    if outcome.renders and failed_components:
-        shown = "; ".join(failed_components[:6])
-        text += (
-            f"\nThe render uses the methods of these graders, which failed: {shown}. "
-            "Fix those first."
-        )
     return text
+
+
+def failed_in_scene(render: Graded, ranked: list[Graded], groups: list, tasks: dict) -> str:
+    """For a failed render: the visible graders that failed among those of the tasks
+    its scene uses (rtpy.grading.graders.scene_uses) and of its own task, all of them,
+    by task with the task's methods; "" when none failed."""
+    from .graders import scene_tasks
+
+    used = [*scene_tasks(render.nodeid), render.task]
+    parts = []
+    for task_id in dict.fromkeys(t for t in used if t in tasks):
+        failed = [
+            f"{number} {g.name}"
+            for g, (_, number) in zip(ranked, groups, strict=True)
+            if g.task == task_id
+            and not g.hidden
+            and g.outcome is not None
+            and not g.outcome.passed
+            and not g.outcome.renders
+        ]
+        if failed:
+            task = tasks[task_id]
+            methods = ", ".join(short_name(m) for m in task.methods)
+            parts.append(f"{task.number} {task.title} ({methods}): {'; '.join(failed)}")
+    if not parts:
+        return ""
+    return (
+        "\nThis render's scene uses methods whose own checks failed; fix those first: "
+        + ". ".join(parts)
+        + "."
+    )
+
+
+def short_name(qualified: str) -> str:
+    """ "Phong.BRDF" for "rtpy.materials.phong.Phong.BRDF", "cross" for "rtpy.vec3.cross"."""
+    parts = qualified.split(".")
+    return ".".join(parts[-2:]) if parts[-2][:1].isupper() else parts[-1]
 
 
 def score_table(results: dict) -> str:

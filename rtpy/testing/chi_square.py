@@ -394,8 +394,10 @@ def chi2_test(
     category. A sample in a bin where pdf() integrates to 0 fails the test
     outright (p = 0), as does a pdf() value that is negative or not finite, or
     a pdf() whose integral over the sphere exceeds 1 by more than the
-    quadrature's uncertainty. inside: the viewer is inside the material (the hit
-    on its back face). material: an rtpy Material or a MaterialSubject.
+    quadrature's uncertainty, and so does a draw too small to test (every bin
+    pooled into one: nothing scattered, or almost nothing). inside: the viewer is
+    inside the material (the hit on its back face). material: an rtpy Material or
+    a MaterialSubject.
     """
     if theta_bins < 2 or theta_bins % 2 or phi_bins < 1:
         raise ValueError("theta_bins must be even and >= 2, phi_bins >= 1")
@@ -431,8 +433,14 @@ def _assess(samples: Samples, hist: _Histogram, bins, integral, errors, min_expe
     if message:
         p_value = 0.0
     elif dof < 1:
-        p_value = 1.0
-        message = "too few samples for a test (all bins pooled into one)"
+        # Nothing to compare: a check of sampling needs samples (a material that
+        # absorbs every draw, with pdf() 0, is consistent but tells nothing).
+        p_value = 0.0
+        scattered = n - n_absorbed - n_specular
+        message = (
+            f"too few scattered samples for a test ({scattered} of {n}; all bins pooled "
+            "into one): scattering() must return directions for the test to check them"
+        )
     else:
         p_value = chi2_sf(statistic, dof)
     worst = _worst(

@@ -104,13 +104,14 @@ def check_weights(
 ) -> CheckResult:
     """For the first n scattered (non-specular) samples: attenuation ==
     BRDF(ray_in, scattered, hit) * |cos| / pdf(ray_in, scattered, hit) per channel,
-    ScatterInfo.pdf == pdf(...), and the direction is a unit vector."""
+    ScatterInfo.pdf == pdf(...), and the direction is a unit vector. A draw with no
+    scattered sample fails: it shows nothing."""
     subject = as_subject(material)
     samples = get_samples(subject, incident_deg, n, seed, phi_deg, samples, inside)
     idx = np.flatnonzero(samples.scattered)[:n]
-    if len(idx) == 0:
-        detail = "no scattered samples"
-        return CheckResult("weights", incident_deg, True, detail, skipped=True, inside=inside)
+    if len(idx) == 0:  # nothing to check is not a pass
+        detail = f"no scattered samples: scattering() returned no direction in {samples.n} draws"
+        return CheckResult("weights", incident_deg, False, detail, inside=inside)
     wi = samples.directions[idx]
     wo = np.broadcast_to(local_direction(incident_deg, phi_deg).tolist(), wi.shape)
     brdfs = np.asarray(subject.brdf(wo, wi, inside=inside), dtype=float).tolist()

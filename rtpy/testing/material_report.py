@@ -25,6 +25,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from ..materials.material import Material
 from ..texture import Texture
@@ -68,6 +69,7 @@ class MaterialReport:
     checks: list[CheckResult]
     alpha: float
     seconds: float = 0.0
+    picture: Path | None = None  # the picture of the first failed chi2 check, if drawn
 
     @property
     def passed(self) -> bool:
@@ -93,6 +95,8 @@ class MaterialReport:
             lines.append(f"{c.check:<12} {c.angle_text:>7}  {result:<7} {p:<9} {c.detail}")
         if not self.passed:
             lines.append(_hints(self.failures))
+        if self.picture is not None:
+            lines.append(f"picture of the first failed chi2 check: {self.picture}")
         lines.append(
             f"(chi2 tests reject at p < {self.alpha:.3g} each: alpha Sidak-corrected over "
             f"the incident angles and sides; {self.seconds:.1f} s)"
@@ -140,6 +144,7 @@ def check_material(
     phi_bins: int = 48,
     inside: bool | None = None,
     ior: float | None = None,
+    picture: str | Path | None = None,
 ) -> MaterialReport:
     """Run every check on `material` and return a MaterialReport (print it).
 
@@ -154,7 +159,8 @@ def check_material(
     energy over the whole sphere (reflected plus transmitted), and reciprocity
     across the surface too, with `ior` the index of refraction inside over outside
     (default: the material's own `ior`). inside=True or False forces checking
-    from inside, or not.
+    from inside, or not. picture: a PNG file to draw the first failed chi2 check in
+    (rtpy.testing.chi_square_picture); nothing is written when every one passes.
     """
     start = time.perf_counter()
     name = material_name(material)
@@ -178,6 +184,7 @@ def check_material(
     sides = (False, True) if (transmits if inside is None else inside) else (False,)
     a = sidak_alpha(alpha, max(1, len(angles) * len(sides)))
     options = dict(theta_bins=theta_bins, phi_bins=phi_bins, two_sided=transmits)
+    options["failed_chi2"] = []  # (Chi2Result, angle, inside) of each failed chi2 check
     options["max_albedo"] = math.inf if max_albedo is None else max_albedo
     for side in sides:
         for theta in angles:
@@ -200,7 +207,18 @@ def check_material(
                 lambda side=side: check_non_negative_finite(material, seed=seed, inside=side),
             )
         )
-    return MaterialReport(name, checks, a, time.perf_counter() - start)
+    report = MaterialReport(name, checks, a, time.perf_counter() - start)
+    if picture is not None and options["failed_chi2"]:
+        report.picture = _picture(picture, options["failed_chi2"][0], material, name)
+    return report
+
+
+def _picture(path: str | Path, failed: tuple, material: MaterialSubject, name: str) -> Path:
+    """The picture of a failed chi2 check (its Chi2Result, angle and side) at path."""
+    from .chi_square_picture import chi2_picture
+
+    result, theta, side = failed
+    return chi2_picture(result, path, theta, material, inside=side, title=name)
 
 
 def _draw(subject: MaterialSubject, theta: float, n: int, seed: int, inside: bool):
@@ -222,6 +240,8 @@ def _checks_at(
         bins = dict(theta_bins=options["theta_bins"], phi_bins=options["phi_bins"])
         r = chi2_test(material, theta, samples=samples, inside=inside, **bins)
         ok = r.passed(a)
+        if not ok:
+            options["failed_chi2"].append((r, theta, inside))
         detail = r.summary(worst=not ok)
         return CheckResult("chi2", theta, ok, detail, p_value=r.p_value, inside=inside)
 
@@ -247,7 +267,8 @@ def _checks_at(
 
 
 def assert_material(material: Material | MaterialSubject, **options) -> MaterialReport:
-    """check_material, raising AssertionError with the report's table when a check fails."""
+    """check_material, raising AssertionError with the report's table when a check fails
+    (picture=PATH: with the picture of the first failed chi2 check drawn there)."""
     report = check_material(material, **options)
     if not report.passed:
         raise AssertionError("\n" + str(report))

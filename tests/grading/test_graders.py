@@ -48,6 +48,7 @@ from rtpy.cli.main import main
 from rtpy.grading import compare, summarize
 from rtpy.grading.assignment import WEEKS
 from rtpy.grading.graders import collect_graders, local_probe
+from rtpy.grading.sandbox import StudentError
 from rtpy.grading.tasks import load_weeks
 from rtpy.materials import BlinnPhong, CookTorrance, Lambertian, Metal, Phong, Ward
 from rtpy.vec3 import Vec3
@@ -128,6 +129,26 @@ def two_blockers_needed(mp):
     mp.setattr(Scene, "find_occlusion", find_occlusion)
 
 
+def occlusion_by_the_bvh(mp):
+    """find_occlusion answered by the given BVH's any_hit (the code above the stub)."""
+
+    def find_occlusion(self, ray, interval, ignore=None):
+        return self.bvh().any_hit(ray, interval.min, interval.max, ignore)
+
+    mp.setattr(Scene, "find_occlusion", find_occlusion)
+
+
+def lambertian_as_oren_nayar(mp):
+    """Lambertian's three methods answered by the given OrenNayar with sigma = 0."""
+    from rtpy.materials import OrenNayar
+
+    def delegate(name):
+        return lambda self, *args: getattr(OrenNayar(self.albedo, 0.0), name)(*args)
+
+    for name in ("BRDF", "pdf", "scattering"):
+        mp.setattr(Lambertian, name, delegate(name))
+
+
 def cosine_with_unnormalised_vector(mp):
     # The course code's cosine: the normal dotted with the vector to the light.
     plant(
@@ -151,6 +172,31 @@ def path_counts_light_twice(mp):
         "result = result + beta * emitted * w",
         "result = result + beta * emitted",
     )
+
+
+def path_right_on_average(mp):
+    """compute_scattering times a random factor of mean 1: 0, or 50 with probability
+    1/50. Unbiased and never negative, but with a huge variance."""
+    from rtpy.sampling import generator
+
+    def change(self, value, *args):
+        return value * (50.0 if generator().random() < 0.02 else 0.0)
+
+    cls = path_module.PathIntegrator
+    mp.setattr(cls, "compute_scattering", wrap(cls, "compute_scattering", change))
+
+
+def path_zero_mean_noise(mp):
+    """compute_scattering plus zero-mean noise of standard deviation 30."""
+    from rtpy.sampling import generator
+    from rtpy.vec3 import Color
+
+    def change(self, value, *args):
+        noise = 30.0 * (1.0 if generator().random() < 0.5 else -1.0)
+        return value + Color(noise, noise, noise)
+
+    cls = path_module.PathIntegrator
+    mp.setattr(cls, "compute_scattering", wrap(cls, "compute_scattering", change))
 
 
 def albedo_as_brdf(mp):
@@ -252,6 +298,15 @@ def first_hit_not_closest(mp):
             if t is not None:
                 return obj.hit_info(ray, t)
         return None
+
+    mp.setattr(Scene, "find_intersection", find_intersection)
+
+
+def closest_hit_by_the_bvh(mp):
+    """find_intersection answered by the given BVH (the code above the stub)."""
+
+    def find_intersection(self, ray, interval):
+        return self.bvh().find_intersection(ray, interval)
 
     mp.setattr(Scene, "find_intersection", find_intersection)
 
@@ -436,10 +491,13 @@ PLANTED = [
     ("04.2", quad_no_interior_test, ["test_quad_hit", "test_center_render_matches_reference"]),
     ("04.3", source("triangle_as_parallelogram"), ["test_triangle_hit"]),
     ("04.4", first_hit_not_closest, ["test_closest_hit", "test_center_render_matches_reference"]),
+    ("04.4", closest_hit_by_the_bvh, ["test_closest_hit"]),
     ("05.1", no_falloff, ["test_point_light_sample", "test_direct_light_on_a_plane_is_exact"]),
     ("05.1", unnormalised_light_vector, ["test_point_light_sample"]),
     ("05.2", two_blockers_needed, ["test_shadow_rays", "test_direct_light_on_a_plane_is_exact"]),
+    ("05.2", occlusion_by_the_bvh, ["test_shadow_rays"]),
     ("05.3", albedo_as_brdf, ["test_lambertian_brdf_and_sampling"]),
+    ("05.3", lambertian_as_oren_nayar, ["test_lambertian_brdf_and_sampling"]),
     ("05.3", lambertian_no_pdf, ["test_lambertian_brdf_and_sampling"]),
     ("05.3", source("lambertian_pdf_uniform"), ["test_lambertian_brdf_and_sampling"]),
     (
@@ -514,6 +572,16 @@ PLANTED = [
     ("08.4", path_counts_light_twice, ["test_path_render_matches_reference", "test_path_furnace"]),
     ("08.4", roulette_not_divided, ["test_path_furnace"]),
     (
+        "08.4",
+        path_right_on_average,
+        [
+            "test_path_render_matches_reference",
+            "test_path_furnace",
+            "hidden/test_path_furnace_at_new_seeds",
+        ],
+    ),
+    ("08.4", path_zero_mean_noise, ["test_path_furnace", "hidden/test_path_furnace_at_new_seeds"]),
+    (
         "08.5",
         source("ward_without_jacobian"),
         ["test_pdf[ward]", "test_sampling_follows_pdf[ward]"],
@@ -527,10 +595,23 @@ def probe_of(week: str):
     return local_probe(week, ROOT, in_process=True)
 
 
+@cache
+def hidden_grader(week: str):
+    path = ROOT / "assignments" / f"week{week}" / "hidden" / f"test_week{week}_hidden.py"
+    spec = importlib.util.spec_from_file_location(f"hidden_grader_week{week}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def run_grader_test(week: str, name: str) -> None:
-    """Call one grader test function (name[param] for a parametrized one)."""
+    """Call one grader test function (name[param] for a parametrized one; hidden/name
+    for a hidden check)."""
     base, _, param = name.partition("[")
-    fn = getattr(grader(week), base)
+    module = grader(week)
+    if base.startswith("hidden/"):
+        module, base = hidden_grader(week), base.removeprefix("hidden/")
+    fn = getattr(module, base)
     if param:
         fn(param.rstrip("]"), probe=probe_of(week))
     else:
@@ -544,7 +625,7 @@ def run_grader_test(week: str, name: str) -> None:
 def test_a_planted_mistake_fails_its_graders(monkeypatch, task, mistake, graders):
     mistake(monkeypatch)
     for name in graders:
-        with pytest.raises(AssertionError) as info:
+        with pytest.raises((AssertionError, StudentError)) as info:  # a verdict or a refusal
             run_grader_test(task[:2], name)
         message = str(info.value)
         # where to look: a file, a Class.method or a function of rtpy, or the integrator
@@ -566,7 +647,7 @@ def plant_problems(planted, weeks, graders_of) -> list[str]:
     tasks = {t.id for w in weeks for t in w.tasks}
     for task, mistake, names in planted:
         graders = graders_of(task[:2])
-        missing = [n for n in names if n not in graders]
+        missing = [n for n in names if n not in graders and not n.startswith("hidden/")]
         if task not in tasks or missing:
             problems.append(f"{task} {mistake.__name__}: no such task or graders {missing}")
         elif not any(graders[n] == task for n in names):
@@ -655,3 +736,36 @@ def test_shadow_acne_is_blamed_on_the_missing_spawn_ray(monkeypatch):
     source("shadow_ray_without_offset")(monkeypatch)
     with pytest.raises(AssertionError, match=r"spawn_ray\(hit.point, hit.normal, direction\)"):
         run_grader_test("05", "test_direct_render_matches_reference")
+
+
+def test_a_failed_chi_square_grader_draws_its_picture_locally(monkeypatch, tmp_path):
+    """Phong's highlight drawn around the normal: in a local run (PICTURES set by
+    grade()) the sampling grader draws the check and names the file; elsewhere (the
+    autograder, plain pytest) its message says how to get the picture."""
+    import rtpy.grading.graders as graders
+
+    source("phong_highlight_around_the_normal")(monkeypatch)
+    with pytest.raises(AssertionError, match=r"python -m rtpy grade 08.* rtpy-checks/week08"):
+        run_grader_test("08", "test_sampling_follows_pdf[phong]")
+    monkeypatch.setattr(graders, "PICTURES", tmp_path / "rtpy-checks")
+    with pytest.raises(AssertionError) as info:
+        run_grader_test("08", "test_sampling_follows_pdf[phong]")
+    drawn = list((tmp_path / "rtpy-checks").glob("week08-Phong-*.png"))
+    assert len(drawn) == 1 and f"Picture of this check: {drawn[0].as_posix()}" in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "label,blamed,spared",
+    [
+        ("phong_pdf_around_the_normal", "pdf()", "BRDF()"),
+        ("phong_wrong_normalisation", "BRDF()", "pdf()"),
+    ],
+)
+def test_a_wrong_weight_names_the_method_that_makes_it_wrong(monkeypatch, label, blamed, spared):
+    """The weights of weighted_sample are BRDF * cos / pdf of the student's own methods:
+    when they differ from the model's, the message names the one that differs there."""
+    source(label)(monkeypatch)
+    with pytest.raises(AssertionError) as info:
+        run_grader_test("08", "test_weight_is_brdf_cos_over_pdf[phong]")
+    message = str(info.value)
+    assert f"your {blamed} differs from the model" in message and f"your {spared}" not in message

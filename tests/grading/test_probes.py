@@ -39,3 +39,29 @@ def test_the_render_probe_renders_each_seed():
     stack = probes.render("probes_test_sky", [1, 2], {"spp": 2, "integrator": "jittered"})
     assert stack.shape == (2, 4, 8, 3) and np.isfinite(stack).all()
     assert not np.array_equal(stack[0], stack[1])  # two seeds, two renders
+
+
+def test_given_code_that_answers_a_task_is_seen_however_it_is_called():
+    """given_code_unused: a call of the watched module's code, through the class or a
+    reference kept before the watch, raises GivenCodeUsed naming it; code that does
+    not call it passes; the previous profile function is put back."""
+    import sys
+
+    from rtpy import Interval, Lambertian, Ray, Scene, Sphere, Vec3
+    from rtpy.bvh import BVH
+
+    scene = Scene([Sphere(Vec3(0, 0, -2), 0.5, Lambertian())])
+    ray, interval = Ray(Vec3(0, 0, 0), Vec3(0, 0, -1)), Interval(0.0, 5.0)
+    any_hit = BVH.any_hit  # kept before the watch, as a submission could
+    task = "Scene.find_occlusion (rtpy/scene.py)"
+    before = sys.getprofile()
+    for use in (
+        lambda: scene.bvh().any_hit(ray, 0.0, 5.0),
+        lambda: any_hit(scene.bvh(), ray, 0, 5),
+    ):
+        with pytest.raises(probes.GivenCodeUsed, match=r"find_occlusion .* called rtpy\.bvh\.BVH"):
+            with probes.given_code_unused(("rtpy.bvh",), task):
+                use()
+    with probes.given_code_unused(("rtpy.bvh",), task):
+        assert scene.find_occlusion(ray, interval) is True  # 1 object: no BVH
+    assert sys.getprofile() is before

@@ -9,7 +9,7 @@ import math
 from rtpy.materials import Lambertian, Material, Phong
 from rtpy.onb import ONB
 from rtpy.ray import spawn_ray
-from rtpy.sampling import generator, random_cosine_direction
+from rtpy.sampling import generator
 from rtpy.scatter_info import ScatterInfo
 from rtpy.vec3 import BLACK, Color, Vec3, dot
 
@@ -111,11 +111,15 @@ class CrashesAtGrazing(Lambertian):
 
 
 class DiffuseTransmitter(Material):
-    """Lambertian on both sides of the surface: f = r / pi toward the viewer's side,
-    t / pi through it; cosine-weighted samples on the viewer's side with probability
-    r / (r + t), else on the other. Reciprocal (no refraction): weight r + t."""
+    """Diffuse on both sides of the surface: f = r / pi toward the viewer's side, t / pi
+    through it (0 < t); directions drawn uniformly over the viewer's hemisphere with
+    probability r / (r + t), else over the other one. Reciprocal (no refraction).
+    Uniform, not cosine-weighted, sampling and t > 0 keep it from being a Lambertian
+    in disguise (this file ships to students: nothing here answers a task)."""
 
     def __init__(self, r: float = 0.3, t: float = 0.5) -> None:
+        if not t > 0.0:
+            raise ValueError(f"t: a transmitter transmits, expected t > 0, got {t!r}")
         self.r, self.t = r, t
 
     def BRDF(self, ray_view, ray_light, hit):
@@ -127,20 +131,36 @@ class DiffuseTransmitter(Material):
 
     def pdf(self, ray_view, ray_light, hit):
         cos_o, cos_i = -dot(hit.normal, ray_view.direction), dot(hit.normal, ray_light.direction)
-        if cos_o <= 0.0:
+        if cos_o <= 0.0 or cos_i == 0.0:
             return 0.0
         p_r = self.r / (self.r + self.t)
-        return (p_r if cos_i > 0.0 else 1.0 - p_r) * abs(cos_i) * INV_PI
+        return (p_r if cos_i > 0.0 else 1.0 - p_r) / (2.0 * math.pi)
 
     def scattering(self, ray_in, hit):
         if dot(hit.normal, ray_in.direction) >= 0.0:
             return None
-        local = random_cosine_direction()
-        side = hit.normal if generator().random() < self.r / (self.r + self.t) else -hit.normal
-        d = ONB(side).to_world(local)
-        ray = spawn_ray(hit.point, hit.normal, d)
-        weight = self.r + self.t
+        r = generator().random
+        z, phi = r(), 2.0 * math.pi * r()
+        s = math.sqrt(max(0.0, 1.0 - z * z))
+        local = Vec3(s * math.cos(phi), s * math.sin(phi), z)
+        side = hit.normal if r() < self.r / (self.r + self.t) else -hit.normal
+        ray = spawn_ray(hit.point, hit.normal, ONB(side).to_world(local))
+        weight = 2.0 * (self.r + self.t) * z  # f |cos| / pdf on either side
         return ScatterInfo(ray, Color(weight, weight, weight), self.pdf(ray_in, ray, hit))
+
+
+class AbsorbsEverything(Lambertian):
+    """Reflects nothing: BRDF black, pdf 0, scattering() None. Consistent, and no
+    check of sampling may pass it (it shows nothing)."""
+
+    def BRDF(self, ray_view, ray_light, hit):
+        return BLACK
+
+    def pdf(self, ray_view, ray_light, hit):
+        return 0.0
+
+    def scattering(self, ray_in, hit):
+        return None
 
 
 class UpperPdfOnly(DiffuseTransmitter):

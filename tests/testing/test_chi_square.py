@@ -15,6 +15,7 @@ from rtpy.vec3 import Color
 from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from .materials_to_check import (
+    AbsorbsEverything,
     DiffuseTransmitter,
     HalfSampler,
     OverNormalised,
@@ -224,3 +225,20 @@ def test_chi2_covers_the_whole_sphere(results, request, inside):
     assert r.pdf_integral == pytest.approx(1.0, abs=1e-6)
     assert r.observed[r.observed.shape[0] // 2 :].sum() > 10_000
     assert forgetful.p_value == 0.0 and "pdf() is 0" in forgetful.message
+
+
+def test_chi2_fails_a_material_that_scatters_nothing():
+    """BRDF black, pdf 0, scattering() None is self-consistent, but a check of sampling
+    needs samples: every draw absorbed is a failure (p = 0), not p = 1."""
+    result = chi2_test(AbsorbsEverything(), 30.0, n_samples=2000, theta_bins=8, phi_bins=8)
+    assert result.p_value == 0.0 and not result.passed(1e-9)
+    assert "too few scattered samples" in result.summary() and "0 of 2000" in result.summary()
+
+
+def test_the_diffuse_transmitter_is_no_lambertian_in_disguise():
+    """DiffuseTransmitter ships to students: it samples uniformly (its pdf is not
+    cos / pi), and without transmission it refuses to be built."""
+    with pytest.raises(ValueError, match="t"):
+        DiffuseTransmitter(r=0.8, t=0.0)
+    result = chi2_test(DiffuseTransmitter(), 30.0, n_samples=20_000, theta_bins=8, phi_bins=8)
+    assert result.passed(0.001) and result.pdf_integral == pytest.approx(1.0, abs=1e-4)

@@ -62,3 +62,20 @@ def test_check_material_checks_a_material_that_transmits_from_both_sides():
     assert not any(c.inside for c in front.checks)
     broken = check_material(UpperPdfOnly(), incident_angles=(30.0,), n_samples=5000)
     assert {(c.check, c.inside) for c in broken.failures} >= {("chi2", False), ("chi2", True)}
+
+
+def test_a_failed_chi2_check_can_be_drawn(tmp_path):
+    """picture=PATH: the first failed chi2 check is drawn there and the report (and
+    assert_material's message) names the file; a material whose chi2 checks pass
+    writes nothing."""
+    from PIL import Image
+
+    from .materials_to_check import UniformSampler
+
+    path = tmp_path / "uniform.png"
+    with pytest.raises(AssertionError, match="picture of the first failed chi2 check: .*uniform"):
+        assert_material(UniformSampler(), incident_angles=(30.0,), n_samples=5000, picture=path)
+    assert Image.open(path).format == "PNG"
+    fine = tmp_path / "fine.png"
+    report = check_material(Lambertian(), incident_angles=(30.0,), n_samples=5000, picture=fine)
+    assert report.passed and report.picture is None and not fine.exists()

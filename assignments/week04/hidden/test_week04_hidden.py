@@ -12,6 +12,7 @@ solution never fails these checks (false-failure rate 0).
 import math
 
 import numpy as np
+import pytest
 
 from rtpy.grading import points
 from rtpy.grading.autograder_seed import grading_rng
@@ -111,8 +112,12 @@ def approach(rng, p: np.ndarray, normal: np.ndarray) -> tuple[np.ndarray, np.nda
     return p - dist * d, d, dist
 
 
-@points(3)
-def test_quad_and_triangle_hits_at_new_rays(probe):
+# One case per task (04.2 Quad, 04.3 Triangle): a stub costs only its own points.
+@pytest.mark.parametrize(
+    "kind",
+    [pytest.param("Quad", marks=points(1.5)), pytest.param("Triangle", marks=points(1.5))],
+)
+def test_quad_and_triangle_hits_at_new_rays(kind, probe):
     """Quad.hit_t and Triangle.hit_t: new shapes and rays, inside, outside, the interval"""
     rng = grading_rng(402)
     asked = []
@@ -140,7 +145,7 @@ def test_quad_and_triangle_hits_at_new_rays(probe):
                         f"{where}, t_max below the hit",
                     )
                 )
-    checked_hits(probe, asked)
+    checked_hits(probe, [a for a in asked if a[0]["shape"]["type"] == kind])
 
 
 @points(2)

@@ -14,6 +14,7 @@ probability at most ALPHA = 1e-4 per submission.
 import math
 
 import numpy as np
+import pytest
 
 from rtpy.grading import points
 from rtpy.grading.autograder_seed import grading_rng, grading_seed
@@ -34,8 +35,11 @@ def incidence(rng, cos_range=(0.05, 1.0)):
     return n, d, cos
 
 
-@points(2)
-def test_reflect_and_refract_at_new_directions(probe):
+# One case per task (06.1 reflect, 06.2 refract): a stub costs only its own points.
+@pytest.mark.parametrize(
+    "law", [pytest.param("reflect", marks=points(1)), pytest.param("refract", marks=points(1))]
+)
+def test_reflect_and_refract_at_new_directions(law, probe):
     """reflect and refract: the laws of reflection and Snell's law at new directions"""
     rng = grading_rng(601)
     reflections, refractions = [], []
@@ -47,8 +51,12 @@ def test_reflect_and_refract_at_new_directions(probe):
         if sin_t > math.sin(math.radians(88)):
             continue  # total internal reflection, or within 2 degrees of it
         refractions.append((n, d, eta, sin_t))
-    reflected = probe.week06_reflect(cases=[[d, n] for n, d in reflections])
-    refracted = probe.week06_refract(cases=[[d, n, eta] for n, d, eta, _ in refractions])
+    if law == "reflect":
+        reflected = probe.week06_reflect(cases=[[d, n] for n, d in reflections])
+        refractions, refracted = [], []
+    else:
+        refracted = probe.week06_refract(cases=[[d, n, eta] for n, d, eta, _ in refractions])
+        reflections, reflected = [], []
     for (n, d), got in zip(reflections, reflected, strict=True):
         want = d - 2 * (d @ n) * n
         assert np.allclose(got, want, atol=1e-12), (
