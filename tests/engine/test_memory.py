@@ -212,7 +212,8 @@ scene, camera = rtpy.Scene([ball], sky=True), rtpy.Camera(width=16)
 for backend in ("scalar", "numpy"):
     for workers in (1, 2):
         rtpy.render(scene, camera=camera, spp=2, backend=backend, workers=workers)
-changed = sorted(k for k in set(os.environ) | set(environment) if os.environ.get(k) != environment.get(k))
+names = set(os.environ) | set(environment)
+changed = sorted(k for k in names if os.environ.get(k) != environment.get(k))
 print(json.dumps([calls, changed]))
 """
 
