@@ -10,7 +10,7 @@ from .hit_info import HitInfo
 from .hittable import Hittable
 from .onb import local_to_world
 from .ray import Ray
-from .sampling import cone_angle, cone_pdf, larger, uniform_sphere
+from .sampling import cone_angle, cone_pdf, uniform_sphere
 from .vec3 import Vec3, dot, unit_vector
 
 
@@ -156,16 +156,14 @@ class Sphere(Hittable):
 
 
 # --- the cone a sphere subtends ------------------------------------------------------
-# Plain arithmetic on floats or numpy arrays alike (the numpy backend passes its sqrt
-# and maximum): one formula for both backends.
 
 
-def one_minus_cos_max(r2, d2, sqrt=math.sqrt):
+def one_minus_cos_max(r2: float, d2: float) -> float:
     """1 - cos_theta_max of the cone a sphere of squared radius r2 subtends at squared
     distance d2 from its center: sin^2 / (1 + cos) with sin^2 = r2 / d2, which does not
     cancel for small cones as 1 - sqrt(1 - sin^2) would."""
     sin2 = r2 / d2
-    return sin2 / (1.0 + sqrt(1.0 - sin2))
+    return sin2 / (1.0 + math.sqrt(1.0 - sin2))
 
 
 def direction_around(axis: Vec3, length: float, cos_t: float, sin_t: float, phi: float) -> Vec3:
@@ -176,11 +174,11 @@ def direction_around(axis: Vec3, length: float, cos_t: float, sin_t: float, phi:
     return local_to_world(w, sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
 
 
-def nearer_root(d2, r2, distance, cos_t, sin2_t, sqrt=math.sqrt, maximum=larger):
+def nearer_root(d2: float, r2: float, distance: float, cos_t: float, sin2_t: float) -> float:
     """How far a ray from a point at `distance` from a sphere's center (d2 = distance^2,
     r2 = radius^2) goes to the sphere, sent at angle theta (cos_t, sin2_t = sin^2) from
     the direction to the center, inside the cone: the nearer root of
     t^2 - 2 t D cos_t + D^2 - r^2 = 0, as (D^2 - r^2) / (D cos_t + sqrt(r^2 - D^2 sin^2_t))
     without cancellation (inside the cone the square root's argument is >= 0 but for
     rounding)."""
-    return (d2 - r2) / (distance * cos_t + sqrt(maximum(0.0, r2 - d2 * sin2_t)))
+    return (d2 - r2) / (distance * cos_t + math.sqrt(max(0.0, r2 - d2 * sin2_t)))

@@ -57,15 +57,11 @@ def cosine_power_pdf(exponent: float, cos_theta: float) -> float:
     return cosine_power_density(exponent, cos_theta**exponent)
 
 
-# The two below work on floats and on numpy arrays alike (the numpy backend passes its
-# sqrt and maximum): the numpy kernels compute with them.
-
-
-def cosine_power_angle(exponent, r1, sqrt=math.sqrt, maximum=max):
+def cosine_power_angle(exponent: float, r1: float) -> tuple[float, float]:
     """(cos, sin) of theta drawn with density (n + 1) / (2 pi) cos^n(theta) from a uniform
     r1: cos(theta) = r1^(1 / (n + 1)), inverting the distribution 1 - cos^(n + 1)."""
     cos_theta = r1 ** (1.0 / (exponent + 1.0))
-    return cos_theta, sqrt(maximum(0.0, 1.0 - cos_theta * cos_theta))
+    return cos_theta, math.sqrt(max(0.0, 1.0 - cos_theta * cos_theta))
 
 
 def cosine_power_density(exponent, power):
