@@ -47,8 +47,6 @@ class BlinnPhong(Material):
     that sample is absorbed.
     """
 
-    kernel = "blinn_phong"
-
     __init__ = Phong.__init__  # the same parameters as Phong's
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:

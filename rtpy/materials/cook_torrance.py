@@ -117,8 +117,6 @@ class CookTorrance(Material):
     kd = 1, ks = 1 and the default ior.
     """
 
-    kernel = "cook_torrance"
-
     def __init__(
         self,
         albedo: Color | Texture = Color(0.5, 0.5, 0.5),

@@ -90,8 +90,6 @@ class Phong(Material):
     the lobe's own shape. Directions that fall below the surface are absorbed.
     """
 
-    kernel = "phong"
-
     def __init__(
         self,
         albedo: Color | Texture = Color(0.5, 0.5, 0.5),

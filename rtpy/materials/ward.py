@@ -106,8 +106,6 @@ class Ward(Material):
     shading frame hit.frame: u along the tangent, v = normal x u, w = the normal.
     """
 
-    kernel = "ward"
-
     def __init__(
         self,
         albedo: Color | Texture = Color(0.5, 0.5, 0.5),
