@@ -69,7 +69,23 @@ def cosine_power_density(exponent, power):
     return (exponent + 1.0) * INV_TWO_PI * power
 
 
-class Phong(Material):
+class CosinePowerHighlight(Material):
+    """Diffuse plus a highlight shaped by a power of a cosine: the parameters Phong
+    and Blinn-Phong share (their docstrings say what each means)."""
+
+    def __init__(
+        self,
+        albedo: Color | Texture = Color(0.5, 0.5, 0.5),
+        kd: float = 1.0,
+        ks: float = 0.0,
+        exponent: float = 1.0,
+    ) -> None:
+        self.albedo = as_texture(albedo)
+        self.kd, self.ks = check_strengths(kd, ks)
+        self.exponent = check_exponent(exponent)
+
+
+class Phong(CosinePowerHighlight):
     """Diffuse plus a normalised Phong highlight around the mirror direction.
 
     albedo    colour (or texture) of the diffuse part
@@ -89,17 +105,6 @@ class Phong(Material):
     density (n + 1) / (2 pi) * max(0, m . wi)^n; since m . wi = r . wo, that is
     the lobe's own shape. Directions that fall below the surface are absorbed.
     """
-
-    def __init__(
-        self,
-        albedo: Color | Texture = Color(0.5, 0.5, 0.5),
-        kd: float = 1.0,
-        ks: float = 0.0,
-        exponent: float = 1.0,
-    ) -> None:
-        self.albedo = as_texture(albedo)
-        self.kd, self.ks = check_strengths(kd, ks)
-        self.exponent = check_exponent(exponent)
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
         """kd * albedo / pi + ks * (n + 2) / (2 pi) * max(0, r . wo)^n with
