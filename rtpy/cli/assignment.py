@@ -9,9 +9,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..engine.exit_status import EXIT_BAD_INPUT, EXIT_WRITE_FAILED
 from ..engine.files import OutputError, WriteError
-from .grade import WEEK_HELP
+from .grade import WEEK_HELP, refused
 
 
 def add_assignment_commands(sub, seconds) -> None:
@@ -50,12 +49,8 @@ def command_assignment(args: argparse.Namespace) -> int:
             return 0
         what = "autograder" if args.assignment_command == "autograder" else "repository"
         written = write_assignment(args, week)
-    except WriteError as err:
-        print(f"rtpy: error: {err}", file=sys.stderr)
-        return EXIT_WRITE_FAILED
-    except (AssignmentError, OutputError, FileNotFoundError) as err:
-        print(f"rtpy: error: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    except (WriteError, AssignmentError, OutputError, FileNotFoundError) as err:
+        return refused(err)
     print(f"rtpy: wrote the week {week} {what} to {written}", file=sys.stderr)
     return 0
 

@@ -32,12 +32,14 @@ def command_grade(args: argparse.Namespace) -> int:
         if args.json:
             check_writable(args.json)
         return grade_week(week, args.json, args.hidden)
-    except WriteError as err:
-        print(f"rtpy: error: {err}", file=sys.stderr)
-        return EXIT_WRITE_FAILED
-    except (AssignmentError, OutputError, FileNotFoundError) as err:
-        print(f"rtpy: error: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    except (WriteError, AssignmentError, OutputError, FileNotFoundError) as err:
+        return refused(err)
+
+
+def refused(err: Exception) -> int:
+    """Say err in one line; the exit status: a failed write 1, anything else 2."""
+    print(f"rtpy: error: {err}", file=sys.stderr)
+    return EXIT_WRITE_FAILED if isinstance(err, WriteError) else EXIT_BAD_INPUT
 
 
 def grade_week(week: str, json_path: str | None, hidden: bool = False) -> int:
