@@ -4,9 +4,10 @@ import gc
 import os
 import sys
 
-from .engine import signals
+from .engine import memory, signals
 
 signals.defer()  # rtpy/__init__.py did it already when run as `python -m rtpy`
+memory.small_pages_for_numpy()  # this process is rtpy's own: before numpy is imported
 
 from .cli.main import main  # noqa: E402 (imported with the signals deferred)
 

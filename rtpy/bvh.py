@@ -61,15 +61,19 @@ class AABB:
 
     def __init__(self, lo: Vec3, hi: Vec3) -> None:
         """The box with corners lo (smallest coordinates) and hi (largest)."""
-        self.x0, self.y0, self.z0 = lo.e0, lo.e1, lo.e2
-        self.x1, self.y1, self.z1 = hi.e0, hi.e1, hi.e2
+        self.x0, self.y0, self.z0 = lo.x(), lo.y(), lo.z()
+        self.x1, self.y1, self.z1 = hi.x(), hi.y(), hi.z()
 
     @staticmethod
     def from_points(*points: Vec3) -> AABB:
         """The smallest box containing the points."""
         return AABB(
-            Vec3(min(p.e0 for p in points), min(p.e1 for p in points), min(p.e2 for p in points)),
-            Vec3(max(p.e0 for p in points), max(p.e1 for p in points), max(p.e2 for p in points)),
+            Vec3(
+                min(p.x() for p in points), min(p.y() for p in points), min(p.z() for p in points)
+            ),
+            Vec3(
+                max(p.x() for p in points), max(p.y() for p in points), max(p.z() for p in points)
+            ),
         )
 
     @property
@@ -121,7 +125,9 @@ class AABB:
 
     def contains(self, p: Vec3) -> bool:
         return (
-            self.x0 <= p.e0 <= self.x1 and self.y0 <= p.e1 <= self.y1 and self.z0 <= p.e2 <= self.z1
+            self.x0 <= p.x() <= self.x1
+            and self.y0 <= p.y() <= self.y1
+            and self.z0 <= p.z() <= self.z1
         )
 
     def centroid(self) -> tuple[float, float, float]:
@@ -276,7 +282,7 @@ class BVH:
         # index can decide. (hit_t with a smaller t_max returns the same t or None.)
         limit = t_max
         o, d = ray.origin, ray.direction
-        ox, oy, oz, dx, dy, dz = o.e0, o.e1, o.e2, d.e0, d.e1, d.e2
+        ox, oy, oz, dx, dy, dz = o.x(), o.y(), o.z(), d.x(), d.y(), d.z()
         # Per axis: 1 / d (inf where d = 0, see the slab test) and the positions in
         # a node's bounds (x0, y0, z0, x1, y1, z1) of the faces the ray meets first
         # (n) and last (f) along it: the low ones when d >= 0, else the high ones.

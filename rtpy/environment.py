@@ -37,7 +37,7 @@ class Environment:
         out = np.empty((len(d), 3))
         for k, row in enumerate(d):
             c = self.radiance(Vec3(*row))
-            out[k] = (c.e0, c.e1, c.e2)
+            out[k] = c.tolist()
         return out
 
 
@@ -66,7 +66,7 @@ class SkyBand(Environment):
         return self.value * (math.pi * (s2 * s2 - s1 * s1))
 
     def radiance(self, direction: Vec3) -> Color:
-        cos_theta = direction.e1 / direction.length()
+        cos_theta = direction.y() / direction.length()
         if self._cos_lo <= cos_theta <= self._cos_hi:
             return self.value
         return Color(0.0, 0.0, 0.0)
@@ -77,5 +77,5 @@ class SkyBand(Environment):
         # Twin of radiance kept: einsum's sum of squares is not length()'s order.
         cos_theta = d[:, 1] / np.sqrt(np.einsum("ij,ij->i", d, d))
         inside = (cos_theta >= self._cos_lo) & (cos_theta <= self._cos_hi)
-        value = np.array([self.value.e0, self.value.e1, self.value.e2])
+        value = np.array(self.value.tolist())
         return inside[:, None] * value

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from .hit_info import HitInfo
 from .interval import Interval
 from .ray import Ray
-from .vec3 import Vec3
+from .vec3 import Vec3, dot
 
 # Light sampling gives no sample to a receiving point nearer than 1e-50 (d^2 < 1e-100)
 # to the point it samples on a light, as to that point itself: there the 1 / d^2 of a
@@ -87,15 +87,12 @@ class Hittable:
         """A unit direction from p toward this object and its solid-angle pdf, or
         None when the sample is useless (p on the object's plane)."""
         point, normal = self.sample_point(r1, r2)
-        dx, dy, dz = point.e0 - p.e0, point.e1 - p.e1, point.e2 - p.e2
-        dist2 = dx * dx + dy * dy + dz * dz
+        to_point = point - p
+        dist2 = to_point.length_squared()
         if dist2 < MIN_LIGHT_DISTANCE2:
             return None
-        k = 1.0 / math.sqrt(dist2)
-        direction = Vec3(dx * k, dy * k, dz * k)
-        cos_light = abs(
-            direction.e0 * normal.e0 + direction.e1 * normal.e1 + direction.e2 * normal.e2
-        )
+        direction = to_point / math.sqrt(dist2)
+        cos_light = abs(dot(direction, normal))
         if cos_light < 1e-12:
             return None
         return direction, area_to_solid_angle(dist2, cos_light, self.area())
@@ -118,12 +115,11 @@ class Hittable:
     def direction_pdf(self, p: Vec3, hit: HitInfo) -> float:
         """Solid-angle density with which sample_direction(p) picks the direction
         from p to `hit`, a point on this object."""
-        q, n = hit.point, hit.normal
-        dx, dy, dz = q.e0 - p.e0, q.e1 - p.e1, q.e2 - p.e2
-        dist2 = dx * dx + dy * dy + dz * dz
+        to_point = hit.point - p
+        dist2 = to_point.length_squared()
         if dist2 < MIN_LIGHT_DISTANCE2:  # never sampled (sample_direction)
             return 0.0
-        cos_light = abs(dx * n.e0 + dy * n.e1 + dz * n.e2) / math.sqrt(dist2)
+        cos_light = abs(dot(to_point, hit.normal)) / math.sqrt(dist2)
         if cos_light < 1e-12:
             return 0.0
         return area_to_solid_angle(dist2, cos_light, self.area())

@@ -125,7 +125,7 @@ class Transform:
 
         out = np.empty_like(q)
         for i, r in enumerate(self.rows):  # dot(r, q) (+ shift), term by term as dot() adds
-            out[:, i] = q[:, 0] * r.e0 + q[:, 1] * r.e1 + q[:, 2] * r.e2
+            out[:, i] = q[:, 0] * r.x() + q[:, 1] * r.y() + q[:, 2] * r.z()
             if shift is not None:
                 out[:, i] += shift[i]
         return out

@@ -23,11 +23,12 @@ class ONB:
     __slots__ = ("u", "v", "w")
 
     def __init__(self, w: Vec3) -> None:
-        sign = math.copysign(1.0, w.e2)
-        a = -1.0 / (sign + w.e2)
-        b = w.e0 * w.e1 * a
-        self.u = Vec3(1.0 + sign * w.e0 * w.e0 * a, sign * b, -sign * w.e0)
-        self.v = Vec3(b, sign + w.e1 * w.e1 * a, -w.e1)
+        x, y, z = w.x(), w.y(), w.z()
+        sign = math.copysign(1.0, z)
+        a = -1.0 / (sign + z)
+        b = x * y * a
+        self.u = Vec3(1.0 + sign * x * x * a, sign * b, -sign * x)
+        self.v = Vec3(b, sign + y * y * a, -y)
         self.w = w
 
     @classmethod
@@ -50,26 +51,4 @@ class ONB:
 
     def to_world(self, a: Vec3) -> Vec3:
         """The world vector x u + y v + z w of the local coordinates a = (x, y, z)."""
-        # Written per component: every bounce of a path calls this, and one Vec3
-        # costs less than the five that u * x + v * y + w * z would make.
-        u, v, w = self.u, self.v, self.w
-        x, y, z = a.e0, a.e1, a.e2
-        return Vec3(
-            x * u.e0 + y * v.e0 + z * w.e0,
-            x * u.e1 + y * v.e1 + z * w.e1,
-            x * u.e2 + y * v.e2 + z * w.e2,
-        )
-
-
-def local_to_world(w: Vec3 | tuple[float, float, float], x: float, y: float, z: float) -> Vec3:
-    """x * u + y * v + z * w for the frame ONB(w) builds, without building it
-    (the same numbers). w is a unit Vec3 or its three components."""
-    w0, w1, w2 = w
-    sign = math.copysign(1.0, w2)
-    a = -1.0 / (sign + w2)
-    b = w0 * w1 * a
-    return Vec3(
-        x * (1.0 + sign * w0 * w0 * a) + y * b + z * w0,
-        x * sign * b + y * (sign + w1 * w1 * a) + z * w1,
-        -x * sign * w0 - y * w1 + z * w2,
-    )
+        return self.u * a.x() + self.v * a.y() + self.w * a.z()

@@ -51,30 +51,22 @@ def random_double(lo: float = 0.0, hi: float = 1.0) -> float:
 def uniform_sphere(r1: float, r2: float) -> tuple[float, float, float]:
     """Maps two uniform numbers in [0, 1) to a point uniform on the unit sphere."""
     z = 1.0 - 2.0 * r1
-    s = 1.0 - z * z
-    s = math.sqrt(s if s > 0.0 else 0.0)  # max(0, .), cheaper than the builtin
+    s = math.sqrt(max(0.0, 1.0 - z * z))
     phi = 2.0 * math.pi * r2
     return s * math.cos(phi), s * math.sin(phi), z
 
 
-def larger(a: float, b: float) -> float:
-    """max(a, b) for two floats, the same value (a unless b is greater), at a few
-    times less than the builtin's cost: the scalar default of the `maximum` the
-    formulas below take (numpy passes np.maximum)."""
-    return b if b > a else a
-
-
-def cone_angle(r1, cone_size, maximum=larger):
+def cone_angle(r1: float, cone_size: float) -> tuple[float, float]:
     """(cos theta, sin^2 theta) of a direction uniform by solid angle in a cone whose
     half-angle has 1 - cos = cone_size: cos theta uniform in [1 - cone_size, 1] (pbrt-v4's
-    SampleUniformCone). Floats or numpy arrays (with numpy's maximum)."""
+    SampleUniformCone)."""
     cos_t = 1.0 - r1 * cone_size
-    return cos_t, maximum(0.0, 1.0 - cos_t * cos_t)
+    return cos_t, max(0.0, 1.0 - cos_t * cos_t)
 
 
-def cone_pdf(cone_size):
+def cone_pdf(cone_size: float) -> float:
     """The solid-angle density of directions uniform in a cone of 1 - cos = cone_size:
-    1 / (2 pi cone_size). Floats or numpy arrays."""
+    1 / (2 pi cone_size)."""
     return 1.0 / (2.0 * math.pi * cone_size)
 
 
@@ -91,13 +83,12 @@ def random_in_unit_disk() -> Vec3:
     return Vec3(*disk_point(r1, r()), 0.0)
 
 
-def disk_point(r1, r2, sqrt=math.sqrt, cos=math.cos, sin=math.sin):
+def disk_point(r1: float, r2: float) -> tuple[float, float]:
     """(x, y) uniform in the unit disk from two uniform numbers: radius sqrt(r1),
-    angle 2 pi r2. Floats or numpy arrays (with numpy's sqrt, cos and sin, which call
-    the same C library as math's)."""
-    radius = sqrt(r1)
+    angle 2 pi r2."""
+    radius = math.sqrt(r1)
     phi = 2.0 * math.pi * r2
-    return radius * cos(phi), radius * sin(phi)
+    return radius * math.cos(phi), radius * math.sin(phi)
 
 
 def random_cosine_direction() -> Vec3:

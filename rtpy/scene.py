@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
@@ -153,7 +152,7 @@ class Scene:
             return self.background
         # RTIOW's sky: white at the horizon to light blue overhead, by the
         # direction's y component.
-        a = 0.5 * (direction.e1 / math.sqrt(direction.length_squared()) + 1.0)
+        a = 0.5 * (direction.y() / direction.length() + 1.0)
         return Color(1.0 - 0.5 * a, 1.0 - 0.3 * a, 1.0)
 
 

@@ -8,9 +8,9 @@ from ._checks import LENGTH, checked_number, checked_point
 from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import Hittable
-from .onb import local_to_world
+from .onb import ONB
 from .ray import Ray
-from .sampling import cone_angle, cone_pdf, larger, uniform_sphere
+from .sampling import cone_angle, cone_pdf, uniform_sphere
 from .vec3 import Vec3, dot, unit_vector
 
 
@@ -61,8 +61,8 @@ class Sphere(Hittable):
 
     def bounding_box(self) -> AABB:
         """center -+ radius on each axis, padded."""
-        c, r = self.center, self.radius
-        return AABB(Vec3(c.e0 - r, c.e1 - r, c.e2 - r), Vec3(c.e0 + r, c.e1 + r, c.e2 + r)).padded()
+        extent = Vec3(self.radius, self.radius, self.radius)
+        return AABB(self.center - extent, self.center + extent).padded()
 
     def hit_info(self, ray: Ray, t: float) -> HitInfo:
         # BEGIN SOLUTION week04: hit point, unit normal facing the ray, front_face
@@ -86,8 +86,8 @@ class Sphere(Hittable):
 
     def surface_tangent(self, hit: HitInfo) -> Vec3 | None:
         """d(point)/du: along the circle of latitude, toward increasing phi."""
-        c = self.center
-        x, z = hit.point.e0 - c.e0, hit.point.e2 - c.e2
+        offset = hit.point - self.center
+        x, z = offset.x(), offset.z()
         length = math.hypot(x, z)
         if length < 1e-12 * self.radius:
             return None  # at a pole u has no direction
@@ -138,15 +138,8 @@ class Sphere(Hittable):
     def surface_along(self, p: Vec3, direction: Vec3, t: float) -> tuple[Vec3, Vec3]:
         """(outward normal, point) where the ray from p along direction meets the
         sphere at t: the point put back onto the surface, as hit_info puts it."""
-        # Per component, not unit_vector(p + direction * t - c) (the same numbers): its
-        # temporary Vec3s cost a lamp-lit render 2% more, and every light sample comes here.
-        c, r = self.center, self.radius
-        nx = p.e0 + t * direction.e0 - c.e0
-        ny = p.e1 + t * direction.e1 - c.e1
-        nz = p.e2 + t * direction.e2 - c.e2
-        k = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
-        nx, ny, nz = nx * k, ny * k, nz * k
-        return Vec3(nx, ny, nz), Vec3(c.e0 + nx * r, c.e1 + ny * r, c.e2 + nz * r)
+        normal = unit_vector(p + direction * t - self.center)
+        return normal, self.center + normal * self.radius
 
     def direction_pdf(self, p: Vec3, hit: HitInfo) -> float:
         cone = self._cone(p)
@@ -156,31 +149,28 @@ class Sphere(Hittable):
 
 
 # --- the cone a sphere subtends ------------------------------------------------------
-# Plain arithmetic on floats or numpy arrays alike (the numpy backend passes its sqrt
-# and maximum): one formula for both backends.
 
 
-def one_minus_cos_max(r2, d2, sqrt=math.sqrt):
+def one_minus_cos_max(r2: float, d2: float) -> float:
     """1 - cos_theta_max of the cone a sphere of squared radius r2 subtends at squared
     distance d2 from its center: sin^2 / (1 + cos) with sin^2 = r2 / d2, which does not
     cancel for small cones as 1 - sqrt(1 - sin^2) would."""
     sin2 = r2 / d2
-    return sin2 / (1.0 + sqrt(1.0 - sin2))
+    return sin2 / (1.0 + math.sqrt(1.0 - sin2))
 
 
 def direction_around(axis: Vec3, length: float, cos_t: float, sin_t: float, phi: float) -> Vec3:
     """The unit direction at angle theta (cos_t, sin_t) from axis / length (axis a
     vector of that length) and at azimuth phi around it, in the frame ONB builds."""
-    k = 1.0 / length
-    w = (axis.e0 * k, axis.e1 * k, axis.e2 * k)  # unit: axis / length, as Vec3's / does
-    return local_to_world(w, sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
+    local = Vec3(sin_t * math.cos(phi), sin_t * math.sin(phi), cos_t)
+    return ONB(axis / length).to_world(local)
 
 
-def nearer_root(d2, r2, distance, cos_t, sin2_t, sqrt=math.sqrt, maximum=larger):
+def nearer_root(d2: float, r2: float, distance: float, cos_t: float, sin2_t: float) -> float:
     """How far a ray from a point at `distance` from a sphere's center (d2 = distance^2,
     r2 = radius^2) goes to the sphere, sent at angle theta (cos_t, sin2_t = sin^2) from
     the direction to the center, inside the cone: the nearer root of
     t^2 - 2 t D cos_t + D^2 - r^2 = 0, as (D^2 - r^2) / (D cos_t + sqrt(r^2 - D^2 sin^2_t))
     without cancellation (inside the cone the square root's argument is >= 0 but for
     rounding)."""
-    return (d2 - r2) / (distance * cos_t + sqrt(maximum(0.0, r2 - d2 * sin2_t)))
+    return (d2 - r2) / (distance * cos_t + math.sqrt(max(0.0, r2 - d2 * sin2_t)))

@@ -111,9 +111,8 @@ class Triangle(FlatShape):
         return self.a + self.e1 * wb + self.e2 * wc, self.normal
 
 
-def triangle_weights(r1, r2, sqrt=math.sqrt):
+def triangle_weights(r1: float, r2: float) -> tuple[float, float]:
     """The barycentric weights (of b, of c) of a point uniform by area on a triangle,
-    from two uniform numbers: s = sqrt(r1) warps the unit square onto the triangle.
-    Floats or numpy arrays (with numpy's sqrt)."""
-    s = sqrt(r1)
+    from two uniform numbers: s = sqrt(r1) warps the unit square onto the triangle."""
+    s = math.sqrt(r1)
     return s * (1.0 - r2), s * r2

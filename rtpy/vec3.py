@@ -3,8 +3,7 @@
 `Vec3` is used for points, directions and normals. `Color` is a Vec3 whose
 components are read as linear RGB (r(), g(), b()). Both store their three
 components in the slots ``e0, e1, e2`` (like RTIOW's ``e[0..2]``); the
-accessors ``x()``, ``y()``, ``z()`` read them. Hot loops may read the slots
-directly: attribute access is several times cheaper than a method call.
+accessors ``x()``, ``y()``, ``z()`` read them.
 
 Arithmetic keeps the type of the left operand, so ``Color * float`` is a
 Color and ``Vec3 + Vec3`` is a Vec3. ``a * b`` with two vectors multiplies
@@ -66,7 +65,7 @@ class Vec3:
         return type(self)(self.e0 * s, self.e1 * s, self.e2 * s)
 
     def __truediv__(self, s: float) -> Vec3:
-        k = 1.0 / s
+        k = 1.0 / s  # v / s as (1 / s) v, as RTIOW's operator/ computes it
         return type(self)(self.e0 * k, self.e1 * k, self.e2 * k)
 
     def __eq__(self, o: object) -> bool:
@@ -91,9 +90,7 @@ class Vec3:
         return abs(self.e0) < eps and abs(self.e1) < eps and abs(self.e2) < eps
 
     def max_component(self) -> float:
-        # max(e0, e1, e2) without the builtin, whose call costs more than the comparisons
-        m = self.e1 if self.e1 > self.e0 else self.e0
-        return self.e2 if self.e2 > m else m
+        return max(self.e0, self.e1, self.e2)
 
     def is_black(self) -> bool:
         return self.e0 == 0.0 and self.e1 == 0.0 and self.e2 == 0.0

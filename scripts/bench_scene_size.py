@@ -8,8 +8,8 @@ under the sky, max depth 4) are written to a temporary folder, the mesh both as 
 OBJ text file and as a binary PLY file (float32, as downloaded scans come). For each
 size:
 
-- read and build: in a fresh process set up as a render is (rtpy.engine.memory
-  .tune_for_large_scenes), seconds of rtpy.io.obj.read_obj, of rtpy.io.ply.read_ply,
+- read and build: in a fresh process set up as a command-line render is
+  (rtpy.engine.memory), seconds of rtpy.io.obj.read_obj, of rtpy.io.ply.read_ply,
   and of rtpy.mesh.Mesh (placing the vertices, leaving out degenerate faces,
   building the tree: rtpy/_bvh_build.py), on one core;
 - whole renders, `python -m rtpy render SCENE -q -j 2`, numpy backend at 128x72 x
@@ -58,17 +58,19 @@ MEMORY_GOAL_MB = 1000
 def stages_child(scene: str) -> dict:
     """Seconds to read the scene's OBJ file, its PLY file, and to build its Mesh (of
     the OBJ file's arrays), in this process."""
+    from rtpy.engine.memory import small_pages_for_numpy, tune_for_large_scenes
+
+    small_pages_for_numpy()  # as `python -m rtpy` does, before numpy is imported
     import numpy  # noqa: F401  (imported before the clock starts, as a render has it)
 
     import rtpy._bvh_build  # noqa: F401
     import rtpy.io.obj_arrays  # noqa: F401
-    from rtpy.engine.memory import tune_for_large_scenes
     from rtpy.io.obj import read_obj
     from rtpy.io.ply import read_ply
     from rtpy.materials import Lambertian
     from rtpy.mesh import Mesh
 
-    tune_for_large_scenes()  # as a render does
+    tune_for_large_scenes()  # as a command-line render does
     obj_path = Path(scene).with_suffix(".obj")
     start = time.perf_counter()
     read_ply(obj_path.with_suffix(".ply"))

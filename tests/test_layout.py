@@ -26,6 +26,7 @@ is reported too, so the lists stay true.
 from __future__ import annotations
 
 import ast
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -364,6 +365,43 @@ def _strongly_connected(graph: dict[str, list[str]]) -> list[set[str]]:
         if v not in index:
             visit(v)
     return groups
+
+
+def engine_pipes(root: Path) -> list[str]:
+    """What the course's files (floor 0) carry for a backend: a parameter defaulting to
+    math's or the builtins' functions (`sqrt=math.sqrt`, `maximum=max`), a class's
+    `kernel = ...`, a read of Vec3's slot e0 outside vec3.py."""
+    out = []
+    for path in modules(root):
+        rel = path.relative_to(root).as_posix()
+        if floor_of(rel) != 0:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.FunctionDef):
+                for default in [*node.args.defaults, *node.args.kw_defaults]:
+                    text = ast.unparse(default) if default is not None else ""
+                    function = callable(getattr(math, text.removeprefix("math."), None))
+                    if text in ("max", "min") or (text.startswith("math.") and function):
+                        out.append(f"{rel}:{node.lineno}: {node.name} takes ={text}")
+            elif isinstance(node, ast.ClassDef):
+                for item in node.body:
+                    targets = item.targets if isinstance(item, ast.Assign) else []
+                    if any(isinstance(t, ast.Name) and t.id == "kernel" for t in targets):
+                        out.append(f"{rel}:{item.lineno}: {node.name}.kernel")
+            elif isinstance(node, ast.Attribute) and node.attr == "e0" and rel != "rtpy/vec3.py":
+                out.append(f"{rel}:{node.lineno}: reads .e0")
+    return out
+
+
+def test_the_course_files_carry_nothing_for_a_backend(tmp_path):
+    assert engine_pipes(ROOT) == []
+    planted = tmp_path / "rtpy" / "materials" / "velvet.py"
+    planted.parent.mkdir(parents=True)
+    planted.write_text(
+        "import math\n\n\nclass Velvet:\n    kernel = 'velvet'\n\n\n"
+        "def f(x, y, sqrt=math.sqrt, maximum=max):\n    return x.e0\n"
+    )
+    assert len(engine_pipes(tmp_path)) == 4
 
 
 def test_every_module_is_on_a_floor_and_imports_only_down():

@@ -145,25 +145,3 @@ def test_power_heuristic_weights_sum_to_one(a, b):
     assert math.isclose(wa + wb, 1.0, rel_tol=1e-12)
     if a > b:
         assert wa > wb
-
-
-@given(
-    st.floats(allow_nan=True, allow_infinity=True),
-    st.floats(allow_nan=True, allow_infinity=True),
-)
-def test_larger_is_the_builtin_max_of_two_floats(a, b):
-    # The same object, so -0.0 against 0.0 and NaN come out as max gives them.
-    assert sampling.larger(a, b) is max(a, b)
-
-
-def test_disk_point_and_triangle_weights_agree_with_numpy_bit_for_bit():
-    np = pytest.importorskip("numpy")
-    from rtpy.triangle import triangle_weights
-
-    rng = np.random.default_rng(7)
-    r1, r2 = rng.random(200), rng.random(200)
-    xs, ys = sampling.disk_point(r1, r2, sqrt=np.sqrt, cos=np.cos, sin=np.sin)
-    wb, wc = triangle_weights(r1, r2, sqrt=np.sqrt)
-    for k in range(200):
-        assert sampling.disk_point(float(r1[k]), float(r2[k])) == (xs[k], ys[k])
-        assert triangle_weights(float(r1[k]), float(r2[k])) == (wb[k], wc[k])

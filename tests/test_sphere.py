@@ -7,7 +7,6 @@ import math
 import random
 from decimal import Decimal, getcontext
 
-import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
@@ -502,18 +501,3 @@ def test_nearer_root_meets_the_sphere_first(distance, r1):
     to_center2 = t * t - 2.0 * t * distance * cos_t + d2
     assert to_center2 == pytest.approx(r2, rel=1e-6, abs=1e-9 * d2)
     assert t <= distance * cos_t + 1e-9 * distance  # before the chord's midpoint
-
-
-def test_the_cone_formulas_give_the_same_bits_on_arrays():
-    """The numpy backend passes arrays (and np.sqrt, np.maximum): the same numbers."""
-    rng = np.random.default_rng(3)
-    d2 = rng.uniform(1.1, 1e4, 200)
-    r2 = np.ones(200)
-    cos_t = 1.0 - rng.random(200) * one_minus_cos_max(r2, d2, sqrt=np.sqrt)
-    sin2_t = np.maximum(0.0, 1.0 - cos_t * cos_t)
-    dist = np.sqrt(d2)
-    batched = nearer_root(d2, r2, dist, cos_t, sin2_t, sqrt=np.sqrt, maximum=np.maximum)
-    for i in range(200):
-        a, b = float(d2[i]), float(cos_t[i])
-        assert one_minus_cos_max(1.0, a) == one_minus_cos_max(r2, d2, sqrt=np.sqrt)[i]
-        assert nearer_root(a, 1.0, math.sqrt(a), b, float(sin2_t[i])) == batched[i]

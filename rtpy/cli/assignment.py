@@ -1,16 +1,16 @@
-"""The commands `assignment make WEEK OUT_DIR`, `assignment autograder WEEK OUT.zip`,
-`assignment map-tests` and `grade WEEK`: their options, the week and the outputs
-checked before any work, a failing write reported in one line (exit 1)."""
+"""The instructor's commands `assignment make WEEK OUT_DIR`, `assignment autograder WEEK
+OUT.zip` and `assignment map-tests`: their options, the week and the outputs checked
+before any work, a failing write reported in one line (exit 1). Not shipped in a
+student repository (rtpy.grading.assignment INSTRUCTOR_MODULES), where the command
+line has no `assignment`."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
-from ..engine.exit_status import EXIT_BAD_INPUT, EXIT_WRITE_FAILED
-from ..engine.files import OutputError, WriteError, check_writable
-
-WEEK_HELP = "the week's two digits, 03 to 08"
+from ..engine.files import OutputError, WriteError
+from .grade import WEEK_HELP, refused
 
 
 def add_assignment_commands(sub, seconds) -> None:
@@ -34,35 +34,23 @@ def add_assignment_commands(sub, seconds) -> None:
         )
     m = asub.add_parser("map-tests", help="record which weeks each test file needs (slow)")
     m.add_argument("files", nargs="*", metavar="TEST_FILE", help="only these (tests/...)")
-    g = sub.add_parser("grade", help="run a week's graders and print the score")
-    g.add_argument("week", metavar="WEEK", help=WEEK_HELP)
-    g.add_argument("--json", metavar="RESULTS.json", help="Gradescope results file")
-    g.add_argument(
-        "--hidden", action="store_true", help="also the hidden checks (rtpy's own repository)"
-    )
 
 
 def command_assignment(args: argparse.Namespace) -> int:
-    """Run `assignment ...` or `grade`: 0 done (grade: every grader passed), 1 a grader
-    failed or a write failed, 2 a bad week or output (nothing written)."""
+    """Run `assignment ...`: 0 done, 1 a write failed, 2 a bad week or output (nothing
+    written)."""
     from ..grading.assignment import AssignmentError, check_week, map_tests
 
     try:
         week = None if getattr(args, "week", None) is None else check_week(args.week)
-        if args.command == "grade":
-            return command_grade(week, args.json, args.hidden)
         if args.assignment_command == "map-tests":
             weeks = map_tests(files=tuple(args.files))
             print(f"rtpy: {len(weeks)} test files need solution regions", file=sys.stderr)
             return 0
         what = "autograder" if args.assignment_command == "autograder" else "repository"
         written = write_assignment(args, week)
-    except WriteError as err:
-        print(f"rtpy: error: {err}", file=sys.stderr)
-        return EXIT_WRITE_FAILED
-    except (AssignmentError, OutputError, FileNotFoundError) as err:
-        print(f"rtpy: error: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    except (WriteError, AssignmentError, OutputError, FileNotFoundError) as err:
+        return refused(err)
     print(f"rtpy: wrote the week {week} {what} to {written}", file=sys.stderr)
     return 0
 
@@ -83,18 +71,3 @@ def write_assignment(args: argparse.Namespace, week: str):
         )
     except OSError as err:
         raise WriteError(out, err) from err
-
-
-def command_grade(week: str, json_path: str | None, hidden: bool = False) -> int:
-    """0 when every grader passes, 1 otherwise."""
-    from ..grading.graders import grade
-    from ..grading.results import score_table, write_results
-
-    if json_path:
-        check_writable(json_path)
-    results = grade(week, hidden=hidden)
-    print(score_table(results))
-    if json_path:
-        write_results(json_path, results)
-    passed = bool(results["tests"]) and results["score"] == results["max_score"]
-    return 0 if passed else 1

@@ -1,5 +1,6 @@
 """Command line: `python -m rtpy render SCENE ...` and `python -m rtpy scenes`; the
-other commands are in rtpy.cli.assignment and rtpy.cli.bench.command.
+other commands are in rtpy.cli.grade, rtpy.cli.bench.command and, in the instructor's
+install only, rtpy.cli.assignment.
 
 The values of a render are checked once, by rtpy.render's boundary
 (rtpy.engine.render_request.prepare_render): the command line reads them (TOML values of
@@ -14,6 +15,7 @@ import argparse
 import sys
 import tomllib
 import warnings
+from importlib.util import find_spec
 from pathlib import Path
 
 from ..engine.backends import BACKENDS
@@ -31,7 +33,7 @@ from ..engine.workers import WorkerError, available_cpus
 from ..io.image import check_image_path, check_linear_path, write_image
 from ..io.outputs import check_output
 from ..render_settings import SETTINGS, SettingError, unknown_setting
-from .assignment import add_assignment_commands
+from .grade import add_grade_command, command_grade
 
 MAX_WORKERS = 256  # more processes than that only exhaust the machine
 
@@ -115,7 +117,11 @@ def build_parser(prog: str = "rtpy", every_command: bool = True) -> argparse.Arg
     from .bench.command import add_parser as add_bench_parser
 
     add_bench_parser(sub)
-    add_assignment_commands(sub, seconds)
+    add_grade_command(sub)
+    if find_spec(f"{__package__}.assignment") is not None:  # the instructor's install only
+        from .assignment import add_assignment_commands
+
+        add_assignment_commands(sub, seconds)
     from .ladder import add_ladder_parser
 
     add_ladder_parser(sub)
@@ -480,7 +486,9 @@ def _run_command(args: argparse.Namespace) -> int:
         from .ladder import command_ladder
 
         return command_ladder(args)
-    if args.command in ("assignment", "grade"):
+    if args.command == "grade":
+        return command_grade(args)
+    if args.command == "assignment":
         from .assignment import command_assignment
 
         return command_assignment(args)

@@ -5,24 +5,30 @@ Linux reads the kernel's high-water mark (/proc/self/status), which
 reset_peak_memory() resets; elsewhere getrusage's maximum since the process
 started. The module imports `resource` only when asked (Windows has none).
 
-tune_for_large_scenes(), which a render calls before it loads its scene, tells the
-C library to keep freed memory for the next array (reuse_freed_memory) and numpy
-to back its arrays with ordinary pages (avoid_huge_pages). A render that forks its
-workers hands that kept memory back first (give_back_freed_memory).
+Tuning, for rtpy's own processes only (`python -m rtpy` and its workers; a library
+call such as rtpy.render changes nothing process-wide): it took the first render of
+the 1M-triangle OBJ scene from 2.95 s to 2.2 s and of its PLY twin from 1.9 s to
+1.4 s (docs/performance.md#scene-size). The command line calls small_pages_for_numpy()
+before numpy is imported and tune_for_large_scenes() before it loads a scene: glibc
+keeps freed memory for the next array (reuse_freed_memory), numpy backs its arrays
+with ordinary pages, and the workers it starts get both through the documented
+environment variables. A render that forks its workers from such a process hands the
+kept memory back first (give_back_freed_memory).
 """
 
 from __future__ import annotations
 
 import math
+import os
 import sys
 
 __all__ = [
-    "avoid_huge_pages",
     "give_back_freed_memory",
     "max_rss_mb",
     "peak_memory_mb",
     "reset_peak_memory",
     "reuse_freed_memory",
+    "small_pages_for_numpy",
     "tune_for_large_scenes",
 ]
 
@@ -30,6 +36,8 @@ __all__ = [
 M_TRIM_THRESHOLD = -1
 M_MMAP_THRESHOLD = -3
 KEEP_BYTES = 1 << 30  # blocks up to this size come from the heap and stay there
+
+_kept = False  # whether reuse_freed_memory has set this process to keep freed memory
 
 
 def reset_peak_memory() -> bool:
@@ -98,17 +106,21 @@ def reuse_freed_memory(mmap_threshold: int = KEEP_BYTES, trim_threshold: int = K
     blocks are not given back (565 MB against 542 MB for that render).
     Elsewhere (macOS, Windows, musl) nothing is changed and False is returned.
     """
+    global _kept
     mallopt = _c_library_function("mallopt", "c_int", "c_int")
     if mallopt is None:
         return False
-    return bool(mallopt(M_MMAP_THRESHOLD, mmap_threshold)) and bool(
+    _kept = bool(mallopt(M_MMAP_THRESHOLD, mmap_threshold)) and bool(
         mallopt(M_TRIM_THRESHOLD, trim_threshold)
     )
+    return _kept
 
 
 def give_back_freed_memory() -> bool:
-    """Give the pages of freed heap blocks back to the system (glibc's malloc_trim);
-    True where that was done.
+    """Give the pages of freed heap blocks back to the system (glibc's malloc_trim)
+    in a process that reuse_freed_memory set to keep them; True where that was done.
+    Anywhere else (a library call's host process) nothing is done: glibc gives freed
+    memory back by itself there.
 
     After reading and building a million-triangle mesh, reuse_freed_memory leaves
     about 380 MB of freed blocks resident. Worker processes forked then share those
@@ -119,7 +131,7 @@ def give_back_freed_memory() -> bool:
     at 134 MB rather than 516 MB while the workers render.
     Elsewhere (macOS, Windows, musl) nothing is done and False is returned.
     """
-    malloc_trim = _c_library_function("malloc_trim", "c_size_t")
+    malloc_trim = _c_library_function("malloc_trim", "c_size_t") if _kept else None
     if malloc_trim is None:
         return False
     malloc_trim(0)
@@ -142,30 +154,28 @@ def _c_library_function(name: str, *argument_types: str):
     return function
 
 
-def avoid_huge_pages() -> bool:
-    """Stop numpy from asking the kernel (Linux) to back its arrays of 4 MB or more
-    with 2 MB pages; True where numpy asked until now.
+def small_pages_for_numpy() -> None:
+    """Have numpy back its arrays with ordinary 4 kB pages in this process, if numpy is
+    not imported yet, and in the processes it starts: numpy's documented
+    NUMPY_MADVISE_HUGEPAGE=0, unless the user set it.
 
-    Where transparent huge pages are given on request (the usual "madvise" setting),
-    the kernel finds a free 2 MB page at the first touch of each, compacting memory
-    if it must, while the process waits. A first render of a million triangles from
-    binary PLY spent about 1 s of system time so (docs/performance.md#scene-size):
-    2.0 s in all against 1.4 s with ordinary 4 kB pages. Elsewhere numpy never asks,
-    and False is returned.
+    On Linux numpy asks the kernel to back arrays of 4 MB or more with 2 MB pages;
+    where transparent huge pages are given on request (the usual "madvise" setting),
+    the kernel finds a free 2 MB page at the first touch of each, compacting memory if
+    it must, while the process waits. A first render of a million triangles from
+    binary PLY spent about 1 s of system time so (docs/performance.md#scene-size).
+    Elsewhere numpy never asks, and the variable changes nothing.
     """
-    if not sys.platform.startswith("linux"):
-        return False
-    try:
-        from numpy._core import multiarray
-    except ImportError:  # numpy 1
-        from numpy.core import multiarray
-    set_advice = getattr(multiarray, "_set_madvise_hugepage", None)
-    return False if set_advice is None else bool(set_advice(False))
+    os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
 
 
 def tune_for_large_scenes() -> None:
-    """The memory policy of a render (reuse_freed_memory and avoid_huge_pages), which
-    lets a million-triangle mesh be read and built without page faults dominating;
-    a no-op where the platform offers neither."""
-    reuse_freed_memory()
-    avoid_huge_pages()
+    """The memory policy of the command line's renders: reuse_freed_memory here, and
+    the same thresholds for the workers it starts by running Python afresh (spawn,
+    forkserver) through glibc's documented MALLOC_MMAP_THRESHOLD_ and
+    MALLOC_TRIM_THRESHOLD_ (forked workers inherit the setting). It lets a
+    million-triangle mesh be read and built without page faults dominating; a no-op
+    where the platform offers nothing of the kind. Never called by a library call."""
+    if reuse_freed_memory():
+        os.environ.setdefault("MALLOC_MMAP_THRESHOLD_", str(KEEP_BYTES))
+        os.environ.setdefault("MALLOC_TRIM_THRESHOLD_", str(KEEP_BYTES))

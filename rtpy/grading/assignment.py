@@ -51,8 +51,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .student_readme import student_rtpy_readme, workflow_section
+from .weeks import WEEKS, AssignmentError, check_week
 
-WEEKS = ("03", "04", "05", "06", "07", "08")
+__all__ = ["WEEKS", "AssignmentError", "check_week", "make_assignment", "map_tests"]
 BEGIN = re.compile(r"^(?P<indent>[ \t]*)# BEGIN SOLUTION week(?P<week>\d\d)(?::\s*(?P<msg>.*))?$")
 END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
 
@@ -63,7 +64,20 @@ TEST_WEEKS_FILE = "assignments/test_weeks.toml"
 # which grade every week, generate repositories and check the task maps against the solution
 # regions and the pages made from them, the checks of rtpy's README (a student repository's
 # README.md is the week's) and of its layout (which counts the numpy backend's modules and tests).
-MACHINERY_TESTS = ("tests/docs/test_pages.py", "tests/test_layout.py")  # and tests/grading/*
+MACHINERY_TESTS = (
+    "tests/docs/test_pages.py",
+    "tests/test_layout.py",
+    "tests/cli/test_assignment.py",
+)  # and tests/grading/*
+# The instructor's modules: assignment authoring and Gradescope packaging. Students get
+# the course, the engine and `rtpy grade`; these stay with the instructor's install.
+INSTRUCTOR_MODULES = (
+    "rtpy/grading/assignment.py",
+    "rtpy/grading/autograder.py",
+    "rtpy/grading/student_readme.py",
+    "rtpy/grading/task_pages.py",
+    "rtpy/cli/assignment.py",
+)
 # A test file that uses the numpy backend (withheld from student repositories).
 NUMPY_USE = re.compile(r"numpy_backend|[\"']numpy[\"']|rtpy\.BACKENDS")
 
@@ -95,10 +109,6 @@ WITHHELD_MESSAGE = (
     "vectorized code contains the solutions); render with the scalar backend (the default)"
 )
 HIDDEN_FOLDER = "hidden"  # assignments/weekNN/hidden/: checks only the autograder holds
-
-
-class AssignmentError(Exception):
-    """A bad week, source tree or output directory (the CLI exits with status 2)."""
 
 
 @dataclass(frozen=True)
@@ -212,16 +222,6 @@ def rewrite(path: Path, root: Path, replace) -> str:
     return "".join(lines)
 
 
-def check_week(week: str | int) -> str:
-    """The week as two digits ("5", "05" -> "05") when ASCII digits name one of WEEKS."""
-    text, digits = str(week), str(week).lstrip("0")
-    if text.isdigit() and len(digits) <= 2:  # WEEKS are ASCII: other digits stay unknown
-        text = digits.zfill(2)
-    if text not in WEEKS:
-        raise AssignmentError(f"week {week!r}: expected one of {', '.join(WEEKS)}")
-    return text
-
-
 def weeks_of_tests(root: Path) -> dict[str, list[str]]:
     """tests/... path -> the weeks whose solution regions that test file runs."""
     path = Path(root) / TEST_WEEKS_FILE
@@ -320,10 +320,10 @@ def make_assignment(week: str | int, out_dir: str | Path, root: str | Path | Non
 
 def _write_repository(root: Path, week: str, dest: Path) -> None:
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")
-    # rtpy with the stubs, the numpy backend withheld
+    # rtpy with the stubs, the numpy backend and the instructor's modules withheld
     for path in sorted((root / "rtpy").rglob("*.py")):
         rel = path.relative_to(root)
-        if rel.parts[1] == "numpy_backend":
+        if rel.parts[1] == "numpy_backend" or rel.as_posix() in INSTRUCTOR_MODULES:
             continue
         target = dest / rel
         target.parent.mkdir(parents=True, exist_ok=True)

@@ -14,8 +14,7 @@ The shape of every line is checked at once: its bytes are classified (a number's
 characters, blanks, slashes, the keyword), runs of one class collapsed, and the
 result compared with the shapes allowed ("v d d d", "f d//d d//d d//d", ...). The
 numbers are then parsed by numpy.fromstring, which rounds decimals correctly as
-float() does (Python's own string-to-double). In a large file the vertex lines are
-read by a second process (rtpy/io/forked.py) while this one reads the faces.
+float() does (Python's own string-to-double).
 """
 
 from __future__ import annotations
@@ -24,7 +23,6 @@ import warnings
 
 import numpy as np
 
-from .forked import Forked
 from .obj import IGNORED, ObjMesh
 
 # Byte classes for the shape of a line: a number's characters become "d", blanks " ".
@@ -55,7 +53,6 @@ FORMS = {
 V, VN, VT, F, SKIP, OTHER = range(6)
 BLANK_LETTERS = bytes.maketrans(b"vntf/", b"     ")
 CHUNK = 1 << 20  # bytes of text classified at a time (_shape)
-PARALLEL_BYTES = 8 << 20  # `v`, `vn` and `vt` text read by a second process (Forked)
 
 
 def parse_obj_bytes(raw: bytes) -> ObjMesh | None:
@@ -79,12 +76,8 @@ def parse_obj_bytes(raw: bytes) -> ObjMesh | None:
     if kind is None:
         return None
     lines = [np.flatnonzero(kind == k) for k in (V, VN, VT, F)]
-    # The vertices' numbers in a second process while this one reads the faces.
-    vertex_bytes = int((ends - starts)[np.concatenate(lines[:3])].sum())
-    fork = vertex_bytes >= PARALLEL_BYTES
-    with Forked(_vertices, raw, starts, ends, lines, fork=fork) as vertices:
-        triangles = _faces(raw, starts, ends, lines)
-        positions, normals, texcoords = vertices.result()
+    positions, normals, texcoords = _vertices(raw, starts, ends, lines)
+    triangles = _faces(raw, starts, ends, lines)
     if positions is None or normals is None or not texcoords or triangles is None:
         return None
     return ObjMesh(positions, normals, triangles)

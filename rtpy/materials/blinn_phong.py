@@ -24,13 +24,12 @@ from ..sampling import generator, random_cosine_direction
 from ..scatter_info import ScatterInfo
 from ..vec3 import BLACK, WHITE, Color, dot, halfvector, reflect
 from .glossy import INV_PI, diffuse_probability, mixture_pdf, reflected_density, weighted_sample
-from .material import Material
-from .phong import Phong, cosine_power_pdf, sample_cosine_power
+from .phong import CosinePowerHighlight, cosine_power_pdf, sample_cosine_power
 
 INV_EIGHT_PI = 0.125 / math.pi
 
 
-class BlinnPhong(Material):
+class BlinnPhong(CosinePowerHighlight):
     """Diffuse plus a Blinn-Phong highlight.
 
     albedo    colour (or texture) of the diffuse part
@@ -46,10 +45,6 @@ class BlinnPhong(Material):
     vector facing away from the viewer (wo . h <= 0) reflects wo below the surface:
     that sample is absorbed.
     """
-
-    kernel = "blinn_phong"
-
-    __init__ = Phong.__init__  # the same parameters as Phong's
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
         """kd * albedo / pi + ks * (n + 8) / (8 pi) * (normal . h)^n with the unit half

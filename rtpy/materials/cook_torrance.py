@@ -78,10 +78,10 @@ DISTRIBUTIONS = ("ggx", "beckmann")
 MIN_ALPHA = 1e-4
 
 
-def schlick_weight(cosine, minimum=min, maximum=max):
+def schlick_weight(cosine: float) -> float:
     """(1 - cos)^5, cos clamped to [0, 1]: the weight of 1 - F0 in Schlick's Fresnel
-    reflectance (floats, or arrays with numpy's minimum and maximum)."""
-    return (1.0 - minimum(1.0, maximum(0.0, cosine))) ** 5
+    reflectance."""
+    return (1.0 - min(1.0, max(0.0, cosine))) ** 5
 
 
 def schlick_fresnel(f0: Color, cosine: float) -> Color:
@@ -116,8 +116,6 @@ class CookTorrance(Material):
     For a metal use kd = 0, ks = 1 and f0 = the metal's colour; for plastic use
     kd = 1, ks = 1 and the default ior.
     """
-
-    kernel = "cook_torrance"
 
     def __init__(
         self,

@@ -32,7 +32,6 @@ class Dielectric(Material):
     by 1/eta^2 on refraction. Sampled only (delta).
     """
 
-    kernel = "dielectric"
     is_specular = True
 
     def __init__(self, ior: float = 1.5, albedo: Color | Texture = Color(1.0, 1.0, 1.0)) -> None:

@@ -13,7 +13,6 @@ class DiffuseLight(Material):
     direction) from its front face, or from both faces when two_sided.
     Scatters nothing."""
 
-    kernel = "diffuse_light"
     is_emitter = True
 
     def __init__(self, emit: Color, two_sided: bool = False) -> None:

@@ -23,8 +23,6 @@ class Lambertian(Material):
     BRDF * cos / pdf is exactly the albedo.
     """
 
-    kernel = "lambertian"
-
     def __init__(self, albedo: Color | Texture = Color(0.5, 0.5, 0.5)) -> None:
         self.albedo = as_texture(albedo)
 

@@ -58,10 +58,6 @@ def check_strengths(kd: float, ks: float) -> tuple[float, float]:
 class Material:
     is_specular = False  # True: delta scattering only (mirror, metal, glass)
     is_emitter = False  # True: emitting() may be non-zero (an area light)
-    # The name a batched backend registers this class's twin under. Only the class
-    # that sets it is computed by the twin: a subclass may override anything, so it
-    # is computed by its own methods.
-    kernel: str | None = None
 
     def scattering(self, ray_in: Ray, hit: HitInfo) -> ScatterInfo | None:
         """Sample a scattered ray; None when the light is absorbed."""

@@ -20,7 +20,6 @@ class Metal(Material):
     light sampling at it).
     """
 
-    kernel = "metal"
     is_specular = True
 
     def __init__(self, albedo: Color | Texture = Color(0.5, 0.5, 0.5), fuzz: float = 0.0) -> None:

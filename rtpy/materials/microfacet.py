@@ -14,10 +14,10 @@ section 5, with alpha the width (rtpy/materials/cook_torrance.py explains them):
 
 Each is written with cos^2 and sin^2 = |normal x v|^2 rather than tan^2, and
 multiplied out so that no cosine is divided by: finite at grazing angles and for tiny
-widths. The functions are the arithmetic alone, for one direction or for arrays of
-them: the callers decide what lies below the horizon (where D and G1 are 0), and the
-numpy backend passes numpy's elementary functions where these take math's. The same
-operations in the same order give both backends the same numbers.
+widths. The functions are the arithmetic alone, for one direction: the callers decide
+what lies below the horizon (where D and G1 are 0). The numpy backend has its own
+vectorized copies of those that call math's functions
+(rtpy/numpy_backend/materials/cook_torrance.py), the same operations in the same order.
 """
 
 from __future__ import annotations
@@ -40,26 +40,26 @@ def beckmann_exponent(a2, cos2, sin2):
     return sin2 / (a2 * cos2)
 
 
-def beckmann_d(a2, cos2, exponent, exp=math.exp):
+def beckmann_d(a2, cos2, exponent):
     """Beckmann's D, exp(-tan^2 / alpha^2) / (pi alpha^2 cos^4), from its exponent."""
-    return exp(-exponent) / (math.pi * a2 * cos2 * cos2)
+    return math.exp(-exponent) / (math.pi * a2 * cos2 * cos2)
 
 
-def ggx_g1(a2, cos, sin2, sqrt=math.sqrt):
+def ggx_g1(a2, cos, sin2):
     """GGX's Smith masking of a direction above the surface (cos > 0):
     2 / (1 + sqrt(1 + alpha^2 tan^2)) multiplied through by cos."""
-    return 2.0 * cos / (cos + sqrt(cos * cos + a2 * sin2))
+    return 2.0 * cos / (cos + math.sqrt(cos * cos + a2 * sin2))
 
 
-def beckmann_a(alpha, cos, sin2, sqrt=math.sqrt):
+def beckmann_a(alpha, cos, sin2):
     """a = 1 / (alpha tan(theta)) of a direction off the normal (sin2 > 0)."""
-    return cos / (alpha * sqrt(sin2))
+    return cos / (alpha * math.sqrt(sin2))
 
 
-def beckmann_lambda(a, exp=math.exp, erfc=math.erfc):
+def beckmann_lambda(a):
     """Beckmann's Lambda(a) for a > 0, with erf(a) - 1 = -erfc(a), which does not
     cancel for large a; G1 = 1 / (1 + max(0, Lambda))."""
-    return 0.5 * (INV_SQRT_PI * exp(-a * a) / a - erfc(a))
+    return 0.5 * (INV_SQRT_PI * math.exp(-a * a) / a - math.erfc(a))
 
 
 def ggx_tan2(a2, r1):
@@ -67,12 +67,12 @@ def ggx_tan2(a2, r1):
     return a2 * r1 / (1.0 - r1)
 
 
-def beckmann_tan2(a2, r1, log1p=math.log1p):
+def beckmann_tan2(a2, r1):
     """tan^2(theta_h) of a half vector with density D cos, from a uniform r1 in [0, 1)."""
-    return -a2 * log1p(-r1)
+    return -a2 * math.log1p(-r1)
 
 
-def cos_sin_of_tan2(tan2, sqrt=math.sqrt):
+def cos_sin_of_tan2(tan2):
     """(cos, sin) of the angle whose tangent squared is tan2."""
-    cos = 1.0 / sqrt(1.0 + tan2)
-    return cos, sqrt(tan2) * cos
+    cos = 1.0 / math.sqrt(1.0 + tan2)
+    return cos, math.sqrt(tan2) * cos

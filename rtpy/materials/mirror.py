@@ -14,7 +14,6 @@ class Mirror(Material):
     """Reflects every ray about the normal; the reflected light is scaled by albedo.
     A delta BRDF: sampled only (weight = albedo, no cosine, no pdf)."""
 
-    kernel = "mirror"
     is_specular = True
 
     def __init__(self, albedo: Color | Texture = Color(1.0, 1.0, 1.0)) -> None:

@@ -51,8 +51,6 @@ class OrenNayar(Material):
     Sampling is cosine-weighted, pdf = cos(theta_i) / pi, as for Lambertian.
     """
 
-    kernel = "oren_nayar"
-
     def __init__(self, albedo: Color | Texture = Color(0.5, 0.5, 0.5), sigma: float = 20.0) -> None:
         self.albedo = as_texture(albedo)
         self.sigma = material_number("sigma", sigma)  # degrees

@@ -57,15 +57,11 @@ def cosine_power_pdf(exponent: float, cos_theta: float) -> float:
     return cosine_power_density(exponent, cos_theta**exponent)
 
 
-# The two below work on floats and on numpy arrays alike (the numpy backend passes its
-# sqrt and maximum): the numpy kernels compute with them.
-
-
-def cosine_power_angle(exponent, r1, sqrt=math.sqrt, maximum=max):
+def cosine_power_angle(exponent: float, r1: float) -> tuple[float, float]:
     """(cos, sin) of theta drawn with density (n + 1) / (2 pi) cos^n(theta) from a uniform
     r1: cos(theta) = r1^(1 / (n + 1)), inverting the distribution 1 - cos^(n + 1)."""
     cos_theta = r1 ** (1.0 / (exponent + 1.0))
-    return cos_theta, sqrt(maximum(0.0, 1.0 - cos_theta * cos_theta))
+    return cos_theta, math.sqrt(max(0.0, 1.0 - cos_theta * cos_theta))
 
 
 def cosine_power_density(exponent, power):
@@ -73,7 +69,23 @@ def cosine_power_density(exponent, power):
     return (exponent + 1.0) * INV_TWO_PI * power
 
 
-class Phong(Material):
+class CosinePowerHighlight(Material):
+    """Diffuse plus a highlight shaped by a power of a cosine: the parameters Phong
+    and Blinn-Phong share (their docstrings say what each means)."""
+
+    def __init__(
+        self,
+        albedo: Color | Texture = Color(0.5, 0.5, 0.5),
+        kd: float = 1.0,
+        ks: float = 0.0,
+        exponent: float = 1.0,
+    ) -> None:
+        self.albedo = as_texture(albedo)
+        self.kd, self.ks = check_strengths(kd, ks)
+        self.exponent = check_exponent(exponent)
+
+
+class Phong(CosinePowerHighlight):
     """Diffuse plus a normalised Phong highlight around the mirror direction.
 
     albedo    colour (or texture) of the diffuse part
@@ -93,19 +105,6 @@ class Phong(Material):
     density (n + 1) / (2 pi) * max(0, m . wi)^n; since m . wi = r . wo, that is
     the lobe's own shape. Directions that fall below the surface are absorbed.
     """
-
-    kernel = "phong"
-
-    def __init__(
-        self,
-        albedo: Color | Texture = Color(0.5, 0.5, 0.5),
-        kd: float = 1.0,
-        ks: float = 0.0,
-        exponent: float = 1.0,
-    ) -> None:
-        self.albedo = as_texture(albedo)
-        self.kd, self.ks = check_strengths(kd, ks)
-        self.exponent = check_exponent(exponent)
 
     def BRDF(self, ray_view: Ray, ray_light: Ray, hit: HitInfo) -> Color:
         """kd * albedo / pi + ks * (n + 2) / (2 pi) * max(0, r . wo)^n with

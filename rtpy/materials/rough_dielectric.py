@@ -143,8 +143,6 @@ class RoughDielectric(Material):
     microfacets, with the exact Fresnel reflectance (see the module's docstring for
     the formulas and the parameters)."""
 
-    kernel = "rough_dielectric"
-
     def __init__(
         self,
         ior: float = 1.5,

@@ -63,10 +63,6 @@ MAX_EXPONENT = 700.0
 MIN_COS_PRODUCT = 1e-200
 
 
-# The formulas below work on floats and on numpy arrays alike (the numpy backend
-# passes its exp and log1p): the numpy kernel computes with them.
-
-
 def squared_slopes(hx, hy, ax, ay):
     """(hx / alpha_x)^2 + (hy / alpha_y)^2 of a half vector's frame coordinates: the
     slope exponent times hz^2."""
@@ -74,23 +70,23 @@ def squared_slopes(hx, hy, ax, ay):
     return sx * sx + sy * sy
 
 
-def half_vector_tan2(r1, cos_phi, sin_phi, ax, ay, log1p=math.log1p):
+def half_vector_tan2(r1, cos_phi, sin_phi, ax, ay):
     """tan^2(theta_h) = -ln(1 - r1) / (cos^2(phi_h) / alpha_x^2 + sin^2(phi_h) / alpha_y^2)
     of a half vector drawn at azimuth phi_h (Walter 2005)."""
     a = cos_phi * cos_phi / (ax * ax) + sin_phi * sin_phi / (ay * ay)
-    return -log1p(-r1) / a
+    return -math.log1p(-r1) / a
 
 
-def highlight_lobe(exponent, cos_i, cos_o, ax, ay, exp=math.exp, sqrt=math.sqrt, maximum=max):
+def highlight_lobe(exponent, cos_i, cos_o, ax, ay):
     """exp(-slope exponent) / (4 pi alpha_x alpha_y sqrt(cos_i cos_o)), the product of the
     cosines kept from 0 (MIN_COS_PRODUCT)."""
-    root = sqrt(maximum(cos_i * cos_o, MIN_COS_PRODUCT))
-    return exp(-exponent) / (4.0 * math.pi * ax * ay * root)
+    root = math.sqrt(max(cos_i * cos_o, MIN_COS_PRODUCT))
+    return math.exp(-exponent) / (4.0 * math.pi * ax * ay * root)
 
 
-def half_vector_density(exponent, cos, ax, ay, exp=math.exp):
+def half_vector_density(exponent, cos, ax, ay):
     """p_h = exp(-slope exponent) / (pi alpha_x alpha_y cos^3(theta_h))."""
-    return exp(-exponent) / (math.pi * ax * ay * cos**3)
+    return math.exp(-exponent) / (math.pi * ax * ay * cos**3)
 
 
 class Ward(Material):
@@ -109,8 +105,6 @@ class Ward(Material):
     The highlight is anisotropic, so it is evaluated and sampled in the hit's
     shading frame hit.frame: u along the tangent, v = normal x u, w = the normal.
     """
-
-    kernel = "ward"
 
     def __init__(
         self,

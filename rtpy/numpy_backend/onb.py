@@ -81,7 +81,7 @@ def _where(mask: np.ndarray, a: Columns, b: Columns) -> Columns:
 
 
 def local_to_world(w: Columns, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Columns:
-    """rtpy.onb.local_to_world: x u + y v + z w for the frames ONB(w) builds, without
+    """ONB(w).to_world of rtpy.onb: x u + y v + z w for the frames ONB(w) builds, without
     building them (the same numbers, as in the scalar code)."""
     w0, w1, w2 = w
     sign = np.copysign(1.0, w2)

@@ -20,7 +20,6 @@ from functools import partial
 import numpy as np
 
 from ..engine.backend import Backend
-from ..engine.memory import reuse_freed_memory
 from ..engine.plan import Plan, Unit
 from .camera import CameraRays
 from .integrators import BatchIntegrator, make_integrator
@@ -78,28 +77,9 @@ class NumpyBackend(Backend):
         return Plan(width, height, spp, MAX_RAYS)  # read now: a test may make it smaller
 
     def start(self) -> Callable[[Unit], np.ndarray]:
-        keep_freed_memory()
         scene, rays = BatchScene(self.scene), CameraRays(self.camera)
         integrator = self.make_integrator()
         settings = self.settings
         return partial(
             render_unit, scene, rays, integrator, settings.seed, sampler=settings.sampler
         )
-
-
-def keep_freed_memory() -> None:
-    """Ask glibc's malloc to keep freed blocks of up to 32 MB in the heap (Linux; a
-    no-op elsewhere), once per process. The backend allocates and frees the same
-    temporaries of a few hundred KB (arrays over a unit's rays) thousands of times per
-    second; by default glibc maps each one freshly from the kernel and unmaps it when
-    it is freed, so every page of every temporary faults on first touch, a large share
-    of the render time. rtpy.engine.memory.reuse_freed_memory sets malloc's documented tuning
-    (mallopt: the mmap and trim thresholds), process-wide: here the process keeps up to
-    128 MB of freed memory for reuse instead of returning it."""
-    global _malloc_tuned
-    if not _malloc_tuned:
-        _malloc_tuned = True
-        reuse_freed_memory(mmap_threshold=32 << 20, trim_threshold=128 << 20)
-
-
-_malloc_tuned = False

@@ -28,7 +28,6 @@ import math
 
 import numpy as np
 
-from ..sampling import cone_angle, disk_point
 from .onb import local_to_world
 from .vec3 import Columns
 
@@ -98,8 +97,17 @@ def cosine_direction(r1: np.ndarray, r2: np.ndarray) -> Columns:
 
 def unit_disk(r1: np.ndarray, r2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """rtpy.sampling.random_in_unit_disk from its two uniform numbers: (x, y) uniform
-    in the unit disk, by rtpy.sampling.disk_point."""
-    return disk_point(r1, r2, sqrt=np.sqrt, cos=np.cos, sin=np.sin)
+    in the unit disk, as rtpy.sampling.disk_point computes them (numpy's cos and sin
+    call the same C library as math's)."""
+    radius = np.sqrt(r1)
+    phi = 2.0 * math.pi * r2
+    return radius * np.cos(phi), radius * np.sin(phi)
+
+
+def cone_angle(r1: np.ndarray, cone_size: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """rtpy.sampling.cone_angle on arrays: (cos theta, sin^2 theta)."""
+    cos_t = 1.0 - r1 * cone_size
+    return cos_t, np.maximum(0.0, 1.0 - cos_t * cos_t)
 
 
 def cone_direction(
@@ -109,7 +117,7 @@ def cone_direction(
     from outside): (world direction, cos_t, sin_t^2) at angle cos_t = 1 - r1 omc from
     the unit axis, azimuth 2 pi r2 in the frame ONB(axis); omc is 1 - cos of the
     cone's half-angle, and the density 1 / (2 pi omc)."""
-    cos_t, sin2_t = cone_angle(r1, omc, maximum=np.maximum)
+    cos_t, sin2_t = cone_angle(r1, omc)
     sin_t = np.sqrt(sin2_t)
     cos_phi, sin_phi = cos_sin_2pi(r2)
     return local_to_world(axis, sin_t * cos_phi, sin_t * sin_phi, cos_t), cos_t, sin2_t

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..sampling import cone_pdf
-from ..sphere import Sphere, nearer_root, one_minus_cos_max
+from ..sphere import Sphere
 from .arrays import at, axpy, dot, put_rows, scale
 from .hittable import INF, PrimitiveSet, area_direction, area_direction_pdf
 from .sampling import cone_direction, uniform_sphere
@@ -26,6 +26,17 @@ SPHERE_CHUNK = 16384
 
 
 # Twin kept: Sphere.hit_t is the week-4 exercise, in Vec3 form with early misses.
+def one_minus_cos_max(r2: np.ndarray, d2: np.ndarray) -> np.ndarray:
+    """rtpy.sphere.one_minus_cos_max on arrays: sin^2 / (1 + cos) with sin^2 = r2 / d2."""
+    sin2 = r2 / d2
+    return sin2 / (1.0 + np.sqrt(1.0 - sin2))
+
+
+def nearer_root(d2, r2, distance, cos_t, sin2_t) -> np.ndarray:
+    """rtpy.sphere.nearer_root on arrays: (D^2 - r^2) / (D cos_t + sqrt(r^2 - D^2 sin^2_t))."""
+    return (d2 - r2) / (distance * cos_t + np.sqrt(np.maximum(0.0, r2 - d2 * sin2_t)))
+
+
 def _sphere_roots(h, c_term, a, r, f2, t_min, t_max):
     """Sphere.hit_t's root step, op for op (see rtpy/sphere.py): the nearer root of
     a t^2 - 2 h t + c_term = 0 inside (t_min, t_max), else INF; and q, which is 0
@@ -206,7 +217,7 @@ class SphereSet(PrimitiveSet):
         r2 = at(self.r2, k)
         outside = ~(d2 <= r2 * 1.0000001)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inside: unused
-            return outside, one_minus_cos_max(r2, d2, sqrt=np.sqrt)
+            return outside, one_minus_cos_max(r2, d2)
 
     def sample_direction(self, k, p, r1, r2):
         """Sphere.sample_direction: by solid angle inside the cone seen from outside,
@@ -265,14 +276,14 @@ class SphereSet(PrimitiveSet):
         if not (d2 > rr * 1.0000001).all():  # some point inside: the general path
             return super().sample_light(k, p, r1, r2)
         # The cone and a direction in it, as cone() and sample_direction().
-        omc = one_minus_cos_max(rr, d2, sqrt=np.sqrt)
+        omc = one_minus_cos_max(rr, d2)
         dist = np.sqrt(d2)
         inv = 1.0 / dist
         (dx, dy, dz), cos_t, sin2_t = cone_direction((ocx * inv, ocy * inv, ocz * inv), omc, r1, r2)
         pdf = cone_pdf(omc)
         # The distance to the sphere along the sampled direction (see above); inside
         # the cone, r^2 - D^2 sin^2 >= 0 but for rounding.
-        t = nearer_root(d2, rr, dist, cos_t, sin2_t, sqrt=np.sqrt, maximum=np.maximum)
+        t = nearer_root(d2, rr, dist, cos_t, sin2_t)
         valid = np.ones(len(t), dtype=bool)
         # The point and its normal, as geometric().
         qx, qy, qz = px + t * dx, py + t * dy, pz + t * dz

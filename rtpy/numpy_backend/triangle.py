@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..mesh import Mesh, SmoothTriangle
-from ..triangle import PARALLEL_TOLERANCE, Triangle, triangle_weights
+from ..triangle import PARALLEL_TOLERANCE, Triangle
 from .arrays import at, axpy, dot, scale
 from .bvh import BVH
 from .hittable import INF, PlanarSet, area_direction_pdf
@@ -161,7 +161,8 @@ class TriangleSet(PlanarSet):
         return area_direction_pdf(p, q, self._frame(k)[0], self.area(k))
 
     def sample_point(self, k, r1, r2):
-        wb, wc = triangle_weights(r1, r2, sqrt=np.sqrt)
+        s = np.sqrt(r1)  # rtpy.triangle.triangle_weights
+        wb, wc = s * (1.0 - r2), s * r2
         a, e1, e2 = self._edges(k)
         p = a + wb[:, None] * e1 + wc[:, None] * e2
         return p, self._frame(k)[0]

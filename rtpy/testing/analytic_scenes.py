@@ -140,7 +140,6 @@ def pixels_fully_off_sphere(camera: Camera, sphere: Sphere, margin: int = 0) -> 
 class GlowingLambertian(Lambertian):
     """Diffuse reflection plus uniform emission `emit` from both faces."""
 
-    kernel = "glowing_lambertian"
     is_emitter = True
 
     def __init__(self, albedo: Color, emit: Color) -> None:

@@ -10,7 +10,7 @@ from rtpy.environment import Environment
 from rtpy.light import Light
 from rtpy.materials import MATERIALS
 from rtpy.mesh import Mesh
-from rtpy.numpy_backend.materials import KERNELS
+from rtpy.numpy_backend.materials import KERNELS, class_name
 from rtpy.numpy_backend.scene import KINDS
 from rtpy.testing.analytic_scenes import GlowingLambertian
 
@@ -40,7 +40,7 @@ def first_cells(subsection: str) -> set[str]:
 
 def test_every_material_with_a_kernel_has_a_row():
     declaring = [*MATERIALS.values(), GlowingLambertian]
-    expected = {cls.__name__ for cls in declaring if cls.__dict__.get("kernel") in KERNELS}
+    expected = {cls.__name__ for cls in declaring if class_name(cls) in KERNELS}
     assert len(expected) == len(KERNELS)
     assert first_cells("Reflection models") == expected
 

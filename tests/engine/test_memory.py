@@ -3,6 +3,7 @@ and the `resource` module."""
 
 from __future__ import annotations
 
+import json
 import mmap
 import os
 import platform
@@ -138,10 +139,13 @@ def test_freed_memory_kept_for_reuse_is_given_back():
 
 PAGES_CHILD = """
 import resource, sys
-import numpy as np
-from rtpy.engine.memory import avoid_huge_pages
+from rtpy.engine.memory import small_pages_for_numpy
 
-if sys.argv[1] == "small" and not avoid_huge_pages():
+if sys.argv[1] == "small":
+    small_pages_for_numpy()
+import numpy as np
+
+if sys.argv[1] == "small" and not sys.platform.startswith("linux"):
     print("unsupported")
     sys.exit(0)
 before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
@@ -166,7 +170,7 @@ def faults_of_a_fresh_array(mode: str) -> str:
 
 
 def test_numpy_arrays_get_small_pages():
-    """avoid_huge_pages: a fresh 96 MB array is faulted in by 4 kB pages, as many
+    """small_pages_for_numpy: a fresh 96 MB array is faulted in by 4 kB pages, as many
     faults as pages, not by 48 huge ones the kernel may compact memory to find."""
     found = faults_of_a_fresh_array("small")
     if found == "unsupported":
@@ -175,3 +179,49 @@ def test_numpy_arrays_get_small_pages():
     if not huge_pages_on_request():
         pytest.skip("the kernel's huge pages are not given on request")
     assert int(found) >= SMALL_PAGES  # numpy's default here: 49 faults (huge pages)
+
+
+# A library call in someone else's interpreter: every way rtpy could change the
+# process's allocator is recorded (glibc's mallopt and malloc_trim through ctypes,
+# numpy's private huge-page switch), then both backends render, in this process and
+# with forked workers.
+LIBRARY_CALL_CHILD = """
+import ctypes, json, os, sys
+calls = []
+
+class RecordingCDLL(ctypes.CDLL):
+    def __getattr__(self, name):
+        if name in ("mallopt", "malloc_trim"):
+            calls.append(name)
+        return super().__getattr__(name)
+
+ctypes.CDLL = RecordingCDLL
+from numpy._core import multiarray
+real_switch = getattr(multiarray, "_set_madvise_hugepage", None)
+
+def switch(enabled):
+    calls.append("_set_madvise_hugepage")
+    return real_switch(enabled)
+
+multiarray._set_madvise_hugepage = switch
+environment = dict(os.environ)
+import rtpy
+
+ball = rtpy.Sphere(rtpy.Vec3(0, 0, -1), 0.5, rtpy.Lambertian())
+scene, camera = rtpy.Scene([ball], sky=True), rtpy.Camera(width=16)
+for backend in ("scalar", "numpy"):
+    for workers in (1, 2):
+        rtpy.render(scene, camera=camera, spp=2, backend=backend, workers=workers)
+names = set(os.environ) | set(environment)
+changed = sorted(k for k in names if os.environ.get(k) != environment.get(k))
+print(json.dumps([calls, changed]))
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="Windows cannot fork")
+def test_a_library_render_changes_nothing_process_wide():
+    """import rtpy; rtpy.render(...) in a fresh interpreter, either backend, with and
+    without workers, sets no allocator option and no environment variable."""
+    calls, changed = json.loads(child_says(LIBRARY_CALL_CHILD, "library"))
+    assert calls == []
+    assert changed == []

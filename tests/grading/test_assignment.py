@@ -35,6 +35,7 @@ import pytest
 
 from rtpy.cli.main import main
 from rtpy.grading.assignment import (
+    INSTRUCTOR_MODULES,
     NUMPY_USE,
     TEST_WEEKS_FILE,
     WEEKS,
@@ -281,3 +282,48 @@ def test_map_tests_of_some_files_records_their_weeks_and_keeps_the_rest(tmp_path
     weeks = map_tests(tmp_path, files=("tests/numpy_backend/test_sampling.py",))
     assert weeks == {"tests/test_other.py": {"07"}, "tests/test_shade.py": {"05"}}
     assert (tmp_path / TEST_WEEKS_FILE).read_text() == before
+
+
+# Every module of the repository's rtpy imported there: none needs a withheld one.
+IMPORT_ALL = """
+import pkgutil, importlib, rtpy
+names = [m.name for m in pkgutil.walk_packages(rtpy.__path__, "rtpy.")]
+names = [n for n in names if n != "rtpy.__main__"]  # importing it runs the CLI
+for name in names:
+    importlib.import_module(name)
+print(len(names))
+"""
+
+
+def test_a_student_repository_holds_no_authoring_or_packaging(tmp_path):
+    """Week 08's repository: none of INSTRUCTOR_MODULES, nothing shipped that names
+    them, no `assignment` in `python -m rtpy`, and `rtpy grade 08` grading there."""
+    with MAKING:
+        repo = make_assignment("08", tmp_path / "week08")
+    for rel in INSTRUCTOR_MODULES:
+        assert (ROOT / rel).exists() and not (repo / rel).exists(), rel
+
+    def rtpy_there(*args: str) -> subprocess.CompletedProcess:
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+        return subprocess.run(
+            [sys.executable, *args],
+            cwd=repo,
+            env=dict(env, PYTHONPATH=str(repo)),
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
+
+    imported = rtpy_there("-c", IMPORT_ALL)
+    assert imported.returncode == 0 and int(imported.stdout) > 50, imported.stderr
+    usage = rtpy_there("-m", "rtpy", "--help")
+    assert usage.returncode == 0 and "grade" in usage.stdout, usage.stderr
+    assert "assignment" not in usage.stdout
+    assert (
+        rtpy_there("-m", "rtpy", "assignment", "make", "08", "out").returncode == 2
+    )  # no such command
+    graded = rtpy_there("-m", "rtpy", "grade", "08", "--json", str(tmp_path / "results.json"))
+    results = json.loads((tmp_path / "results.json").read_text())
+    assert graded.returncode == 1, graded.stderr  # the stubs fail every grader
+    assert len(results["tests"]) >= 5 and results["score"] == 0
+    assert "NotImplementedError" in graded.stdout and "week08 task" in graded.stdout

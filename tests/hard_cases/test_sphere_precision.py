@@ -18,7 +18,7 @@ import pytest
 from rtpy import Lambertian, Sphere, Vec3
 from rtpy.numpy_backend.ray import spawn_origins
 from rtpy.numpy_backend.sphere import SphereSet
-from rtpy.onb import local_to_world
+from rtpy.onb import ONB
 from rtpy.ray import Ray, spawn_ray
 
 EPS = 2.0**-53  # unit roundoff of float64
@@ -71,7 +71,7 @@ def rays_at_cap(c, r, eye, n, seed):
         cos_t = rng.uniform(0.05, 1.0)
         phi = rng.uniform(0.0, 2.0 * math.pi)
         s = math.sqrt(1.0 - cos_t * cos_t)
-        w = local_to_world(Vec3(*axis), s * math.cos(phi), s * math.sin(phi), cos_t)
+        w = ONB(Vec3(*axis)).to_world(Vec3(s * math.cos(phi), s * math.sin(phi), cos_t))
         target = c + r * np.array([w.e0, w.e1, w.e2])
         v = target - eye
         o.append(eye)
@@ -173,7 +173,7 @@ def directions_above(nrm, cos_lo, cos_hi, seed):
         cz = rng.uniform(cos_lo, cos_hi)
         phi = rng.uniform(0.0, 2.0 * math.pi)
         s = math.sqrt(1.0 - cz * cz)
-        w = local_to_world(Vec3(*n), s * math.cos(phi), s * math.sin(phi), cz)
+        w = ONB(Vec3(*n)).to_world(Vec3(s * math.cos(phi), s * math.sin(phi), cz))
         out.append([w.e0, w.e1, w.e2])
     return np.array(out)
 

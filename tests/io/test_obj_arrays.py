@@ -3,15 +3,12 @@ file to parse_obj (None), and on the usual shapes of files it does answer."""
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rtpy.io import obj_arrays
-from rtpy.io.forked import can_fork
 from rtpy.io.obj import ObjError, parse_obj, read_obj
 from rtpy.io.obj_arrays import parse_obj_bytes
 
@@ -167,20 +164,6 @@ def test_the_text_classified_in_pieces_gives_the_same_answer(text, chunk):
         assert disagreement(text) is None  # parse_obj's answer, whatever the pieces
     assert (whole is None) == (pieces is None)
     assert whole is None or same(whole, pieces)
-
-
-@settings(max_examples=15, suppress_health_check=[HealthCheck.too_slow], deadline=None)
-@given(obj_texts())
-def test_vertices_read_by_a_second_process_give_the_same_answer(text):
-    """A large file's `v`, `vn` and `vt` lines are read by a forked child (rtpy.io
-    .forked) while this process reads the faces: the same answer as one process."""
-    assert can_fork() or not sys.platform.startswith("linux")
-    alone = parse_obj_bytes(text.encode("utf-8"))
-    with pytest.MonkeyPatch.context() as m:
-        m.setattr(obj_arrays, "PARALLEL_BYTES", 0)
-        two = parse_obj_bytes(text.encode("utf-8"))
-    assert (alone is None) == (two is None)
-    assert alone is None or same(alone, two)
 
 
 def test_read_obj_gives_parse_objs_errors_with_their_lines(tmp_path):

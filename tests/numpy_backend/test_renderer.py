@@ -104,11 +104,12 @@ class Velvet(Material):
         self.albedo_color = Color(0.3, 0.6, 0.3)
 
     def scattering(self, ray_in, hit):
-        from rtpy.onb import local_to_world
+        from rtpy.onb import ONB
         from rtpy.sampling import random_cosine_direction
 
-        x, y, z = random_cosine_direction()
-        direction = local_to_world(hit.normal, x, y, z)
+        local = random_cosine_direction()
+        direction = ONB(hit.normal).to_world(local)
+        z = local.z()
         ray = spawn_ray(hit.point, hit.normal, direction)
         return ScatterInfo(ray, self.albedo_color, z / np.pi)
 

@@ -94,3 +94,16 @@ def test_generators_depend_on_the_whole_key_only():
     for other in ((7, 3, 2), (7, 4, 1), (8, 3, 1)):
         assert not np.array_equal(a, make_generator(*other).random(4))
     assert math.isclose(make_generator(np.int64(7), 3, 1).random(), a[0])
+
+
+def test_unit_disk_and_cone_angle_are_the_scalar_ones_to_the_bit():
+    from rtpy.numpy_backend.sampling import cone_angle, unit_disk
+
+    rng = np.random.default_rng(7)
+    r1, r2 = rng.random(200), rng.random(200)
+    xs, ys = unit_disk(r1, r2)
+    cos_t, sin2_t = cone_angle(r1, r2)
+    for k in range(200):
+        a, b = float(r1[k]), float(r2[k])
+        assert scalar.disk_point(a, b) == (xs[k], ys[k])
+        assert scalar.cone_angle(a, b) == (cos_t[k], sin2_t[k])

@@ -36,3 +36,21 @@ def test_sphere_tangent_at_the_pole_falls_back_to_the_normal_frame():
     hits = geo.hit_batch(obj, o, d, t)
     ref = s.hit_info(Ray(V(o[0]), V(d[0])), float(t[0]))
     np.testing.assert_allclose(hits.tangent[0], arr(ref.tangent), atol=1e-15)
+
+
+def test_the_cone_formulas_are_the_scalar_ones_to_the_bit():
+    """one_minus_cos_max and nearer_root on arrays: rtpy.sphere's numbers, row by row."""
+    from rtpy import sphere as scalar
+    from rtpy.numpy_backend.sphere import nearer_root, one_minus_cos_max
+
+    rng = np.random.default_rng(3)
+    d2 = rng.uniform(1.1, 1e4, 200)
+    r2 = np.ones(200)
+    omc = one_minus_cos_max(r2, d2)
+    cos_t = 1.0 - rng.random(200) * omc
+    sin2_t = np.maximum(0.0, 1.0 - cos_t * cos_t)
+    batched = nearer_root(d2, r2, np.sqrt(d2), cos_t, sin2_t)
+    for i in range(200):
+        a, b = float(d2[i]), float(cos_t[i])
+        assert scalar.one_minus_cos_max(1.0, a) == omc[i]
+        assert scalar.nearer_root(a, 1.0, math.sqrt(a), b, float(sin2_t[i])) == batched[i]

@@ -6,6 +6,6 @@ once. Materials without a kernel run through their scalar methods (fallback.py).
 """
 
 from .material import Kernel
-from .table import KERNELS, MaterialTable, kernel_class
+from .table import KERNELS, MaterialTable, class_name, kernel_class
 
-__all__ = ["KERNELS", "Kernel", "MaterialTable", "kernel_class"]
+__all__ = ["KERNELS", "Kernel", "MaterialTable", "class_name", "kernel_class"]

@@ -9,18 +9,56 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...materials import CookTorrance, microfacet
-from ...materials.cook_torrance import schlick_weight
 from ..onb import ONB
 from ..sampling import cos_sin_2pi
 from ..vec3 import Columns, cross, dot, halfvector, reflect
 from .glossy import GlossyKernel, reflected_density
 from .material import Bounce, color_param, param
 
+# The formulas of rtpy/materials/microfacet.py and cook_torrance.py that call math's
+# functions, on arrays: the same operations in the same order, with numpy's.
+
+
+def schlick_weight(cosine: np.ndarray) -> np.ndarray:
+    """cook_torrance.schlick_weight: (1 - cos)^5, cos clamped to [0, 1]."""
+    return (1.0 - np.minimum(1.0, np.maximum(0.0, cosine))) ** 5
+
+
+def beckmann_d(a2, cos2, exponent) -> np.ndarray:
+    """microfacet.beckmann_d: exp(-tan^2 / alpha^2) / (pi alpha^2 cos^4)."""
+    return np.exp(-exponent) / (math.pi * a2 * cos2 * cos2)
+
+
+def ggx_g1(a2, cos, sin2) -> np.ndarray:
+    """microfacet.ggx_g1: 2 / (1 + sqrt(1 + alpha^2 tan^2)) multiplied through by cos."""
+    return 2.0 * cos / (cos + np.sqrt(cos * cos + a2 * sin2))
+
+
+def beckmann_a(alpha, cos, sin2) -> np.ndarray:
+    """microfacet.beckmann_a: 1 / (alpha tan(theta))."""
+    return cos / (alpha * np.sqrt(sin2))
+
+
+def beckmann_lambda(a: np.ndarray) -> np.ndarray:
+    """microfacet.beckmann_lambda: Lambda(a) for a > 0, with math's erfc (erfc below)."""
+    return 0.5 * (microfacet.INV_SQRT_PI * np.exp(-a * a) / a - erfc(a))
+
+
+def beckmann_tan2(a2, r1) -> np.ndarray:
+    """microfacet.beckmann_tan2: tan^2(theta_h) = -alpha^2 ln(1 - r1)."""
+    return -a2 * np.log1p(-r1)
+
+
+def cos_sin_of_tan2(tan2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """microfacet.cos_sin_of_tan2: (cos, sin) of the angle whose tangent squared is tan2."""
+    cos = 1.0 / np.sqrt(1.0 + tan2)
+    return cos, np.sqrt(tan2) * cos
+
 
 def schlick_fresnel(f0: np.ndarray, cosine: np.ndarray) -> np.ndarray:
     """cook_torrance.schlick_fresnel for colours f0 (n, 3) (its F0 + (1 - F0) m on rows
     of colours, where the scalar model has Color arithmetic)."""
-    m = schlick_weight(cosine, minimum=np.minimum, maximum=np.maximum)[:, None]
+    m = schlick_weight(cosine)[:, None]
     return f0 + (1.0 - f0) * m
 
 
@@ -71,7 +109,7 @@ class CookTorranceKernel(GlossyKernel):
 
     def sample_half_vector(self, alpha: np.ndarray, r1: np.ndarray, r2: np.ndarray) -> Columns:
         """CookTorrance.sample_half_vector: local (x, y, z) around the normal (z)."""
-        cos, sin = microfacet.cos_sin_of_tan2(self.tan2_half_vector(alpha, r1), sqrt=np.sqrt)
+        cos, sin = cos_sin_of_tan2(self.tan2_half_vector(alpha, r1))
         cos_phi, sin_phi = cos_sin_2pi(r2)
         return sin * cos_phi, sin * sin_phi, cos
 
@@ -107,7 +145,7 @@ class GGXKernel(CookTorranceKernel):
         up = cos > 0.0
         c = cross(normal, v)
         sin2 = dot(c, c)
-        g = microfacet.ggx_g1(alpha * alpha, np.where(up, cos, 1.0), sin2, sqrt=np.sqrt)
+        g = ggx_g1(alpha * alpha, np.where(up, cos, 1.0), sin2)
         return np.where(up, np.where(sin2 == 0.0, 1.0, g), 0.0)
 
     def tan2_half_vector(self, alpha, r1):
@@ -119,7 +157,7 @@ class BeckmannKernel(CookTorranceKernel):
         ok = ok & (a2 * cos2 != 0.0)  # underflow for tiny widths at the horizon
         exponent = microfacet.beckmann_exponent(a2, np.where(ok, cos2, 1.0), sin2)
         ok &= ~(exponent > 700.0)  # exp underflows
-        d = microfacet.beckmann_d(a2, cos2, np.where(ok, exponent, 0.0), exp=np.exp)
+        d = beckmann_d(a2, cos2, np.where(ok, exponent, 0.0))
         return np.where(ok, d, 0.0)
 
     def G1(self, alpha, normal, v):
@@ -128,17 +166,17 @@ class BeckmannKernel(CookTorranceKernel):
         sin2 = dot(c, c)
         g = np.where(cos > 0.0, 1.0, 0.0)  # 1 also where sin2 = 0 and where a >= 6
         slanted = np.flatnonzero((cos > 0.0) & (sin2 != 0.0))
-        a = microfacet.beckmann_a(alpha[slanted], cos[slanted], sin2[slanted], sqrt=np.sqrt)
+        a = beckmann_a(alpha[slanted], cos[slanted], sin2[slanted])
         g[slanted[a == 0.0]] = 0.0
         near = (a != 0.0) & (a < BECKMANN_G1_ONE)
         a = a[near]
         with np.errstate(over="ignore"):  # subnormal a: lam = inf, G1 = 0 (as in Python)
-            lam = microfacet.beckmann_lambda(a, exp=np.exp, erfc=erfc)
+            lam = beckmann_lambda(a)
         g[slanted[near]] = 1.0 / (1.0 + np.maximum(0.0, lam))
         return g
 
     def tan2_half_vector(self, alpha, r1):
-        return microfacet.beckmann_tan2(alpha * alpha, r1, log1p=np.log1p)
+        return beckmann_tan2(alpha * alpha, r1)
 
 
 def cook_torrance_kernel(material: CookTorrance) -> type[CookTorranceKernel]:

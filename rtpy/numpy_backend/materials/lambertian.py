@@ -60,8 +60,8 @@ class LambertianKernel(AlbedoKernel):
 class GlowingLambertianKernel(LambertianKernel):
     """A Lambertian that also emits `emit` from both faces: the closed-form
     "glowing furnace" scene's GlowingLambertian (rtpy/testing/analytic_scenes.py).
-    The table finds it by the name the class declares (its `kernel`, see
-    table.KERNELS), so neither package imports the other."""
+    The table finds it by the class's qualified name (table.KERNELS), so neither
+    package imports the other."""
 
     emits = True
 

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...materials import Phong
-from ...materials.phong import INV_TWO_PI, cosine_power_angle, cosine_power_density
+from ...materials.phong import INV_TWO_PI, cosine_power_density
 from ..onb import ONB
 from ..sampling import cos_sin_2pi
 from ..vec3 import Columns, dot, negative, reflect
@@ -15,10 +15,16 @@ from .glossy import GlossyKernel, positive_power
 from .material import Bounce, param
 
 
+def cosine_power_angle(exponent: np.ndarray, r1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """phong.cosine_power_angle on arrays: (cos, sin) of theta, cos = r1^(1 / (n + 1))."""
+    cos_theta = r1 ** (1.0 / (exponent + 1.0))
+    return cos_theta, np.sqrt(np.maximum(0.0, 1.0 - cos_theta * cos_theta))
+
+
 def sample_cosine_power(exponent: np.ndarray, r1: np.ndarray, r2: np.ndarray) -> Columns:
     """phong.sample_cosine_power: local (x, y, z) with density (n + 1) / (2 pi) cos^n
     around z."""
-    cos_theta, sin_theta = cosine_power_angle(exponent, r1, sqrt=np.sqrt, maximum=np.maximum)
+    cos_theta, sin_theta = cosine_power_angle(exponent, r1)
     cos_phi, sin_phi = cos_sin_2pi(r2)
     return sin_theta * cos_phi, sin_theta * sin_phi, cos_theta
 

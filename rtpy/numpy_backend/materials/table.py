@@ -27,34 +27,37 @@ from .ward import WardKernel
 
 KernelChoice = type[Kernel] | Callable[[Material], type[Kernel]]
 
-# The kernels by the name a material class declares as its `kernel`: its kernel class,
-# or a function choosing one from the instance (Cook-Torrance and the rough dielectric
-# have one kernel per distribution, so no kernel branches per hit). A name, not the
-# class, so that a class this backend does not import has a twin: the closed-form
-# scenes' GlowingLambertian lives in rtpy.testing, which students get without this
-# backend.
+# The kernels by the qualified name of the material class they compute (class_name):
+# its kernel class, or a function choosing one from the instance (Cook-Torrance and
+# the rough dielectric have one kernel per distribution, so no kernel branches per
+# hit). Names, not classes, so that a class this backend does not import has a twin:
+# the closed-form scenes' GlowingLambertian lives in rtpy.testing, above this backend.
 KERNELS: dict[str, KernelChoice] = {
-    "lambertian": LambertianKernel,
-    "glowing_lambertian": GlowingLambertianKernel,
-    "mirror": MirrorKernel,
-    "metal": MetalKernel,
-    "dielectric": DielectricKernel,
-    "rough_dielectric": rough_dielectric_kernel,
-    "diffuse_light": DiffuseLightKernel,
-    "phong": PhongKernel,
-    "blinn_phong": BlinnPhongKernel,
-    "cook_torrance": cook_torrance_kernel,
-    "ward": WardKernel,
-    "oren_nayar": OrenNayarKernel,
+    "rtpy.materials.lambertian.Lambertian": LambertianKernel,
+    "rtpy.testing.analytic_scenes.GlowingLambertian": GlowingLambertianKernel,
+    "rtpy.materials.mirror.Mirror": MirrorKernel,
+    "rtpy.materials.metal.Metal": MetalKernel,
+    "rtpy.materials.dielectric.Dielectric": DielectricKernel,
+    "rtpy.materials.rough_dielectric.RoughDielectric": rough_dielectric_kernel,
+    "rtpy.materials.diffuse_light.DiffuseLight": DiffuseLightKernel,
+    "rtpy.materials.phong.Phong": PhongKernel,
+    "rtpy.materials.blinn_phong.BlinnPhong": BlinnPhongKernel,
+    "rtpy.materials.cook_torrance.CookTorrance": cook_torrance_kernel,
+    "rtpy.materials.ward.Ward": WardKernel,
+    "rtpy.materials.oren_nayar.OrenNayar": OrenNayarKernel,
 }
 
 
+def class_name(cls: type) -> str:
+    """A class's qualified name, "module.Class": what KERNELS is keyed by."""
+    return f"{cls.__module__}.{cls.__qualname__}"
+
+
 def kernel_class(material: Material) -> type[Kernel]:
-    """The kernel for `material`: the one registered under the `kernel` name its own
-    class sets (a subclass may override anything, so it gets the scalar fallback), and
-    the fallback for anything unusual."""
-    name = type(material).__dict__.get("kernel")
-    choose = KERNELS.get(name) if isinstance(name, str) else None
+    """The kernel for `material`: the one registered for its own class (a subclass
+    may override anything, so it gets the scalar fallback), and the fallback for
+    anything unusual."""
+    choose = KERNELS.get(class_name(type(material)))
     if choose is None:
         return ScalarFallback
     kernel = choose if isinstance(choose, type) else choose(material)

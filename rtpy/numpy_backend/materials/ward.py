@@ -2,24 +2,39 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
 
 from ...materials import Ward
-from ...materials.microfacet import cos_sin_of_tan2
-from ...materials.ward import (
-    MAX_EXPONENT,
-    half_vector_density,
-    half_vector_tan2,
-    highlight_lobe,
-    squared_slopes,
-)
+from ...materials.ward import MAX_EXPONENT, MIN_COS_PRODUCT, squared_slopes
 from ..onb import ONB
 from ..sampling import cos_sin_2pi
 from ..vec3 import Columns, dot, halfvector, reflect
+from .cook_torrance import cos_sin_of_tan2
 from .glossy import GlossyKernel, reflected_density
 from .material import Bounce, param
+
+# The formulas of rtpy/materials/ward.py that call math's functions, on arrays: the
+# same operations in the same order, with numpy's.
+
+
+def half_vector_tan2(r1, cos_phi, sin_phi, ax, ay) -> np.ndarray:
+    """ward.half_vector_tan2: -ln(1 - r1) / (cos^2 / alpha_x^2 + sin^2 / alpha_y^2)."""
+    a = cos_phi * cos_phi / (ax * ax) + sin_phi * sin_phi / (ay * ay)
+    return -np.log1p(-r1) / a
+
+
+def highlight_lobe(exponent, cos_i, cos_o, ax, ay) -> np.ndarray:
+    """ward.highlight_lobe: exp(-exponent) / (4 pi alpha_x alpha_y sqrt(cos_i cos_o))."""
+    root = np.sqrt(np.maximum(cos_i * cos_o, MIN_COS_PRODUCT))
+    return np.exp(-exponent) / (4.0 * math.pi * ax * ay * root)
+
+
+def half_vector_density(exponent, cos, ax, ay) -> np.ndarray:
+    """ward.half_vector_density: exp(-exponent) / (pi alpha_x alpha_y cos^3)."""
+    return np.exp(-exponent) / (math.pi * ax * ay * cos**3)
 
 
 class WardKernel(GlossyKernel):
@@ -49,8 +64,8 @@ class WardKernel(GlossyKernel):
         cos_angle, sin_angle = cos_sin_2pi(r2)
         phi = np.arctan2(ay * sin_angle, ax * cos_angle)
         cos_phi, sin_phi = np.cos(phi), np.sin(phi)
-        tan2 = half_vector_tan2(r1, cos_phi, sin_phi, ax, ay, log1p=np.log1p)
-        cos, sin = cos_sin_of_tan2(tan2, sqrt=np.sqrt)
+        tan2 = half_vector_tan2(r1, cos_phi, sin_phi, ax, ay)
+        cos, sin = cos_sin_of_tan2(tan2)
         return sin * cos_phi, sin * sin_phi, cos
 
     def half_vector_pdf(self, ax, ay, frame: ONB, h: Columns) -> np.ndarray:
@@ -59,7 +74,7 @@ class WardKernel(GlossyKernel):
         exponent = self.slope_exponent(ax, ay, frame, h)
         ok = (cos > 0.0) & ~(exponent > MAX_EXPONENT)
         cos = np.where(ok, cos, 1.0)
-        p = half_vector_density(np.where(ok, exponent, 0.0), cos, ax, ay, exp=np.exp)
+        p = half_vector_density(np.where(ok, exponent, 0.0), cos, ax, ay)
         return np.where(ok, p, 0.0)
 
     def highlight(self, b: Bounce) -> np.ndarray:
@@ -71,9 +86,7 @@ class WardKernel(GlossyKernel):
         exponent = self.slope_exponent(ax, ay, b.frame, h)
         lit = (self.ks[b.slots] > 0.0) & (exponent <= MAX_EXPONENT)
         exponent = np.where(lit, exponent, 0.0)
-        lobe = highlight_lobe(
-            exponent, b.cos_i, b.cos_o, ax, ay, exp=np.exp, sqrt=np.sqrt, maximum=np.maximum
-        )
+        lobe = highlight_lobe(exponent, b.cos_i, b.cos_o, ax, ay)
         return np.where(lit, self.ks[b.slots] * lobe, 0.0)
 
     def highlight_pdf(self, b: Bounce) -> np.ndarray:

@@ -8,7 +8,7 @@ import pytest
 
 from rtpy.materials import Phong
 from rtpy.materials.phong import sample_cosine_power as scalar_cosine_power
-from rtpy.numpy_backend.materials import KERNELS, MaterialTable
+from rtpy.numpy_backend.materials import KERNELS, MaterialTable, class_name
 from rtpy.numpy_backend.materials.phong import PhongKernel, sample_cosine_power
 from rtpy.numpy_backend.onb import ONB
 from rtpy.testing import chi2_test
@@ -97,7 +97,7 @@ class PhongAroundTheNormal(PhongKernel):
 
 def test_sampling_checks_catch_a_wrong_sampler(monkeypatch):
     material = Phong(Color(0.2, 0.2, 0.2), kd=0.2, ks=0.8, exponent=10.0)
-    monkeypatch.setitem(KERNELS, Phong.kernel, PhongWithWrongSampler)
+    monkeypatch.setitem(KERNELS, class_name(Phong), PhongWithWrongSampler)
     batched = batched_samples(material, 70.0, 30_000, seed=1)
     assert not chi2_test(material, 70.0, samples=batched).passed(CHI2_ALPHA)
     with pytest.raises(AssertionError, match="absorbed fraction|albedo"):
