@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..bvh import Tree
+from ..engine.user_files import load_npy, read_text
 from ..mesh import Mesh, Transform
 from .obj import mesh_from_obj
 from .ply import mesh_from_ply
@@ -80,19 +81,51 @@ def _key(path: Path, transform: Transform) -> str:
 
 
 def _read(entry: Path, material) -> tuple[Mesh, int] | None:
+    """The entry's mesh and face count; None when it is missing or damaged (an array
+    file emptied or with a header that lies, metadata of another shape), read through
+    rtpy.engine.user_files so that nothing it declares is allocated unchecked."""
     try:
-        meta = json.loads((entry / "meta.json").read_text())
-        arrays = {name: np.load(entry / f"{name}.npy") for name in ARRAYS + TREE}
-    except (OSError, ValueError):
+        meta = json.loads(read_text(entry / "meta.json", limit=1 << 16))
+        faces, skipped = meta["faces"], meta["skipped"]
+        arrays = {name: load_npy(entry / f"{name}.npy") for name in ARRAYS + TREE}
+    except (OSError, ValueError, KeyError, TypeError):
         return None  # removed or damaged meanwhile: built again
+    if not (type(faces) is int and type(skipped) is int and _consistent(arrays)):
+        return None
     mesh = Mesh.from_arrays(
         material,
         *(arrays[name] for name in ARRAYS),
         Tree(*(arrays[name] for name in TREE)),
-        meta["skipped"],
+        skipped,
     )
     os.utime(entry / "meta.json")  # used: the last to go when the cache is pruned
-    return mesh, meta["faces"]
+    return mesh, faces
+
+
+def _consistent(a: dict[str, np.ndarray]) -> bool:
+    """The arrays have the shapes and kinds _write saves, and index one another within
+    bounds (a damaged entry that still reads as arrays is built again too)."""
+    shapes = {"vertices": 3, "normals": 3, "faces": 3, "face_normals": 3, "lo": 3, "hi": 3}
+    for name, array in a.items():
+        width = shapes.get(name)
+        if array.ndim != (1 if width is None else 2) or (width and array.shape[1] != width):
+            return False
+        if name not in ("vertices", "normals", "lo", "hi") and array.dtype.kind not in "iu":
+            return False
+    nodes, faces = len(a["count"]), len(a["faces"])
+    if not (nodes and all(len(a[n]) == nodes for n in ("lo", "hi", "child", "axis"))):
+        return False
+    return (
+        len(a["face_normals"]) == faces
+        and len(a["order"]) == faces
+        and _within(a["faces"], len(a["vertices"]))
+        and _within(a["face_normals"], len(a["normals"]), lowest=-1)
+        and _within(a["order"], faces)
+    )
+
+
+def _within(indices: np.ndarray, count: int, lowest: int = 0) -> bool:
+    return not indices.size or (int(indices.min()) >= lowest and int(indices.max()) < count)
 
 
 def _write(entry: Path, mesh: Mesh, faces: int) -> None:

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..engine.user_files import read_bytes
 from ..mesh import Mesh, Transform
 
 __all__ = ["ObjError", "ObjMesh", "mesh_from_obj", "parse_obj", "read_obj"]
@@ -160,9 +161,9 @@ def parse_obj(text: str) -> ObjMesh:
 
 
 def read_obj(path: str | Path) -> ObjMesh:
-    """The mesh in an OBJ file (UTF-8 or ASCII). OSError when it cannot be read,
-    ObjError when its text cannot."""
-    raw = Path(path).read_bytes()
+    """The mesh in an OBJ file (UTF-8 or ASCII). OSError when it cannot be read (a
+    FIFO or a device is refused: rtpy.engine.user_files), ObjError when its text cannot."""
+    raw = read_bytes(path)
     if not raw.isascii():
         try:
             raw.decode("utf-8")
