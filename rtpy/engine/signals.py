@@ -33,6 +33,7 @@ EXIT_STATUS = EXIT_SIGNALLED  # 130 after SIGINT, 143 after SIGTERM
 NOTHING_WRITTEN = "interrupted: nothing was written"
 
 _received: list[int] = []  # the signals received, in order
+_finishing = False  # the command's work is done: what is left finishes it (finish_from_here)
 
 
 def received() -> int | None:
@@ -76,12 +77,38 @@ def stop_on_signals() -> Iterator[None]:
     """Within: the first SIGINT or SIGTERM raises KeyboardInterrupt (at once if one was
     recorded while starting), a second one ends the process at once (`end_now`). The
     previous handlers are restored after."""
+    global _finishing
     if signal.getsignal(signal.SIGINT) not in (_record, _raise):
         _received.clear()  # a new command in this process
-    with _handled_by(_raise):
-        if _received:
-            raise KeyboardInterrupt  # received while starting
-        yield
+    _finishing = False
+    try:
+        with _handled_by(_raise):
+            if _received:
+                raise KeyboardInterrupt  # received while starting
+            yield
+    finally:
+        _finishing = False
+
+
+def finish_from_here() -> None:
+    """From now until `stop_on_signals` ends, a first signal is recorded, not raised:
+    the work is done (the last pass of a render is in, or it stopped) and what is
+    left finishes it: ending the workers, writing the image. The command then ends
+    with the signal's status; a second signal ends the process at once. One store,
+    so no signal can come in the middle of it; outside rtpy's handlers it does
+    nothing (a program that imports rtpy keeps its own)."""
+    global _finishing
+    _finishing = True
+
+
+def start_work() -> None:
+    """The start of work a first signal stops (a render), after `finish_from_here`
+    (a command that renders again, such as bench): signals raise again, and one
+    recorded while the last work finished stops this one now."""
+    global _finishing
+    was_finishing, _finishing = _finishing, False
+    if was_finishing and _received and signal.getsignal(signal.SIGINT) is _raise:
+        raise KeyboardInterrupt
 
 
 @contextmanager
@@ -167,7 +194,8 @@ def _record(signum: int, frame) -> None:
 
 def _raise(signum: int, frame) -> None:
     _record(signum, frame)
-    raise KeyboardInterrupt
+    if not _finishing:
+        raise KeyboardInterrupt
 
 
 def end_now() -> None:
