@@ -180,6 +180,12 @@ def add_render_parser(sub) -> None:
         help="render on Dask distributed: a scheduler's tcp://host:8786, or local "
         "(a local cluster of -j workers); pip install 'rtpy[cluster]'",
     )
+    r.add_argument(
+        "--cluster-timeout",
+        type=seconds,
+        metavar="SECONDS",
+        help="how long to try to reach the --cluster scheduler (default 5)",
+    )
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     r.add_argument(
         "--plugin",
@@ -273,6 +279,7 @@ def prepare(args: argparse.Namespace, scene, path: Path, given: dict, preview, s
             preview=write_preview if preview is not None else None,
             preview_seconds=args.preview_seconds,
             cluster=args.cluster,
+            cluster_timeout=args.cluster_timeout,
             checkpoint=state,
             resume=args.resume,
             **{key: value for key, (_, value) in given.items()},

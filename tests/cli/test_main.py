@@ -863,3 +863,31 @@ def test_a_cluster_without_dask_says_how_to_install_it(tmp_path, capsys, monkeyp
         err
         == "rtpy: error: --cluster local: needs Dask distributed (pip install 'rtpy[cluster]')\n"
     )
+
+
+@pytest.mark.parametrize(
+    "address", ["tcp://127.0.0.1", "tcp://:8786", "tcp://h:x", "ws://h:8786", "tcp://h:1:2"]
+)
+def test_a_malformed_cluster_address_is_one_line_and_exit_2(tmp_path, capsys, address):
+    pytest.importorskip("distributed")
+    status = main(["render", "cornell", *SMALL, "-o", str(tmp_path / "x.png"), "--cluster", address])
+    err = capsys.readouterr().err
+    assert status == 2 and err.startswith(f"rtpy: error: --cluster {address}: expected"), err
+    assert len(err.splitlines()) == 1 and list(tmp_path.iterdir()) == []
+
+
+def test_the_cluster_timeout_option_reaches_the_connection(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    import socket
+
+    with socket.socket() as s:  # a port of 127.0.0.1 where nothing listens
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    argv = ["render", "cornell", *SMALL, "-o", str(tmp_path / "x.png")]
+    status = main([*argv, "--cluster", f"tcp://127.0.0.1:{port}", "--cluster-timeout", "1"])
+    err = capsys.readouterr().err
+    assert status == 1 and "cannot reach the Dask scheduler" in err and "within 1 s" in err, err
+    assert len(err.splitlines()) == 1 and list(tmp_path.iterdir()) == []
+    with pytest.raises(SystemExit) as caught:  # argparse: seconds above 0
+        main([*argv, "--cluster", "local", "--cluster-timeout", "0"])
+    assert caught.value.code == 2
