@@ -56,9 +56,24 @@ class ResumeError(ValueError):
     """A saved render that cannot be continued: the message says why, in one line."""
 
 
+STATE_SUFFIX = ".resume.npz"
+NAME_MAX = 255  # bytes in a file's name, on the usual file systems
+
+
 def state_path(output: StrPath) -> Path:
-    """Where the command line keeps the state of a render to `output`: beside it."""
-    return Path(f"{os.fspath(output)}.resume.npz")
+    """Where the command line keeps the state of a render to `output`: beside it,
+    OUT.png.resume.npz; for a name too long for that (a legal name of up to NAME_MAX
+    bytes), its first bytes and a digest of the whole, so that it fits and is the
+    same for the same output."""
+    output = Path(output)
+    name = output.name + STATE_SUFFIX
+    if len(os.fsencode(name)) <= NAME_MAX:
+        return output.with_name(name)
+    digest = "." + hashlib.sha256(os.fsencode(output.name)).hexdigest()[:16]
+    keep = output.name
+    while len(os.fsencode(keep + digest + STATE_SUFFIX)) > NAME_MAX:
+        keep = keep[:-1]
+    return output.with_name(keep + digest + STATE_SUFFIX)
 
 
 class Checkpoint:

@@ -891,3 +891,21 @@ def test_the_cluster_timeout_option_reaches_the_connection(tmp_path, capsys):
     with pytest.raises(SystemExit) as caught:  # argparse: seconds above 0
         main([*argv, "--cluster", "local", "--cluster-timeout", "0"])
     assert caught.value.code == 2
+
+
+@pytest.mark.parametrize("gamma", ["1e-5", "5e-324"])
+def test_a_tiny_gamma_writes_the_image_and_its_previews(tmp_path, capsys, gamma):
+    out, preview = tmp_path / "x.png", tmp_path / "p.png"
+    argv = ["render", "cornell", *SMALL, "--spp", "4", "-o", str(out), "--set", f"gamma={gamma}"]
+    status = main([*argv, "--preview", str(preview), "--preview-seconds", "0"])
+    err = capsys.readouterr().err
+    assert status == 0 and "Traceback" not in err, err
+    assert Image.open(out).size[0] == 16 and Image.open(preview).size[0] == 16
+
+
+def test_an_output_name_of_255_characters_is_written(tmp_path, capsys):
+    out = tmp_path / ("o" * 251 + ".png")
+    status = main(["render", "cornell", *SMALL, "-o", str(out)])
+    err = capsys.readouterr().err
+    assert status == 0 and "Traceback" not in err, err
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]

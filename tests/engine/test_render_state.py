@@ -256,6 +256,22 @@ def test_the_command_line_keeps_the_state_beside_the_output(tmp_path):
     assert state_path(tmp_path / "out.png") == tmp_path / "out.png.resume.npz"
 
 
+@pytest.mark.parametrize("letter", ["a", "é"])
+def test_the_state_of_an_output_with_the_longest_name_fits_and_stays_apart(tmp_path, letter):
+    """A name of 255 bytes is legal; its state's name is cut and given a digest of
+    the whole name, so it fits, and two outputs that differ only at the end keep
+    their states apart."""
+    stem = letter * ((251 - 1) // len(letter.encode()))
+    first, second = (tmp_path / f"{stem}{end}.png" for end in "xy")
+    assert len(first.name.encode()) <= 255
+    states = [state_path(first), state_path(second)]
+    assert states[0] == state_path(first) and states[0] != states[1]
+    for state in states:
+        assert state.parent == tmp_path and state.name.endswith(".resume.npz")
+        assert len(state.name.encode()) <= 255 and state.name.startswith(stem[:100])
+        state.write_bytes(b"")  # the file system takes the name
+
+
 def scene_digest(tmp_path, scene: Scene) -> str:
     """The digest of `scene` a checkpoint keys its state with."""
     _, camera = small_scene()
