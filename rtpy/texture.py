@@ -79,7 +79,11 @@ class ImageTexture(Texture):
         from PIL import Image
 
         with Image.open(path) as im:
-            data = np.asarray(im.convert("RGB"), dtype=np.float64) / 255.0
+            if im.mode.startswith("I"):  # 16-bit greyscale: 0 .. 65535 (convert would clip)
+                grey = np.clip(np.asarray(im, dtype=np.float64) / 65535.0, 0.0, 1.0)
+                data = np.stack([grey, grey, grey], axis=2)
+            else:
+                data = np.asarray(im.convert("RGB"), dtype=np.float64) / 255.0
         return cls(srgb_to_linear(data))
 
     def value(self, hit: HitInfo) -> Color:

@@ -126,7 +126,10 @@ def parse_obj(text: str) -> ObjMesh:
     """The mesh in the text of an OBJ file; ObjError on a line it cannot read."""
     obj = _Lists()
     n_texcoords = 0
-    for number, raw in enumerate(text.splitlines(), start=1):
+    # Lines end at \n, \r\n or \r only: str.splitlines would also end them at a form
+    # feed or a vertical tab, which a comment may hold.
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    for number, raw in enumerate(lines, start=1):
         words = raw.split("#", 1)[0].split()
         if not words:
             continue
