@@ -69,6 +69,7 @@ __all__ = [
     "integer",
     "is_number",
     "num_text",
+    "one_line",
     "number",
     "point",
     "scales",
@@ -88,6 +89,14 @@ class Invalid(Exception):
         self.detail = detail
         self.suggestion = suggestion
         self.wrong_type = wrong_type
+
+
+def one_line(text: str) -> str:
+    """text as one line of a message: line breaks, tabs and other characters that do
+    not print written as Python escapes them ("a\\nb"), the rest as it is."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def suggest(word: str, choices: Iterable[str]) -> str | None:

@@ -390,3 +390,16 @@ def test_render_refuses_arguments_of_the_wrong_type():
         rtpy.render("cornell")
     with pytest.raises(TypeError, match=r"^objects\[0\]: "):
         Scene([(0, 0, -1)])
+
+
+@pytest.mark.parametrize(
+    "text, shown",
+    [
+        ("plain text, é and 'quotes'", "plain text, é and 'quotes'"),
+        ("two\nlines", "two\\nlines"),
+        ("a\r\nb\tc", "a\\r\\nb\\tc"),
+        ("nul \x00 and \u2028", "nul \\x00 and \\u2028"),
+    ],
+)
+def test_one_line_escapes_what_would_break_or_hide_a_message_line(text, shown):
+    assert checks.one_line(text) == shown and len(checks.one_line(text).splitlines()) == 1

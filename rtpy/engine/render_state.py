@@ -37,7 +37,7 @@ import numpy as np
 from ..bvh import Tree
 from .files import StrPath, atomic_write
 from .plugins import PLUGINS
-from .user_files import read_arrays
+from .user_files import read_arrays, read_bytes
 from .version import version
 
 if TYPE_CHECKING:
@@ -225,5 +225,5 @@ def _digest(backend: Backend) -> str:
         ) from None
     for name, path in PLUGINS.items():
         hasher.write(name.encode())
-        hasher.write(Path(path).read_bytes())
+        hasher.write(read_bytes(path))
     return hasher.sha.hexdigest()

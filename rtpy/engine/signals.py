@@ -51,7 +51,10 @@ def stopped(what: str) -> int:
     """The end of a command a signal stopped: remove the temporary files of writes it
     cut short, say on stderr what happened (`what`), return the exit status."""
     _remove_temporary_files()
-    print(f"rtpy: {what}", file=sys.stderr)
+    # rtpy._checks.one_line (a path with a line break stays on one line) when it is
+    # imported whole: this may run after an import a signal cut short.
+    one_line = getattr(sys.modules.get("rtpy._checks"), "one_line", str)
+    print(f"rtpy: {one_line(what)}", file=sys.stderr)
     return exit_status()
 
 

@@ -41,9 +41,11 @@ from .._checks import (
     UNIT,
     VFOV,
     describe,
+    one_line,
     suggest,
 )
 from ..camera import Camera
+from ..engine.plugins import plugin_failure
 from ..light import PointLight
 from ..materials import MATERIALS
 from ..materials.ranges import MATERIAL_RANGES
@@ -265,7 +267,9 @@ class _Loader(TableReader):
         try:
             return cls(**kwargs)
         except (ValueError, TypeError, ArithmeticError) as e:
-            raise self.fail(w, *_blame(str(e), params)) from None
+            raise self.fail(w, *_blame(one_line(str(e)), params)) from None
+        except (Exception, SystemExit) as e:  # a plugin's constructor, whatever it raises
+            raise self.fail(w, "type", f'the "{kind}" constructor failed: {plugin_failure(e)}') from None
 
     def material_value(self, w: Where, p: Param, v: Any) -> Any:
         rng = MATERIAL_RANGES.get(p.name, ANY)

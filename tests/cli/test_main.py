@@ -909,3 +909,52 @@ def test_an_output_name_of_255_characters_is_written(tmp_path, capsys):
     err = capsys.readouterr().err
     assert status == 0 and "Traceback" not in err, err
     assert [p.name for p in tmp_path.iterdir()] == [out.name]
+
+
+@pytest.mark.parametrize(
+    "plugin, words",
+    [
+        ("import sys\nsys.exit(0)\n", "it called sys.exit(0)"),
+        ("raise ValueError('one\\ntwo')\n", "ValueError: one\\ntwo"),
+        ("from rtpy.materials import register_material\nregister_material(None)\n", "TypeError"),
+    ],
+)
+def test_a_failing_plugin_is_one_line_exit_2_nothing_written(
+    tmp_path, capsys, material_registry, plugin, words
+):
+    (tmp_path / "student.py").write_text(plugin)
+    out = tmp_path / "o.png"
+    argv = ["render", "cornell", *SMALL, "-o", str(out), "--plugin", str(tmp_path / "student.py")]
+    status = main(argv)
+    err = capsys.readouterr().err
+    assert status == 2 and err.startswith("rtpy: error: --plugin ") and words in err, err
+    assert len(err.splitlines()) == 1 and not out.exists()
+
+
+@pytest.mark.parametrize(
+    "option, value",
+    [
+        ("-o", "no\nsuch/x.png"),
+        ("--linear", "no\nsuch/x.npy"),
+        ("--plugin", "a\nb.py"),
+        ("-o", "x\r.gif"),
+    ],
+)
+def test_a_line_break_in_a_path_is_shown_on_one_line(tmp_path, capsys, monkeypatch, option, value):
+    monkeypatch.chdir(tmp_path)
+    argv = ["render", "cornell", *SMALL, *(["-o", "o.png"] if option != "-o" else [])]
+    status = main([*argv, option, value])
+    err = capsys.readouterr().err
+    assert status == 2 and len(err.splitlines()) == 1, err
+    assert value.replace("\n", "\\n").replace("\r", "\\r") in err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("option", ["-o", "--linear", "--preview"])
+def test_an_empty_output_path_is_refused_for_every_output(tmp_path, capsys, monkeypatch, option):
+    monkeypatch.chdir(tmp_path)
+    argv = ["render", "cornell", *SMALL, *(["-o", "o.png"] if option != "-o" else [])]
+    status = main([*argv, option, ""])
+    err = capsys.readouterr().err
+    assert status == 2 and err.startswith("rtpy: error: cannot write '': no file extension"), err
+    assert list(tmp_path.iterdir()) == []
