@@ -59,6 +59,7 @@ __all__ = [
     "checked",
     "checked_color",
     "checked_edge",
+    "checked_material",
     "checked_number",
     "checked_point",
     "checked_scales",
@@ -388,3 +389,15 @@ def checked_scales(name: str, v: Any) -> Vec3:
 def checked_color(name: str, v: Any, rng: Range = UNIT) -> Color:
     """A Color from a Color or 3 numbers, each in rng (UNIT for reflectances)."""
     return _checked_as(Color, name, triple, v, rng)
+
+
+def checked_material(v: Any) -> Any:
+    """A shape's material: an instance of rtpy.materials.Material (a built-in one or
+    a student's subclass); TypeError naming `material` for anything else (a name, None),
+    which would otherwise fail only when a ray hits the shape."""
+    from .materials.material import Material  # (materials use these checks)
+
+    if not isinstance(v, Material):
+        found = f"the string {v!r}" if isinstance(v, str) else f"{type(v).__name__} {_short(repr(v))}"
+        raise TypeError(f"material: expected a Material such as rtpy.Lambertian(), found {found}")
+    return v
