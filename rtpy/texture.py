@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, BinaryIO
 
 from ._checks import LENGTH, UNIT, checked_color, checked_number
 from .hit_info import HitInfo
@@ -74,7 +74,8 @@ class ImageTexture(Texture):
         self._rows = [[Color(*map(float, px)) for px in row] for row in pixels]
 
     @classmethod
-    def from_file(cls, path: str | Path) -> ImageTexture:
+    def from_file(cls, path: str | Path | BinaryIO) -> ImageTexture:
+        """The texture of a PNG or JPEG file (a path, or a file object open in binary)."""
         import numpy as np
         from PIL import Image
 

@@ -95,7 +95,12 @@ def _read_open(f: BinaryIO, path: StrPath, limit: int | None) -> bytes:
         raise FileTooLargeError(
             errno.EFBIG, f"it has {size} bytes, the most read is {limit}", os.fspath(path)
         )
-    return f.read(size)
+    try:
+        return f.read(size)
+    except MemoryError:  # (the buffer is allocated before anything is read)
+        raise FileTooLargeError(
+            errno.ENOMEM, f"it has {size} bytes, more than the memory free", os.fspath(path)
+        ) from None
 
 
 def read_bytes(path: StrPath, limit: int | None = None) -> bytes:

@@ -88,7 +88,7 @@ def _read(entry: Path, material) -> tuple[Mesh, int] | None:
         meta = json.loads(read_text(entry / "meta.json", limit=1 << 16))
         faces, skipped = meta["faces"], meta["skipped"]
         arrays = {name: load_npy(entry / f"{name}.npy") for name in ARRAYS + TREE}
-    except (OSError, ValueError, KeyError, TypeError):
+    except (OSError, ValueError, KeyError, TypeError, RecursionError):
         return None  # removed or damaged meanwhile: built again
     if not (type(faces) is int and type(skipped) is int and _consistent(arrays)):
         return None
@@ -103,24 +103,33 @@ def _read(entry: Path, material) -> tuple[Mesh, int] | None:
 
 
 def _consistent(a: dict[str, np.ndarray]) -> bool:
-    """The arrays have the shapes and kinds _write saves, and index one another within
-    bounds (a damaged entry that still reads as arrays is built again too)."""
-    shapes = {"vertices": 3, "normals": 3, "faces": 3, "face_normals": 3, "lo": 3, "hi": 3}
+    """The arrays have the shapes and kinds _write saves, finite points, and indices
+    within bounds, the tree's too (a damaged entry that still reads as arrays is built
+    again rather than crash the render)."""
+    points = ("vertices", "normals", "lo", "hi")
     for name, array in a.items():
-        width = shapes.get(name)
-        if array.ndim != (1 if width is None else 2) or (width and array.shape[1] != width):
+        rows = name in points or name in ("faces", "face_normals")
+        if array.ndim != (2 if rows else 1) or (rows and array.shape[1] != 3):
             return False
-        if name not in ("vertices", "normals", "lo", "hi") and array.dtype.kind not in "iu":
+        if name in points and not (array.dtype.kind == "f" and np.isfinite(array).all()):
+            return False
+        if name not in points and array.dtype.kind not in "iu":
             return False
     nodes, faces = len(a["count"]), len(a["faces"])
     if not (nodes and all(len(a[n]) == nodes for n in ("lo", "hi", "child", "axis"))):
         return False
+    child, count = a["child"].astype(np.int64), a["count"].astype(np.int64)
+    inner = count == 0  # children child and child + 1; a leaf: order[child : child + count]
     return (
         len(a["face_normals"]) == faces
         and len(a["order"]) == faces
         and _within(a["faces"], len(a["vertices"]))
         and _within(a["face_normals"], len(a["normals"]), lowest=-1)
         and _within(a["order"], faces)
+        and _within(a["axis"], 3)
+        and _within(child[inner], nodes - 1)
+        and _within(child[~inner], faces + 1)
+        and _within((child + count)[~inner], faces + 1)
     )
 
 

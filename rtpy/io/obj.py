@@ -38,6 +38,9 @@ IGNORED = frozenset(
     + ("trace_obj", "ctech", "stech", "call", "csh")
 )
 
+# The largest mesh file read (OBJ or PLY): a hundred million triangles and more.
+MAX_MESH_BYTES = 4 << 30
+
 # A corner: (position index, normal index or None), both 0-based.
 Corner = tuple[int, int | None]
 
@@ -166,7 +169,7 @@ def parse_obj(text: str) -> ObjMesh:
 def read_obj(path: str | Path) -> ObjMesh:
     """The mesh in an OBJ file (UTF-8 or ASCII). OSError when it cannot be read (a
     FIFO or a device is refused: rtpy.engine.user_files), ObjError when its text cannot."""
-    raw = read_bytes(path)
+    raw = read_bytes(path, MAX_MESH_BYTES)
     if not raw.isascii():
         try:
             raw.decode("utf-8")

@@ -40,7 +40,7 @@ import numpy as np
 from ..engine.user_files import read_bytes
 from ..mesh import Mesh, Transform
 from . import obj_arrays
-from .obj import ObjMesh
+from .obj import MAX_MESH_BYTES, ObjMesh
 
 __all__ = ["PlyError", "mesh_from_ply", "parse_ply", "read_ply"]
 
@@ -86,7 +86,7 @@ class Element:
 def read_ply(path: str | Path) -> ObjMesh:
     """The mesh in a PLY file. OSError when it cannot be read (a FIFO or a device is
     refused: rtpy.engine.user_files), PlyError when its contents cannot."""
-    return parse_ply(read_bytes(path))
+    return parse_ply(read_bytes(path, MAX_MESH_BYTES))
 
 
 def mesh_from_ply(path: str | Path, material, transform: Transform | None = None) -> Mesh:

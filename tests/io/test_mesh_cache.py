@@ -119,6 +119,18 @@ DAMAGES = {
     "faces naming vertices that are not there": lambda entry: np.save(
         entry / "faces.npy", np.load(entry / "faces.npy") + 10**6
     ),
+    "metadata nested deeper than Python recurses": lambda entry: (
+        entry / "meta.json"
+    ).write_text("[" * 20000 + "]" * 20000),
+    "a vertex that is not a number": lambda entry: np.save(
+        entry / "vertices.npy", np.load(entry / "vertices.npy") * np.nan
+    ),
+    "a tree node whose children are not there": lambda entry: np.save(
+        entry / "child.npy", np.load(entry / "child.npy") + 10**6
+    ),
+    "index arrays of floats": lambda entry: np.save(
+        entry / "faces.npy", np.load(entry / "faces.npy").astype(float)
+    ),
     "an array file that is a FIFO": lambda entry: (
         (entry / "lo.npy").unlink(),
         os.mkfifo(entry / "lo.npy"),

@@ -878,3 +878,27 @@ def test_every_key_takes_its_range_and_refuses_the_rest(
 @given(x=extreme_floats(signed=True, zero=True, non_finite=True))
 def test_every_key_over_every_magnitude(key_scene_dir, label, path, key, component, ok, names, x):
     check_key_value(key_scene_dir, path, key, component, ok, names, x)
+
+
+@special_files
+def test_a_scene_or_texture_that_is_a_fifo_is_refused_at_once(tmp_path):
+    os.mkfifo(tmp_path / "pipe.png")
+    err = error_of('[textures.t]\ntype = "image"\npath = "pipe.png"\n', tmp_path / "s.toml")
+    assert err.key == "path" and "FIFO (named pipe), not a regular file" in str(err), str(err)
+    os.mkfifo(tmp_path / "scene.toml")
+    with pytest.raises(SceneError, match="FIFO"):
+        load_scene(tmp_path / "scene.toml")
+
+
+def test_files_beyond_their_limit_are_refused_before_they_are_read(tmp_path, monkeypatch):
+    from rtpy.io import obj, scene_file
+
+    monkeypatch.setattr(obj, "MAX_MESH_BYTES", 100)
+    monkeypatch.setattr("rtpy.io.ply.MAX_MESH_BYTES", 100)
+    for name, text in (("m.obj", TETRA), ("m.ply", TETRA_PLY)):
+        err = mesh_error(tmp_path, text, name=name)
+        assert err.key == "path" and "the most read is 100" in str(err), str(err)
+    monkeypatch.setattr(scene_file, "MAX_TEXTURE_BYTES", 10)
+    Image.new("RGB", (4, 4)).save(tmp_path / "t.png")
+    err = error_of('[textures.t]\ntype = "image"\npath = "t.png"\n', tmp_path / "s.toml")
+    assert err.key == "path" and "the most read is 10" in str(err), str(err)
