@@ -398,6 +398,8 @@ def checked_material(v: Any) -> Any:
     from .materials.material import Material  # (materials use these checks)
 
     if not isinstance(v, Material):
-        found = f"the string {v!r}" if isinstance(v, str) else f"{type(v).__name__} {_short(repr(v))}"
+        found = (
+            f"the string {v!r}" if isinstance(v, str) else f"{type(v).__name__} {_short(repr(v))}"
+        )
         raise TypeError(f"material: expected a Material such as rtpy.Lambertian(), found {found}")
     return v

@@ -414,8 +414,9 @@ def _shapes(material):
         "Sphere": lambda: rtpy.Sphere(o, 0.5, material),
         "Quad": lambda: rtpy.Quad(o, x, y, material),
         "Triangle": lambda: rtpy.Triangle(o, x, y, material),
-        "Mesh": lambda: Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [], [[(0, -1), (1, -1), (2, -1)]],
-                             material),  # fmt: skip
+        "Mesh": lambda: Mesh(
+            [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [], [[(0, -1), (1, -1), (2, -1)]], material
+        ),  # fmt: skip
     }
 
 

@@ -21,11 +21,12 @@ import os
 import stat
 import zipfile
 from pathlib import Path
-from typing import BinaryIO
-
-import numpy as np
+from typing import TYPE_CHECKING, BinaryIO
 
 from .files import StrPath
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = [
     "FileTooLargeError",
@@ -120,6 +121,8 @@ def read_array(f: BinaryIO, size: int, name: str = "array") -> np.ndarray:
     header checked first (a numeric or string dtype, not an object; a shape whose bytes
     are exactly those that follow), so that a damaged header is a ValueError naming
     `name` rather than an allocation of what it declares. EOFError is a ValueError too."""
+    import numpy as np  # (not at import: plugins are read without numpy)
+
     fmt = np.lib.format
     try:
         version = fmt.read_magic(f)

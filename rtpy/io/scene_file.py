@@ -277,7 +277,9 @@ class _Loader(TableReader):
         except (ValueError, TypeError, ArithmeticError) as e:
             raise self.fail(w, *_blame(one_line(str(e)), params)) from None
         except (Exception, SystemExit) as e:  # a plugin's constructor, whatever it raises
-            raise self.fail(w, "type", f'the "{kind}" constructor failed: {plugin_failure(e)}') from None
+            raise self.fail(
+                w, "type", f'the "{kind}" constructor failed: {plugin_failure(e)}'
+            ) from None
 
     def material_value(self, w: Where, p: Param, v: Any) -> Any:
         rng = MATERIAL_RANGES.get(p.name, ANY)

@@ -870,7 +870,9 @@ def test_a_cluster_without_dask_says_how_to_install_it(tmp_path, capsys, monkeyp
 )
 def test_a_malformed_cluster_address_is_one_line_and_exit_2(tmp_path, capsys, address):
     pytest.importorskip("distributed")
-    status = main(["render", "cornell", *SMALL, "-o", str(tmp_path / "x.png"), "--cluster", address])
+    status = main(
+        ["render", "cornell", *SMALL, "-o", str(tmp_path / "x.png"), "--cluster", address]
+    )
     err = capsys.readouterr().err
     assert status == 2 and err.startswith(f"rtpy: error: --cluster {address}: expected"), err
     assert len(err.splitlines()) == 1 and list(tmp_path.iterdir()) == []

@@ -311,7 +311,9 @@ def closed_port() -> int:
 def test_a_scheduler_that_is_not_there_is_one_error_within_the_timeout():
     address = f"tcp://127.0.0.1:{closed_port()}"
     started = time.monotonic()
-    with pytest.raises(WorkerError, match=f"cannot reach the Dask scheduler at {address} within 1 s"):
+    with pytest.raises(
+        WorkerError, match=f"cannot reach the Dask scheduler at {address} within 1 s"
+    ):
         rtpy.render(rtpy.load_scene(SCENE), width=8, spp=1, cluster=address, cluster_timeout=1)
     assert time.monotonic() - started < 5  # Dask's own default is 30 s and more
 

@@ -95,7 +95,10 @@ BAD_PLUGINS = {
         "RuntimeError: first line\\nsecond line",
     ),
     "sys.exit(0) at import": ("import sys\nsys.exit(0)\n", "it called sys.exit(0)"),
-    "sys.exit with a message": ("raise SystemExit('bye\\nnow')\n", "it called sys.exit('bye\\nnow')"),
+    "sys.exit with a message": (
+        "raise SystemExit('bye\\nnow')\n",
+        "it called sys.exit('bye\\nnow')",
+    ),
     "a name that is not a string": (
         "from rtpy.materials import Lambertian, register_material\n"
         "@register_material(3)\nclass A(Lambertian):\n    pass\n",

@@ -295,9 +295,7 @@ class SignallingBar:
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 @pytest.mark.parametrize("moment", ["last unit added", "workers ended"])
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
-def test_a_signal_once_the_last_pass_is_in_returns_the_finished_image(
-    moment, signum, monkeypatch
-):
+def test_a_signal_once_the_last_pass_is_in_returns_the_finished_image(moment, signum, monkeypatch):
     """Under the command line's handlers, a first signal after the last unit's sums
     are in (while the workers are ended) is recorded: the render returns its
     finished image, which the command writes, then exits with the signal's status."""
@@ -306,7 +304,9 @@ def test_a_signal_once_the_last_pass_is_in_returns_the_finished_image(
     expected = rtpy.render(scene, camera=camera, spp=4, seed=1).linear
     executor = SignalledAtTheEnd(signum) if moment == "workers ended" else InProcess()
     settings = RenderSettings(spp=4, seed=1)
-    renderer = Renderer(scene, camera, settings, quiet=moment != "last unit added", executor=executor)
+    renderer = Renderer(
+        scene, camera, settings, quiet=moment != "last unit added", executor=executor
+    )
     monkeypatch.setattr(renderer, "_progress_bar", lambda total, done: SignallingBar(total, signum))
     with signals.stop_on_signals():
         try:

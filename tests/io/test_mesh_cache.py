@@ -119,9 +119,9 @@ DAMAGES = {
     "faces naming vertices that are not there": lambda entry: np.save(
         entry / "faces.npy", np.load(entry / "faces.npy") + 10**6
     ),
-    "metadata nested deeper than Python recurses": lambda entry: (
-        entry / "meta.json"
-    ).write_text("[" * 20000 + "]" * 20000),
+    "metadata nested deeper than Python recurses": lambda entry: (entry / "meta.json").write_text(
+        "[" * 20000 + "]" * 20000
+    ),
     "a vertex that is not a number": lambda entry: np.save(
         entry / "vertices.npy", np.load(entry / "vertices.npy") * np.nan
     ),

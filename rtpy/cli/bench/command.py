@@ -137,7 +137,9 @@ def _options(args: argparse.Namespace) -> dict:
         "spps": _spp_list(args.spp) if args.spp else (QUICK["spp"] if args.quick else DEFAULT_SPP),
         "budget": args.budget,
         "repeats": repeats,
-        "width": _setting("width", _default(args.width, QUICK["width"] if args.quick else 64), "--width"),
+        "width": _setting(
+            "width", _default(args.width, QUICK["width"] if args.quick else 64), "--width"
+        ),
         "workers": args.workers,
         "cache": Path(args.cache) if args.cache else None,
         "reference_spp": min(args.reference_spp, 256) if args.quick else args.reference_spp,
