@@ -380,7 +380,7 @@ def _render(args: argparse.Namespace) -> int:
         )
 
     try:
-        image = renderer.render()
+        image = renderer.render(then_write=True)  # a signal from its end on: written
     except ResumeError as err:
         print(
             f"rtpy: error: --resume: {one_line(str(err))}; render without --resume to start over",

@@ -96,10 +96,16 @@ class Renderer:
             backend = make_backend(backend, scene, camera, settings)
         self.backend = backend
 
-    def render(self) -> RenderedImage:
+    def render(self, *, then_write: bool = False) -> RenderedImage:
         """Render; after Ctrl-C or the time limit, the whole passes finished
-        (image.interrupted is True after Ctrl-C; image.stats["stopped"] says why)."""
-        signals.start_work()
+        (image.interrupted is True after Ctrl-C; image.stats["stopped"] says why).
+
+        Under the command line's signal handlers, a first signal once the loop is
+        over (the last pass in, the workers being ended) is recorded, not raised
+        (rtpy.engine.signals.finish_from_here): then_write=True (the render command,
+        which writes the image next) keeps it so until the command ends; otherwise
+        it is raised as KeyboardInterrupt when the render returns."""
+        signals.raise_again()
         camera, backend = self.camera, self.backend
         spp = 1 if backend.uses_center_ray() else self.settings.spp
         plan = backend.plan(camera.width, camera.height, spp)
@@ -134,7 +140,10 @@ class Renderer:
         if run.stopped:
             run.keep()
         whole = sums.whole_samples()
-        return run.image(sums.mean(), whole, whole, False, seconds, paths=whole * pixels)
+        image = run.image(sums.mean(), whole, whole, False, seconds, paths=whole * pixels)
+        if not then_write:
+            signals.raise_again()
+        return image
 
     def _loop(self, run: _Run, work, bar) -> None:
         """Add the results of `work` until the last pass is in, the time limit is
@@ -155,7 +164,7 @@ class Renderer:
                     run.stopped = "time limit"
                     return
         except KeyboardInterrupt:
-            signals.finish_from_here()
+            signals.finish_from_here(absorbed=sums.done)
             run.stopped = None if sums.done else "interrupted"
 
     def _local(self, units: int) -> Executor:

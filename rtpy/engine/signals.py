@@ -33,7 +33,9 @@ EXIT_STATUS = EXIT_SIGNALLED  # 130 after SIGINT, 143 after SIGTERM
 NOTHING_WRITTEN = "interrupted: nothing was written"
 
 _received: list[int] = []  # the signals received, in order
-_finishing = False  # the command's work is done: what is left finishes it (finish_from_here)
+# While the work is being finished (finish_from_here): how many signals had come
+# when it began; None while a first signal raises.
+_finishing: int | None = None
 
 
 def received() -> int | None:
@@ -83,34 +85,37 @@ def stop_on_signals() -> Iterator[None]:
     global _finishing
     if signal.getsignal(signal.SIGINT) not in (_record, _raise):
         _received.clear()  # a new command in this process
-    _finishing = False
+    _finishing = None
     try:
         with _handled_by(_raise):
             if _received:
                 raise KeyboardInterrupt  # received while starting
             yield
     finally:
-        _finishing = False
+        _finishing = None
 
 
-def finish_from_here() -> None:
-    """From now until `stop_on_signals` ends, a first signal is recorded, not raised:
-    the work is done (the last pass of a render is in, or it stopped) and what is
-    left finishes it: ending the workers, writing the image. The command then ends
-    with the signal's status; a second signal ends the process at once. One store,
-    so no signal can come in the middle of it; outside rtpy's handlers it does
-    nothing (a program that imports rtpy keeps its own)."""
+def finish_from_here(absorbed: bool = False) -> None:
+    """From now on (until `raise_again` or the end of `stop_on_signals`) a first
+    signal is recorded, not raised: the work is done (the last pass of a render is
+    in, or it stopped) and what is left finishes it: ending the workers, writing the
+    image. A second signal ends the process at once. Outside rtpy's handlers it
+    changes nothing (a program that imports rtpy keeps its own). absorbed: the last
+    signal's KeyboardInterrupt came just before and was taken as this finish (the
+    render was done), so `raise_again` counts it as recorded meanwhile."""
     global _finishing
-    _finishing = True
+    if _finishing is None:
+        _finishing = max(0, len(_received) - absorbed)
 
 
-def start_work() -> None:
-    """The start of work a first signal stops (a render), after `finish_from_here`
-    (a command that renders again, such as bench): signals raise again, and one
-    recorded while the last work finished stops this one now."""
+def raise_again() -> None:
+    """Undo `finish_from_here`: signals raise KeyboardInterrupt again, and one
+    recorded meanwhile raises it now (a command that goes on to other work, such as
+    bench's next render, stops as the signal asked)."""
     global _finishing
-    was_finishing, _finishing = _finishing, False
-    if was_finishing and _received and signal.getsignal(signal.SIGINT) is _raise:
+    before, _finishing = _finishing, None
+    recorded = before is not None and len(_received) > before
+    if recorded and signal.getsignal(signal.SIGINT) is _raise:
         raise KeyboardInterrupt
 
 
@@ -197,7 +202,7 @@ def _record(signum: int, frame) -> None:
 
 def _raise(signum: int, frame) -> None:
     _record(signum, frame)
-    if not _finishing:
+    if _finishing is None:
         raise KeyboardInterrupt
 
 

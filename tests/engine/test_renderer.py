@@ -310,7 +310,7 @@ def test_a_signal_once_the_last_pass_is_in_returns_the_finished_image(moment, si
     monkeypatch.setattr(renderer, "_progress_bar", lambda total, done: SignallingBar(total, signum))
     with signals.stop_on_signals():
         try:
-            image = renderer.render()
+            image = renderer.render(then_write=True)
         except KeyboardInterrupt:  # (pytest would take it for the user's, and stop)
             pytest.fail("the finished render was interrupted")
         assert signals.received() == signum
@@ -318,3 +318,23 @@ def test_a_signal_once_the_last_pass_is_in_returns_the_finished_image(moment, si
             renderer.render()
     assert image.stats["stopped"] is None and image.samples_min == 4
     np.testing.assert_array_equal(image.linear, expected)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_a_signal_at_the_end_of_a_render_not_written_next_stops_the_command(monkeypatch):
+    """A command that goes on after a render (bench) stops when it returns: the
+    signal recorded while the workers were ended is raised then. A Ctrl-C that
+    stopped the render is not raised again: its image holds the whole passes."""
+    monkeypatch.setattr(signals, "_received", [])
+    scene, camera = small_scene()
+    settings = RenderSettings(spp=4, seed=1)
+    renderer = Renderer(scene, camera, settings, executor=SignalledAtTheEnd(signal.SIGINT))
+    with signals.stop_on_signals():
+        with pytest.raises(KeyboardInterrupt):
+            renderer.render()
+    monkeypatch.setattr(signals, "_received", [])
+    stopping = InterruptAfter(calls=3000)
+    scene.add_object(stopping)
+    with signals.stop_on_signals():
+        image = Renderer(scene, camera, settings).render()
+    assert image.stats["stopped"] == "interrupted"
