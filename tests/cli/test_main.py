@@ -879,6 +879,8 @@ def test_a_malformed_cluster_address_is_one_line_and_exit_2(tmp_path, capsys, ad
 
 
 def test_the_cluster_timeout_option_reaches_the_connection(tmp_path, capsys):
+    """In a process of its own: Dask's client leaves a thread running in the process
+    that made it (which rtpy.io.forked's tests must not inherit)."""
     pytest.importorskip("distributed")
     import socket
 
@@ -886,10 +888,10 @@ def test_the_cluster_timeout_option_reaches_the_connection(tmp_path, capsys):
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     argv = ["render", "cornell", *SMALL, "-o", str(tmp_path / "x.png")]
-    status = main([*argv, "--cluster", f"tcp://127.0.0.1:{port}", "--cluster-timeout", "1"])
-    err = capsys.readouterr().err
-    assert status == 1 and "cannot reach the Dask scheduler" in err and "within 1 s" in err, err
-    assert len(err.splitlines()) == 1 and list(tmp_path.iterdir()) == []
+    result = run_cli(*argv, "--cluster", f"tcp://127.0.0.1:{port}", "--cluster-timeout", "1")
+    err = result.stderr
+    assert result.returncode == 1 and "cannot reach the Dask scheduler" in err, err
+    assert "within 1 s" in err and len(err.splitlines()) == 1 and list(tmp_path.iterdir()) == []
     with pytest.raises(SystemExit) as caught:  # argparse: seconds above 0
         main([*argv, "--cluster", "local", "--cluster-timeout", "0"])
     assert caught.value.code == 2
