@@ -20,7 +20,7 @@ from pathlib import Path
 from types import ModuleType
 
 from .._checks import one_line
-from .user_files import read_text
+from .user_files import read_bytes
 
 # module name -> the plugin file it was loaded from, in loading order
 PLUGINS: dict[str, str] = {}
@@ -81,11 +81,13 @@ def load_plugin(path: str | Path) -> ModuleType:
         return sys.modules[name]
     resolved = path.resolve()
     try:
-        source = read_text(resolved, MAX_PLUGIN_BYTES)
+        source = _source(resolved)
     except OSError as err:
         raise PluginError(f"{path}: not a .py file ({err.strerror or err})") from None
     except UnicodeDecodeError as err:
         raise PluginError(f"{path}: not UTF-8 text (byte {err.start})") from None
+    except SyntaxError as err:  # a coding declaration Python does not know
+        raise PluginError(f"{path}: {plugin_failure(err)}") from None
     spec = importlib.util.spec_from_file_location(name, resolved)
     module = importlib.util.module_from_spec(spec)
     _run(module, source, str(resolved))
@@ -102,7 +104,13 @@ def load_listed_plugins(plugins: dict[str, str]) -> None:
 def plugin_sources() -> dict[str, tuple[str, str]]:
     """The plugins loaded here, for another machine: module name -> (the file's path
     here, its source)."""
-    return {name: (path, read_text(path, MAX_PLUGIN_BYTES)) for name, path in PLUGINS.items()}
+    return {name: (path, _source(path)) for name, path in PLUGINS.items()}
+
+
+def _source(path: str | Path) -> str:
+    """The text of the plugin file at `path`, decoded as Python decodes a source file
+    (UTF-8, a byte-order mark, a coding declaration), read through user_files."""
+    return importlib.util.decode_source(read_bytes(path, MAX_PLUGIN_BYTES))
 
 
 def load_plugin_source(name: str, source: str, path: str) -> ModuleType:

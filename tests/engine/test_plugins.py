@@ -110,7 +110,7 @@ BAD_PLUGINS = {
         "TypeError: register_material('fn'): expected a subclass of Material, got <function",
     ),
     "an exception without a message": ("raise LookupError\n", "LookupError"),
-    "not UTF-8": (b"x = '\xff'\n", "not UTF-8 text (byte 5)"),
+    "not UTF-8": (b"x = '\xff'\n", "SyntaxError: invalid or missing encoding declaration"),
 }
 
 
@@ -167,3 +167,10 @@ def test_a_material_constructor_that_raises_is_one_line_naming_table_and_key(
     said = str(caught.value)
     assert caught.value.key == "type" and "[materials.m]" in said and "\n" not in said
     assert 'the "raising" constructor failed: RuntimeError: not today\\nor tomorrow' in said
+
+
+def test_a_plugin_is_decoded_as_python_decodes_a_file(tmp_path, clean_plugins):
+    (tmp_path / "bom.py").write_bytes(b"\xef\xbb\xbfX = 1\n")
+    (tmp_path / "latin.py").write_bytes(b"# -*- coding: latin-1 -*-\nX = '\xe9'\n")
+    assert load_plugin(tmp_path / "bom.py").X == 1
+    assert load_plugin(tmp_path / "latin.py").X == "\xe9"
