@@ -59,6 +59,7 @@ __all__ = [
     "checked",
     "checked_color",
     "checked_edge",
+    "checked_material",
     "checked_number",
     "checked_point",
     "checked_scales",
@@ -69,6 +70,7 @@ __all__ = [
     "integer",
     "is_number",
     "num_text",
+    "one_line",
     "number",
     "point",
     "scales",
@@ -88,6 +90,14 @@ class Invalid(Exception):
         self.detail = detail
         self.suggestion = suggestion
         self.wrong_type = wrong_type
+
+
+def one_line(text: str) -> str:
+    """text as one line of a message: line breaks, tabs and other characters that do
+    not print written as Python escapes them ("a\\nb"), the rest as it is."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def suggest(word: str, choices: Iterable[str]) -> str | None:
@@ -379,3 +389,17 @@ def checked_scales(name: str, v: Any) -> Vec3:
 def checked_color(name: str, v: Any, rng: Range = UNIT) -> Color:
     """A Color from a Color or 3 numbers, each in rng (UNIT for reflectances)."""
     return _checked_as(Color, name, triple, v, rng)
+
+
+def checked_material(v: Any) -> Any:
+    """A shape's material: an instance of rtpy.materials.Material (a built-in one or
+    a student's subclass); TypeError naming `material` for anything else (a name, None),
+    which would otherwise fail only when a ray hits the shape."""
+    from .materials.material import Material  # (materials use these checks)
+
+    if not isinstance(v, Material):
+        found = (
+            f"the string {v!r}" if isinstance(v, str) else f"{type(v).__name__} {_short(repr(v))}"
+        )
+        raise TypeError(f"material: expected a Material such as rtpy.Lambertian(), found {found}")
+    return v

@@ -17,6 +17,7 @@ from ._checks import (
     MAX_COORDINATE,
     MIN_AREA,
     checked,
+    checked_material,
     checked_point,
     checked_scales,
     checked_vector,
@@ -179,7 +180,7 @@ class Mesh(Hittable):
         import numpy as np
 
         transform = transform or Transform()
-        self.material = material
+        self.material = checked_material(material)
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
         normals = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
         corners = _corners(triangles, len(positions), len(normals))

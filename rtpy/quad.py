@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._checks import MIN_AREA, checked_edge, checked_point
+from ._checks import MIN_AREA, checked_edge, checked_material, checked_point
 from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import FlatShape
@@ -24,7 +24,7 @@ class Quad(FlatShape):
                 f"quad is degenerate: u and v are parallel (|u x v| = {n_len:.3g} < {MIN_AREA:g})"
             )
         self.q, self.u, self.v = q, u, v
-        self.material = material
+        self.material = checked_material(material)
         self.normal = n / n_len
         self.d = dot(self.normal, q)  # plane: dot(normal, p) = d
         self.w = n / dot(n, n)  # turns a planar vector into (a, b) coordinates

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ._checks import LENGTH, checked_number, checked_point
+from ._checks import LENGTH, checked_material, checked_number, checked_point
 from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import Hittable
@@ -18,7 +18,7 @@ class Sphere(Hittable):
     def __init__(self, center: Vec3, radius: float, material) -> None:
         self.center = checked_point("center", center)
         self.radius = checked_number("radius", radius, LENGTH)
-        self.material = material
+        self.material = checked_material(material)
 
     def hit_t(self, ray: Ray, t_min: float, t_max: float) -> float | None:
         # BEGIN SOLUTION week04: the smallest root t of |o + t d - c|^2 = r^2 inside (t_min, t_max)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, BinaryIO
 
 from ._checks import LENGTH, UNIT, checked_color, checked_number
 from .hit_info import HitInfo
@@ -74,12 +74,17 @@ class ImageTexture(Texture):
         self._rows = [[Color(*map(float, px)) for px in row] for row in pixels]
 
     @classmethod
-    def from_file(cls, path: str | Path) -> ImageTexture:
+    def from_file(cls, path: str | Path | BinaryIO) -> ImageTexture:
+        """The texture of a PNG or JPEG file (a path, or a file object open in binary)."""
         import numpy as np
         from PIL import Image
 
         with Image.open(path) as im:
-            data = np.asarray(im.convert("RGB"), dtype=np.float64) / 255.0
+            if im.mode.startswith("I"):  # 16-bit greyscale: 0 .. 65535 (convert would clip)
+                grey = np.clip(np.asarray(im, dtype=np.float64) / 65535.0, 0.0, 1.0)
+                data = np.stack([grey, grey, grey], axis=2)
+            else:
+                data = np.asarray(im.convert("RGB"), dtype=np.float64) / 255.0
         return cls(srgb_to_linear(data))
 
     def value(self, hit: HitInfo) -> Color:

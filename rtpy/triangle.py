@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ._checks import MIN_AREA, checked_point
+from ._checks import MIN_AREA, checked_material, checked_point
 from .bvh import AABB
 from .hit_info import HitInfo
 from .hittable import FlatShape
@@ -29,6 +29,7 @@ class Triangle(FlatShape):
 
     def __init__(self, a: Vec3, b: Vec3, c: Vec3, material) -> None:
         a, b, c = checked_point("a", a), checked_point("b", b), checked_point("c", c)
+        material = checked_material(material)
         self._place(a, b, c, material)
 
     def _place(self, a: Vec3, b: Vec3, c: Vec3, material) -> None:

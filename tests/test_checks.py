@@ -390,3 +390,41 @@ def test_render_refuses_arguments_of_the_wrong_type():
         rtpy.render("cornell")
     with pytest.raises(TypeError, match=r"^objects\[0\]: "):
         Scene([(0, 0, -1)])
+
+
+@pytest.mark.parametrize(
+    "text, shown",
+    [
+        ("plain text, é and 'quotes'", "plain text, é and 'quotes'"),
+        ("two\nlines", "two\\nlines"),
+        ("a\r\nb\tc", "a\\r\\nb\\tc"),
+        ("nul \x00 and \u2028", "nul \\x00 and \\u2028"),
+    ],
+)
+def test_one_line_escapes_what_would_break_or_hide_a_message_line(text, shown):
+    assert checks.one_line(text) == shown and len(checks.one_line(text).splitlines()) == 1
+
+
+def _shapes(material):
+    """Each of the course's shapes made with `material`."""
+    from rtpy.mesh import Mesh
+
+    o, x, y = rtpy.Vec3(0, 0, 0), rtpy.Vec3(1, 0, 0), rtpy.Vec3(0, 1, 0)
+    return {
+        "Sphere": lambda: rtpy.Sphere(o, 0.5, material),
+        "Quad": lambda: rtpy.Quad(o, x, y, material),
+        "Triangle": lambda: rtpy.Triangle(o, x, y, material),
+        "Mesh": lambda: Mesh(
+            [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [], [[(0, -1), (1, -1), (2, -1)]], material
+        ),  # fmt: skip
+    }
+
+
+@pytest.mark.parametrize("shape", ["Sphere", "Quad", "Triangle", "Mesh"])
+@pytest.mark.parametrize("material", ["lambertian", None, 3, rtpy.Color(0.5, 0.5, 0.5)])
+def test_a_shape_refuses_what_is_not_a_material_naming_material(shape, material):
+    with pytest.raises(TypeError, match=r"^material: expected a Material") as caught:
+        _shapes(material)[shape]()
+    assert "\n" not in str(caught.value)
+    made = _shapes(rtpy.Lambertian())[shape]()
+    assert isinstance(made.material, rtpy.Lambertian)

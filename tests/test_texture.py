@@ -169,3 +169,22 @@ def test_srgb_to_linear_known_points():
     # Monotone.
     xs = np.linspace(0.0, 1.0, 1001)
     assert np.all(np.diff(srgb_to_linear(xs)) > 0)
+
+
+def test_a_16_bit_greyscale_png_reads_its_levels_not_white(tmp_path):
+    """Pillow opens a 16-bit greyscale PNG in mode I;16 (0 .. 65535), which convert
+    to RGB clips at 255: every texel but black would read white."""
+    levels = np.array([[0, 32768, 65535], [1000, 20000, 50000]], dtype=np.uint16)
+    path = tmp_path / "grey16.png"
+    Image.fromarray(levels).save(path)
+    with Image.open(path) as im:
+        assert im.mode.startswith("I")  # the file is what this test is about
+    tex = ImageTexture.from_file(path)
+    for row in range(2):
+        for col in range(3):
+            u, v = (col + 0.5) / 3, 1.0 - (row + 0.5) / 2
+            got = tex.value(hit_at(u=u, v=v)).tolist()
+            level = srgb_to_linear(np.array(levels[row, col] / 65535.0))
+            assert got == pytest.approx([float(level)] * 3, rel=1e-12, abs=1e-15)
+    mid = tex.value(hit_at(u=0.5, v=0.75)).r()
+    assert mid == pytest.approx(0.214, abs=0.002)  # the sRGB mid-grey, in linear

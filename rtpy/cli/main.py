@@ -18,6 +18,7 @@ import warnings
 from importlib.util import find_spec
 from pathlib import Path
 
+from .._checks import one_line
 from ..engine.backends import BACKENDS
 from ..engine.exit_status import EXIT_BAD_INPUT, EXIT_WORKERS_FAILED, EXIT_WRITE_FAILED
 from ..engine.files import OutputError, WriteError
@@ -192,6 +193,12 @@ def add_render_parser(sub) -> None:
         help="render on Dask distributed: a scheduler's tcp://host:8786, or local "
         "(a local cluster of -j workers); pip install 'rtpy[cluster]'",
     )
+    r.add_argument(
+        "--cluster-timeout",
+        type=seconds,
+        metavar="SECONDS",
+        help="how long to try to reach the --cluster scheduler (default 5)",
+    )
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     r.add_argument(
         "--plugin",
@@ -285,6 +292,7 @@ def prepare(args: argparse.Namespace, scene, path: Path, given: dict, preview, s
             preview=write_preview if preview is not None else None,
             preview_seconds=args.preview_seconds,
             cluster=args.cluster,
+            cluster_timeout=args.cluster_timeout,
             checkpoint=state,
             resume=args.resume,
             **{key: value for key, (_, value) in given.items()},
@@ -345,9 +353,9 @@ def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
         check=check_image_path,
     )
     linear = preview = None
-    if args.linear:
+    if args.linear is not None:  # '' is refused as -o '' is
         linear = check_output(args.linear, "--linear", inputs, [output], check_linear_path)
-    if args.preview:
+    if args.preview is not None:
         others = [output] + ([linear] if linear else [])
         preview = check_output(args.preview, "--preview", inputs, others, check_image_path)
     others = [p for p in (output, linear, preview) if p is not None]
@@ -370,13 +378,13 @@ def _render(args: argparse.Namespace) -> int:
             warnings.simplefilter("always", SceneWarning)
             scene = load_scene(path)
         for warning in caught:  # one line each, as errors are
-            print(f"rtpy: warning: {warning.message}", file=sys.stderr)
+            print(f"rtpy: warning: {one_line(str(warning.message))}", file=sys.stderr)
         given = given_settings(args)
         output, linear, preview, state = check_outputs(args, scene, path)
         check_backend(args.backend)
         renderer = prepare(args, scene, path, given, preview, state)
     except (SceneError, OutputError, UsageError) as err:
-        print(f"rtpy: error: {err}", file=sys.stderr)
+        print(f"rtpy: error: {one_line(str(err))}", file=sys.stderr)
         return EXIT_BAD_INPUT
     if state.exists() and not args.resume:
         print(
@@ -384,20 +392,21 @@ def _render(args: argparse.Namespace) -> int:
         )
 
     try:
-        image = renderer.render()
+        image = renderer.render(then_write=True)  # a signal from its end on: written
     except ResumeError as err:
         print(
-            f"rtpy: error: --resume: {err}; render without --resume to start over", file=sys.stderr
+            f"rtpy: error: --resume: {one_line(str(err))}; render without --resume to start over",
+            file=sys.stderr,
         )
         return EXIT_BAD_INPUT
     except WorkerError as err:
         if received() is not None:  # the signal ended the workers too
             raise KeyboardInterrupt from None
-        print(f"rtpy: error: {err}", file=sys.stderr)
+        print(f"rtpy: error: {one_line(str(err))}", file=sys.stderr)
         return EXIT_WORKERS_FAILED
     except WriteError as err:  # a preview, or the render's state
         kept = f"; --resume continues the render ({state})" if renderer.saved else ""
-        print(f"rtpy: error: {err}{kept}", file=sys.stderr)
+        print(f"rtpy: error: {one_line(str(err))}{one_line(kept)}", file=sys.stderr)
         return EXIT_WRITE_FAILED
     return write_outputs(image, [p for p in (output, linear) if p is not None], renderer)
 
@@ -425,7 +434,7 @@ def write_outputs(image, outputs: list[Path], renderer) -> int:
         with finishing():
             written = [write_image(p, image.linear, image.gamma) for p in outputs]
     except WriteError as err:
-        print(f"rtpy: error: {err}", file=sys.stderr)
+        print(f"rtpy: error: {one_line(str(err))}", file=sys.stderr)
         return EXIT_WRITE_FAILED
     files = ", ".join(str(p) for p in written)
     if stopped_by == "interrupted":

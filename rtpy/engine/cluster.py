@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import logging
 import pickle
+import re
 import sys
 import threading
 import time
@@ -43,42 +44,91 @@ if TYPE_CHECKING:
     from .backend import Backend
     from .plan import Unit
 
-__all__ = ["CLUSTER_INSTALL", "DaskCluster", "make_cluster"]
+__all__ = ["CLUSTER_INSTALL", "CLUSTER_TIMEOUT", "DaskCluster", "make_cluster", "scheduler_address"]
 
 CLUSTER_INSTALL = "pip install 'rtpy[cluster]'"
-CONNECT_SECONDS = 30  # to reach a scheduler, and for it to have a worker
+CONNECT_SECONDS = 30  # for a scheduler to have a worker, a local cluster to start
+CLUSTER_TIMEOUT = 5.0  # to reach a scheduler: a lab's network answers in far less
+MAX_CLUSTER_TIMEOUT = 1e6  # as the command line's seconds
+_HOST = re.compile(r"[A-Za-z0-9_.-]+")
+_IPV6 = re.compile(r"[0-9A-Fa-f:.]+(%[A-Za-z0-9_.-]+)?")
 POLL_SECONDS = 0.5  # how often a wait for results looks up (Ctrl-C, the clock)
 
 
-def make_cluster(cluster: object, workers: int = 1) -> DaskCluster:
+def make_cluster(cluster: object, workers: int = 1, timeout: float | None = None) -> DaskCluster:
     """rtpy.render's `cluster`: "local" (a LocalCluster of `workers` processes), a
-    scheduler's address ("tcp://host:8786") or a distributed.Client; ValueError or
-    TypeError naming `cluster` for anything else, or without Dask distributed."""
+    scheduler's address ("tcp://host:8786", checked by scheduler_address before Dask
+    sees it) or a distributed.Client; ValueError or TypeError naming `cluster` for
+    anything else, or without Dask distributed. `timeout`: the seconds to reach a
+    scheduler (rtpy.render's cluster_timeout)."""
+    if isinstance(cluster, str) and cluster != "local":
+        cluster = scheduler_address(cluster)
+    timeout = CLUSTER_TIMEOUT if timeout is None else timeout
+    if isinstance(timeout, bool) or not isinstance(timeout, int | float):
+        raise TypeError(f"cluster_timeout: expected a number of seconds, got {timeout!r}")
+    if not 0.0 < timeout < MAX_CLUSTER_TIMEOUT:
+        raise ValueError(
+            f"cluster_timeout: expected seconds above 0 and below {MAX_CLUSTER_TIMEOUT:g}, "
+            f"got {timeout!r}"
+        )
     try:
         import distributed
     except ImportError:
         raise ValueError(f"cluster: needs Dask distributed ({CLUSTER_INSTALL})") from None
-    if isinstance(cluster, str):
-        if cluster != "local" and "://" not in cluster:
-            raise ValueError(
-                f'cluster: expected "local" or a scheduler\'s address such as '
-                f"tcp://host:8786, got {cluster!r}"
-            )
-    elif not isinstance(cluster, distributed.Client):
+    if not isinstance(cluster, str | distributed.Client):
         raise TypeError(
             f'cluster: expected "local", an address or a distributed.Client, got {cluster!r}'
         )
-    return DaskCluster(cluster, workers)
+    return DaskCluster(cluster, workers, float(timeout))
+
+
+def scheduler_address(text: str) -> str:
+    """A scheduler's address tcp://HOST:PORT (HOST a name, an IPv4 address or an IPv6
+    one in brackets, PORT 1 to 65535) as Dask takes it; ValueError naming `cluster`
+    and saying what is wrong otherwise (Dask's own errors name nothing, or come after
+    its connect timeout)."""
+
+    def bad(why: str) -> ValueError:
+        return ValueError(
+            f'cluster: expected "local" or a scheduler\'s address such as tcp://host:8786, '
+            f"got {text!r}: {why}"
+        )
+
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        raise bad("no tcp:// before the host")
+    if scheme != "tcp":
+        raise bad(f"the scheme is {scheme}://, not tcp://")
+    if rest.startswith("["):  # [IPv6]:PORT
+        host, bracket, port_part = rest[1:].partition("]")
+        if not bracket or not _IPV6.fullmatch(host):
+            raise bad("an IPv6 host is written in brackets: [::1]:8786")
+        port_part = port_part.removeprefix(":") if port_part.startswith(":") else None
+    else:
+        host, colon, port_part = rest.partition(":")
+        port_part = port_part if colon else None
+    if not host:
+        raise bad("the host is empty")
+    if not rest.startswith("[") and not _HOST.fullmatch(host):
+        raise bad(f"{host!r} is not a host name or address")
+    if port_part is None or port_part == "":
+        raise bad("the port is missing")
+    if not (port_part.isascii() and port_part.isdigit()):
+        why = "it has two ports" if ":" in port_part else f"the port {port_part!r} is not a number"
+        raise bad(why)
+    if not 1 <= int(port_part) <= 65535:
+        raise bad(f"the port {int(port_part)} is not from 1 to 65535")
+    return f"tcp://{'[' + host + ']' if rest.startswith('[') else host}:{int(port_part)}"
 
 
 class DaskCluster(Executor):
     """The workers of a Dask cluster: `cluster` is "local", an address or a Client
-    (used as it is, not closed after)."""
+    (used as it is, not closed after); `timeout` the seconds to reach a scheduler."""
 
     name = "dask"
 
-    def __init__(self, cluster: object, workers: int = 1) -> None:
-        self.cluster = cluster
+    def __init__(self, cluster: object, workers: int = 1, timeout: float = CLUSTER_TIMEOUT):
+        self.cluster, self.timeout = cluster, timeout
         self.workers = workers  # the local cluster's processes; a scheduler's threads
 
     def run(
@@ -158,10 +208,12 @@ class DaskCluster(Executor):
             return client, close
         try:
             with signals.held():
-                client = distributed.Client(self.cluster, timeout=CONNECT_SECONDS)
+                client = distributed.Client(self.cluster, timeout=self.timeout)
         except (OSError, TimeoutError) as err:
             raise WorkerError(
-                f"cannot reach the Dask scheduler at {self.cluster}: {err or type(err).__name__}"
+                f"cannot reach the Dask scheduler at {self.cluster} within {self.timeout:g} s "
+                f"({err or type(err).__name__}); is it running? (--cluster-timeout or "
+                f"cluster_timeout waits longer)"
             ) from None
         return client, client.close
 

@@ -65,13 +65,21 @@ def to_8bit(linear: np.ndarray, gamma: Gamma) -> np.ndarray:
     return np.floor(x * 255.0 + 0.5).astype(np.uint8)
 
 
+# A PNG integer is 1 to 2^31 - 1 in a gAMA chunk (0 is invalid).
+PNG_INTEGER_MAX = 2**31 - 1
+
+
 def png_info(gamma: Gamma) -> PngImagePlugin.PngInfo:
     """The PNG chunks that record a display transform: sRGB (rendering intent 0,
-    perceptual) for "srgb", else gAMA, the file's gamma 1 / gamma times 100000."""
+    perceptual) for "srgb", else gAMA, the file's gamma 1 / gamma times 100000, when
+    that is a PNG integer (for a gamma from about 4.7e-5 to 1e5); beyond, no chunk (the
+    pixels are encoded all the same; a viewer assumes its default)."""
     gamma = check_gamma(gamma)
     info = PngImagePlugin.PngInfo()
     if gamma == "srgb":
         info.add(b"sRGB", bytes([0]))
-    else:
-        info.add(b"gAMA", struct.pack(">I", round(100000.0 / gamma)))
+        return info
+    recorded = 100000.0 / gamma  # inf for the smallest gammas
+    if 1.0 <= recorded <= PNG_INTEGER_MAX:
+        info.add(b"gAMA", struct.pack(">I", round(recorded)))
     return info

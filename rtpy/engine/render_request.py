@@ -54,6 +54,9 @@ def render(scene: Scene, **options) -> RenderedImage:
     cluster = "local" (a Dask LocalCluster of `workers` processes), a Dask
     scheduler's address ("tcp://host:8786") or a distributed.Client: the units run
     there (docs/cluster.md; pip install 'rtpy[cluster]'), the same image bit for bit.
+    cluster_timeout = the seconds to reach a scheduler (None: CLUSTER_TIMEOUT, 5, of
+    rtpy.engine.cluster); an address that is not tcp://HOST:PORT is a ValueError
+    naming cluster, before Dask is asked.
     checkpoint = a file where the render keeps its whole passes as it goes and when
     it stops (Ctrl-C, time), removed when it finishes; resume=True continues the
     render kept there (ValueError if it holds another one), bit for bit the image
@@ -81,6 +84,7 @@ def prepare_render(
     preview_seconds: float = 5.0,
     time: float | None = None,
     cluster: object = None,
+    cluster_timeout: float | None = None,
     checkpoint: str | os.PathLike[str] | None = None,
     resume: bool = False,
     **settings,
@@ -114,7 +118,7 @@ def prepare_render(
     if cluster is not None:
         from .cluster import make_cluster
 
-        executor = make_cluster(cluster, workers)
+        executor = make_cluster(cluster, workers, cluster_timeout)
     return Renderer(
         scene,
         camera,

@@ -28,7 +28,6 @@ import hashlib
 import json
 import os
 import pickle
-import zipfile
 from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -38,6 +37,7 @@ import numpy as np
 from ..bvh import Tree
 from .files import StrPath, atomic_write
 from .plugins import PLUGINS
+from .user_files import read_arrays, read_bytes
 from .version import version
 
 if TYPE_CHECKING:
@@ -56,9 +56,24 @@ class ResumeError(ValueError):
     """A saved render that cannot be continued: the message says why, in one line."""
 
 
+STATE_SUFFIX = ".resume.npz"
+NAME_MAX = 255  # bytes in a file's name, on the usual file systems
+
+
 def state_path(output: StrPath) -> Path:
-    """Where the command line keeps the state of a render to `output`: beside it."""
-    return Path(f"{os.fspath(output)}.resume.npz")
+    """Where the command line keeps the state of a render to `output`: beside it,
+    OUT.png.resume.npz; for a name too long for that (a legal name of up to NAME_MAX
+    bytes), its first bytes and a digest of the whole, so that it fits and is the
+    same for the same output."""
+    output = Path(output)
+    name = output.name + STATE_SUFFIX
+    if len(os.fsencode(name)) <= NAME_MAX:
+        return output.with_name(name)
+    digest = "." + hashlib.sha256(os.fsencode(output.name)).hexdigest()[:16]
+    keep = output.name
+    while len(os.fsencode(keep + digest + STATE_SUFFIX)) > NAME_MAX:
+        keep = keep[:-1]
+    return output.with_name(keep + digest + STATE_SUFFIX)
 
 
 class Checkpoint:
@@ -91,12 +106,7 @@ class Checkpoint:
         ResumeError if the file holds another render or none."""
         if not self.path.exists():
             return None
-        try:
-            with np.load(self.path, allow_pickle=False) as data:
-                key, sums = json.loads(str(data["key"])), np.array(data["sums"])
-                rows = np.array(data["current"])
-        except (OSError, ValueError, KeyError, zipfile.BadZipFile, EOFError) as err:
-            raise self._error(f"not a saved render ({type(err).__name__}: {err})") from None
+        key, sums, rows = self._read(plan)
         if not isinstance(key, dict) or key.get("format") != FORMAT:
             raise self._error("not a saved render of this kind (its format differs)")
         if key.get("rtpy") != version():
@@ -108,6 +118,8 @@ class Checkpoint:
         if key.get("scene") != self.scene:
             raise self._error("saved for another scene (the scene, its files or plugins changed)")
         first = key.get("first_row")
+        if rows.ndim != 3:
+            raise self._error(f"its current are {rows.dtype} of {rows.ndim} dimensions, not 3")
         if not (isinstance(first, int) and 0 <= first <= plan.height - len(rows)):
             raise self._error(f"its first row {first!r} does not fit the image")
         current = np.zeros((plan.height, plan.width, 5))
@@ -125,6 +137,20 @@ class Checkpoint:
         if not ((counts == samples).all() and plan.passes_holding(samples) is not None):
             raise self._error("its sample counts are not those of whole passes")
         return sums, current
+
+    def _read(self, plan: Plan) -> tuple[object, np.ndarray, np.ndarray]:
+        """(key, sums, current) as the file holds them, read through
+        rtpy.engine.user_files (a regular file; no array larger than the image's
+        sums, whatever its header declares); ResumeError for anything else."""
+        most = plan.height * plan.width * 5 * 8 + (1 << 20)
+        try:
+            arrays = read_arrays(self.path, ("key", "sums", "current"), most)
+            key = json.loads(str(arrays["key"])) if arrays["key"].ndim == 0 else None
+        except OSError as err:
+            raise self._error(f"cannot be read: {err.strerror or err}") from None
+        except (ValueError, RecursionError) as err:
+            raise self._error(f"not a saved render ({err})") from None
+        return key, arrays["sums"], arrays["current"]
 
     def remove(self) -> None:
         """Delete the file (the render it holds is finished and written)."""
@@ -199,5 +225,5 @@ def _digest(backend: Backend) -> str:
         ) from None
     for name, path in PLUGINS.items():
         hasher.write(name.encode())
-        hasher.write(Path(path).read_bytes())
+        hasher.write(read_bytes(path))
     return hasher.sha.hexdigest()

@@ -96,9 +96,16 @@ class Renderer:
             backend = make_backend(backend, scene, camera, settings)
         self.backend = backend
 
-    def render(self) -> RenderedImage:
+    def render(self, *, then_write: bool = False) -> RenderedImage:
         """Render; after Ctrl-C or the time limit, the whole passes finished
-        (image.interrupted is True after Ctrl-C; image.stats["stopped"] says why)."""
+        (image.interrupted is True after Ctrl-C; image.stats["stopped"] says why).
+
+        Under the command line's signal handlers, a first signal once the loop is
+        over (the last pass in, the workers being ended) is recorded, not raised
+        (rtpy.engine.signals.finish_from_here): then_write=True (the render command,
+        which writes the image next) keeps it so until the command ends; otherwise
+        it is raised as KeyboardInterrupt when the render returns."""
+        signals.raise_again()
         camera, backend = self.camera, self.backend
         spp = 1 if backend.uses_center_ray() else self.settings.spp
         plan = backend.plan(camera.width, camera.height, spp)
@@ -114,32 +121,51 @@ class Renderer:
         units = (unit for unit in plan.units(resumed) if not sums.holds(unit))
         work = executor.run(backend, units, timeout)
         try:
-            for result in work:
-                now = time.perf_counter()
-                if result is not None:
-                    run.add(*result, now)
-                    bar.update(result[0].paths)
-                if sums.done:
-                    break
-                if self.time_limit and now - start >= self.time_limit and sums.passes:
-                    run.stopped = "time limit"
-                    break
-        except KeyboardInterrupt:
-            run.stopped = "interrupted"
+            self._loop(run, work, bar)
         except BaseException:
+            signals.finish_from_here()
             try:
                 run.keep()  # a failure (a worker lost, a bug): what is finished, for --resume
             except Exception:  # the failure, not this, is the error to report
                 pass
             raise
         finally:
+            # The loop is over: a first signal from here on is recorded, not raised, so
+            # that the workers are ended whole (bounded: rtpy.engine.workers) and the
+            # image, finished or stopped, is returned to be written.
+            signals.finish_from_here()
             work.close()  # cancels the units not finished, ends the workers
             bar.close()
         seconds = time.perf_counter() - start
         if run.stopped:
             run.keep()
         whole = sums.whole_samples()
-        return run.image(sums.mean(), whole, whole, False, seconds, paths=whole * pixels)
+        image = run.image(sums.mean(), whole, whole, False, seconds, paths=whole * pixels)
+        if not then_write:
+            signals.raise_again()
+        return image
+
+    def _loop(self, run: _Run, work, bar) -> None:
+        """Add the results of `work` until the last pass is in, the time limit is
+        spent or Ctrl-C (run.stopped says which, None when every pass is in: a
+        signal once the last unit is added stops nothing)."""
+        sums = run.sums
+        try:
+            for result in work:
+                now = time.perf_counter()
+                if result is not None:
+                    run.add(*result, now)
+                    bar.update(result[0].paths)
+                if sums.done:
+                    signals.finish_from_here()
+                    return
+                if self.time_limit and now - run.start >= self.time_limit and sums.passes:
+                    signals.finish_from_here()
+                    run.stopped = "time limit"
+                    return
+        except KeyboardInterrupt:
+            signals.finish_from_here(absorbed=sums.done)
+            run.stopped = None if sums.done else "interrupted"
 
     def _local(self, units: int) -> Executor:
         """This process, or worker processes: no more of them than there are units."""

@@ -33,6 +33,9 @@ EXIT_STATUS = EXIT_SIGNALLED  # 130 after SIGINT, 143 after SIGTERM
 NOTHING_WRITTEN = "interrupted: nothing was written"
 
 _received: list[int] = []  # the signals received, in order
+# While the work is being finished (finish_from_here): how many signals had come
+# when it began; None while a first signal raises.
+_finishing: int | None = None
 
 
 def received() -> int | None:
@@ -50,7 +53,10 @@ def stopped(what: str) -> int:
     """The end of a command a signal stopped: remove the temporary files of writes it
     cut short, say on stderr what happened (`what`), return the exit status."""
     _remove_temporary_files()
-    print(f"rtpy: {what}", file=sys.stderr)
+    # rtpy._checks.one_line (a path with a line break stays on one line) when it is
+    # imported whole: this may run after an import a signal cut short.
+    one_line = getattr(sys.modules.get("rtpy._checks"), "one_line", str)
+    print(f"rtpy: {one_line(what)}", file=sys.stderr)
     return exit_status()
 
 
@@ -76,12 +82,41 @@ def stop_on_signals() -> Iterator[None]:
     """Within: the first SIGINT or SIGTERM raises KeyboardInterrupt (at once if one was
     recorded while starting), a second one ends the process at once (`end_now`). The
     previous handlers are restored after."""
+    global _finishing
     if signal.getsignal(signal.SIGINT) not in (_record, _raise):
         _received.clear()  # a new command in this process
-    with _handled_by(_raise):
-        if _received:
-            raise KeyboardInterrupt  # received while starting
-        yield
+    _finishing = None
+    try:
+        with _handled_by(_raise):
+            if _received:
+                raise KeyboardInterrupt  # received while starting
+            yield
+    finally:
+        _finishing = None
+
+
+def finish_from_here(absorbed: bool = False) -> None:
+    """From now on (until `raise_again` or the end of `stop_on_signals`) a first
+    signal is recorded, not raised: the work is done (the last pass of a render is
+    in, or it stopped) and what is left finishes it: ending the workers, writing the
+    image. A second signal ends the process at once. Outside rtpy's handlers it
+    changes nothing (a program that imports rtpy keeps its own). absorbed: the last
+    signal's KeyboardInterrupt came just before and was taken as this finish (the
+    render was done), so `raise_again` counts it as recorded meanwhile."""
+    global _finishing
+    if _finishing is None:
+        _finishing = max(0, len(_received) - absorbed)
+
+
+def raise_again() -> None:
+    """Undo `finish_from_here`: signals raise KeyboardInterrupt again, and one
+    recorded meanwhile raises it now (a command that goes on to other work, such as
+    bench's next render, stops as the signal asked)."""
+    global _finishing
+    before, _finishing = _finishing, None
+    recorded = before is not None and len(_received) > before
+    if recorded and signal.getsignal(signal.SIGINT) is _raise:
+        raise KeyboardInterrupt
 
 
 @contextmanager
@@ -167,7 +202,8 @@ def _record(signum: int, frame) -> None:
 
 def _raise(signum: int, frame) -> None:
     _record(signum, frame)
-    raise KeyboardInterrupt
+    if _finishing is None:
+        raise KeyboardInterrupt
 
 
 def end_now() -> None:

@@ -37,6 +37,7 @@ from ..engine.files import (  # the file helpers, importable from here too
     extension_error,
     extension_of,
 )
+from ..engine.user_files import read_bytes
 
 __all__ = [
     "EXR_INSTALL",
@@ -191,9 +192,9 @@ def read_pfm(path: StrPath) -> np.ndarray:
 
     Handles both byte orders (by the sign of the scale) and greyscale ``Pf``
     files (replicated to three channels). Raises ``ValueError`` if the file is
-    not a valid PFM.
+    not a valid PFM, OSError if it cannot be read (a FIFO or a device is refused).
     """
-    raw = Path(path).read_bytes()
+    raw = read_bytes(path)  # a regular file (rtpy.engine.user_files)
 
     def bad(what: str) -> ValueError:
         return ValueError(f"'{os.fspath(path)}' is not a valid PFM file: {what}")

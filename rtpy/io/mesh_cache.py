@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..bvh import Tree
+from ..engine.user_files import load_npy, read_text
 from ..mesh import Mesh, Transform
 from .obj import mesh_from_obj
 from .ply import mesh_from_ply
@@ -82,19 +83,60 @@ def _key(path: Path, transform: Transform) -> str:
 
 
 def _read(entry: Path, material) -> tuple[Mesh, int] | None:
+    """The entry's mesh and face count; None when it is missing or damaged (an array
+    file emptied or with a header that lies, metadata of another shape), read through
+    rtpy.engine.user_files so that nothing it declares is allocated unchecked."""
     try:
-        meta = json.loads((entry / "meta.json").read_text())
-        arrays = {name: np.load(entry / f"{name}.npy") for name in ARRAYS + TREE}
-    except (OSError, ValueError):
+        meta = json.loads(read_text(entry / "meta.json", limit=1 << 16))
+        faces, skipped = meta["faces"], meta["skipped"]
+        arrays = {name: load_npy(entry / f"{name}.npy") for name in ARRAYS + TREE}
+    except (OSError, ValueError, KeyError, TypeError, RecursionError):
         return None  # removed or damaged meanwhile: built again
+    if not (type(faces) is int and type(skipped) is int and _consistent(arrays)):
+        return None
     mesh = Mesh.from_arrays(
         material,
         *(arrays[name] for name in ARRAYS),
         Tree(*(arrays[name] for name in TREE)),
-        meta["skipped"],
+        skipped,
     )
     os.utime(entry / "meta.json")  # used: the last to go when the cache is pruned
-    return mesh, meta["faces"]
+    return mesh, faces
+
+
+def _consistent(a: dict[str, np.ndarray]) -> bool:
+    """The arrays have the shapes and kinds _write saves, finite points, and indices
+    within bounds, the tree's too (a damaged entry that still reads as arrays is built
+    again rather than crash the render)."""
+    points = ("vertices", "normals", "lo", "hi")
+    for name, array in a.items():
+        rows = name in points or name in ("faces", "face_normals")
+        if array.ndim != (2 if rows else 1) or (rows and array.shape[1] != 3):
+            return False
+        if name in points and not (array.dtype.kind == "f" and np.isfinite(array).all()):
+            return False
+        if name not in points and array.dtype.kind not in "iu":
+            return False
+    nodes, faces = len(a["count"]), len(a["faces"])
+    if not (nodes and all(len(a[n]) == nodes for n in ("lo", "hi", "child", "axis"))):
+        return False
+    child, count = a["child"].astype(np.int64), a["count"].astype(np.int64)
+    inner = count == 0  # children child and child + 1; a leaf: order[child : child + count]
+    return (
+        len(a["face_normals"]) == faces
+        and len(a["order"]) == faces
+        and _within(a["faces"], len(a["vertices"]))
+        and _within(a["face_normals"], len(a["normals"]), lowest=-1)
+        and _within(a["order"], faces)
+        and _within(a["axis"], 3)
+        and _within(child[inner], nodes - 1)
+        and _within(child[~inner], faces + 1)
+        and _within((child + count)[~inner], faces + 1)
+    )
+
+
+def _within(indices: np.ndarray, count: int, lowest: int = 0) -> bool:
+    return not indices.size or (int(indices.min()) >= lowest and int(indices.max()) < count)
 
 
 def _write(entry: Path, mesh: Mesh, faces: int) -> None:

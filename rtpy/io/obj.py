@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..engine.user_files import read_bytes
 from ..mesh import Mesh, Transform
 
 __all__ = ["ObjError", "ObjMesh", "mesh_from_obj", "parse_obj", "read_obj"]
@@ -36,6 +37,9 @@ IGNORED = frozenset(
     + ("mg", "bevel", "c_interp", "d_interp", "lod", "maplib", "usemap", "shadow_obj")
     + ("trace_obj", "ctech", "stech", "call", "csh")
 )
+
+# The largest mesh file read (OBJ or PLY): a hundred million triangles and more.
+MAX_MESH_BYTES = 4 << 30
 
 # A corner: (position index, normal index or None), both 0-based.
 Corner = tuple[int, int | None]
@@ -125,7 +129,10 @@ def parse_obj(text: str) -> ObjMesh:
     """The mesh in the text of an OBJ file; ObjError on a line it cannot read."""
     obj = _Lists()
     n_texcoords = 0
-    for number, raw in enumerate(text.splitlines(), start=1):
+    # Lines end at \n, \r\n or \r only: str.splitlines would also end them at a form
+    # feed or a vertical tab, which a comment may hold.
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    for number, raw in enumerate(lines, start=1):
         words = raw.split("#", 1)[0].split()
         if not words:
             continue
@@ -160,9 +167,9 @@ def parse_obj(text: str) -> ObjMesh:
 
 
 def read_obj(path: str | Path) -> ObjMesh:
-    """The mesh in an OBJ file (UTF-8 or ASCII). OSError when it cannot be read,
-    ObjError when its text cannot."""
-    raw = Path(path).read_bytes()
+    """The mesh in an OBJ file (UTF-8 or ASCII). OSError when it cannot be read (a
+    FIFO or a device is refused: rtpy.engine.user_files), ObjError when its text cannot."""
+    raw = read_bytes(path, MAX_MESH_BYTES)
     if not raw.isascii():
         try:
             raw.decode("utf-8")

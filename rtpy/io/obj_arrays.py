@@ -38,8 +38,8 @@ for _table in (_FLOAT_CLASSES, _INT_CLASSES):
     for _c in b"\nvntf/":
         _table[_c] = _c
 FLOAT_CLASSES, INT_CLASSES = bytes(_FLOAT_CLASSES), bytes(_INT_CLASSES)
-# Characters that split lines or words in str.splitlines() and str.split() besides
-# " \t\r\n" (obj.py's view of the text): with any of them, obj.py reads the file.
+# Characters that split words in str.split() besides " \t\r\n" (obj.py's view of a
+# line): with any of them, obj.py reads the file.
 SPLITTERS = b"\x0b\x0c\x1c\x1d\x1e\x1f"
 WIDE_SPLITTERS = "\x85\u2028\u2029"
 # The corner forms: their shape after "f", and (numbers per corner, column of the

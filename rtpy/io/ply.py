@@ -37,9 +37,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..engine.user_files import read_bytes
 from ..mesh import Mesh, Transform
 from . import obj_arrays
-from .obj import ObjMesh
+from .obj import MAX_MESH_BYTES, ObjMesh
 
 __all__ = ["PlyError", "mesh_from_ply", "parse_ply", "read_ply"]
 
@@ -83,9 +84,9 @@ class Element:
 
 
 def read_ply(path: str | Path) -> ObjMesh:
-    """The mesh in a PLY file. OSError when it cannot be read, PlyError when its
-    contents cannot."""
-    return parse_ply(Path(path).read_bytes())
+    """The mesh in a PLY file. OSError when it cannot be read (a FIFO or a device is
+    refused: rtpy.engine.user_files), PlyError when its contents cannot."""
+    return parse_ply(read_bytes(path, MAX_MESH_BYTES))
 
 
 def mesh_from_ply(path: str | Path, material, transform: Transform | None = None) -> Mesh:
@@ -386,13 +387,25 @@ def _layout(raw: bytes, pos: int, e: Element, endian: str):
                 (n,) = struct.unpack_from(endian + p.count_type, raw, pos)
             except struct.error:
                 return None
-        if n < 0:
-            return None
+        if n < 0 or n * struct.calcsize(p.type) > len(raw) - pos:
+            return None  # (_Records says where the file ends)
         fields.append((f"{p.name} count", endian + p.count_type))
         fields.append((p.name, endian + p.type, (n,)))
         lists[p.name] = n
         pos += struct.calcsize(p.count_type) + n * struct.calcsize(p.type)
     return np.dtype(fields), lists
+
+
+def _check_finite(array: np.ndarray, names: str, read, elements: list[Element]) -> None:
+    """PlyError naming the first vertex record whose `names` are not all finite."""
+    bad = np.flatnonzero(~np.isfinite(array).all(axis=1))
+    if bad.size:
+        k = int(bad[0])
+        values = " ".join(repr(float(v)) for v in array[k])
+        raise PlyError(
+            f"vertex {k + 1}: expected finite numbers for {names}, found {values}",
+            read.line(elements, "vertex", k),
+        )
 
 
 def _mesh(elements: list[Element], read) -> ObjMesh:
@@ -417,6 +430,8 @@ def _mesh(elements: list[Element], read) -> ObjMesh:
             ],
             1,
         ).reshape(-1, 3)
+    for array, names in ((positions, "x, y, z"), (normals, "nx, ny, nz")):
+        _check_finite(array, names, read, elements)
     face = found.get("face")
     if face is None or face.count == 0:
         return ObjMesh(positions, normals, np.zeros((0, 3, 2), dtype=np.int64))

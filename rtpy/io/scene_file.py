@@ -41,9 +41,12 @@ from .._checks import (
     UNIT,
     VFOV,
     describe,
+    one_line,
     suggest,
 )
 from ..camera import Camera
+from ..engine.plugins import plugin_failure
+from ..engine.user_files import read_bytes
 from ..light import PointLight
 from ..materials import MATERIALS
 from ..materials.ranges import MATERIAL_RANGES
@@ -86,6 +89,8 @@ __all__ = [
 # settings' limits (MAX_SPP, MAX_MAX_DEPTH, MAX_WIDTH) are in rtpy.render_settings.
 MAX_HEIGHT = 16384
 MAX_TEXTURE_PIXELS = 2048 * 2048  # image textures are kept as Python Colors
+MAX_SCENE_BYTES = 64 << 20  # a scene file is text; its meshes are files of their own
+MAX_TEXTURE_BYTES = 256 << 20  # the file: far more than such an image's PNG or JPEG
 
 TOP_LEVEL_TABLES = ("camera", "render", "textures", "materials", "objects", "lights")
 CAMERA_KEYS = (
@@ -230,12 +235,15 @@ class _Loader(TableReader):
             resolved = self.path.parent / rel
             if resolved.is_dir():
                 raise self.fail(w, "path", f"{resolved} is a directory, not an image file")
-            if not resolved.is_file():
+            if not resolved.exists():
                 raise self.fail(w, "path", f"image file not found: {resolved}")
             self.files.append(resolved)
+            import io
+
             from PIL import Image
 
-            with Image.open(resolved) as im:
+            data = read_bytes(resolved, MAX_TEXTURE_BYTES)  # a regular file, bounded
+            with Image.open(io.BytesIO(data)) as im:
                 size = im.size
             if size[0] * size[1] > MAX_TEXTURE_PIXELS:
                 raise self.fail(
@@ -244,9 +252,11 @@ class _Loader(TableReader):
                     f"image {resolved} has {size[0]} x {size[1]} pixels; "
                     f"the most for a texture is {MAX_TEXTURE_PIXELS}",
                 )
-            return ImageTexture.from_file(resolved)
+            return ImageTexture.from_file(io.BytesIO(data))
         except SceneError:
             raise
+        except OSError as e:  # not a regular file, too large
+            raise self.fail(w, "path", f"cannot read image {resolved}: {e.strerror or e}") from None
         except Exception as e:  # PIL raises many kinds for unreadable files
             raise self.fail(w, "path", f"cannot read image {self.path.parent / rel}: {e}") from None
 
@@ -265,7 +275,11 @@ class _Loader(TableReader):
         try:
             return cls(**kwargs)
         except (ValueError, TypeError, ArithmeticError) as e:
-            raise self.fail(w, *_blame(str(e), params)) from None
+            raise self.fail(w, *_blame(one_line(str(e)), params)) from None
+        except (Exception, SystemExit) as e:  # a plugin's constructor, whatever it raises
+            raise self.fail(
+                w, "type", f'the "{kind}" constructor failed: {plugin_failure(e)}'
+            ) from None
 
     def material_value(self, w: Where, p: Param, v: Any) -> Any:
         rng = MATERIAL_RANGES.get(p.name, ANY)
@@ -465,7 +479,7 @@ def load_scene(path: str | Path) -> Scene:
     """A Scene from a scene file (TOML, UTF-8)."""
     path = Path(path)
     try:
-        raw = path.read_bytes()
+        raw = read_bytes(path, MAX_SCENE_BYTES)  # a regular file (a FIFO is not waited on)
     except FileNotFoundError:
         raise SceneError("no such scene file", file=str(path)) from None
     except IsADirectoryError:

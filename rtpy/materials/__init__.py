@@ -53,9 +53,17 @@ MATERIALS: dict[str, type[Material]] = {
 
 def register_material(name: str):
     """Class decorator: make a Material subclass usable as `type = "name"` in scene files.
-    Its constructor's keyword parameters become the keys of [materials.X]."""
+    Its constructor's keyword parameters become the keys of [materials.X]. A name that
+    is not a non-empty string, or a decorated object that is not a Material subclass,
+    is a TypeError at once (not when a scene uses it)."""
+    if not (isinstance(name, str) and name.strip()):
+        raise TypeError(f"register_material: the name must be a non-empty string, got {name!r}")
 
     def decorate(cls: type[Material]) -> type[Material]:
+        if not (isinstance(cls, type) and issubclass(cls, Material)):
+            raise TypeError(
+                f"register_material({name!r}): expected a subclass of Material, got {cls!r}"
+            )
         MATERIALS[name] = cls
         return cls
 

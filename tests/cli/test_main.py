@@ -863,3 +863,102 @@ def test_a_cluster_without_dask_says_how_to_install_it(tmp_path, capsys, monkeyp
         err
         == "rtpy: error: --cluster local: needs Dask distributed (pip install 'rtpy[cluster]')\n"
     )
+
+
+@pytest.mark.parametrize(
+    "address", ["tcp://127.0.0.1", "tcp://:8786", "tcp://h:x", "ws://h:8786", "tcp://h:1:2"]
+)
+def test_a_malformed_cluster_address_is_one_line_and_exit_2(tmp_path, capsys, address):
+    pytest.importorskip("distributed")
+    status = main(
+        ["render", "cornell", *SMALL, "-o", str(tmp_path / "x.png"), "--cluster", address]
+    )
+    err = capsys.readouterr().err
+    assert status == 2 and err.startswith(f"rtpy: error: --cluster {address}: expected"), err
+    assert len(err.splitlines()) == 1 and list(tmp_path.iterdir()) == []
+
+
+def test_the_cluster_timeout_option_reaches_the_connection(tmp_path, capsys):
+    """In a process of its own: Dask's client leaves a thread running in the process
+    that made it (which rtpy.io.forked's tests must not inherit)."""
+    pytest.importorskip("distributed")
+    import socket
+
+    with socket.socket() as s:  # a port of 127.0.0.1 where nothing listens
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    argv = ["render", "cornell", *SMALL, "-o", str(tmp_path / "x.png")]
+    result = run_cli(*argv, "--cluster", f"tcp://127.0.0.1:{port}", "--cluster-timeout", "1")
+    err = result.stderr
+    assert result.returncode == 1 and "cannot reach the Dask scheduler" in err, err
+    assert "within 1 s" in err and len(err.splitlines()) == 1 and list(tmp_path.iterdir()) == []
+    with pytest.raises(SystemExit) as caught:  # argparse: seconds above 0
+        main([*argv, "--cluster", "local", "--cluster-timeout", "0"])
+    assert caught.value.code == 2
+
+
+@pytest.mark.parametrize("gamma", ["1e-5", "5e-324"])
+def test_a_tiny_gamma_writes_the_image_and_its_previews(tmp_path, capsys, gamma):
+    out, preview = tmp_path / "x.png", tmp_path / "p.png"
+    argv = ["render", "cornell", *SMALL, "--spp", "4", "-o", str(out), "--set", f"gamma={gamma}"]
+    status = main([*argv, "--preview", str(preview), "--preview-seconds", "0"])
+    err = capsys.readouterr().err
+    assert status == 0 and "Traceback" not in err, err
+    assert Image.open(out).size[0] == 16 and Image.open(preview).size[0] == 16
+
+
+def test_an_output_name_of_255_characters_is_written(tmp_path, capsys):
+    out = tmp_path / ("o" * 251 + ".png")
+    status = main(["render", "cornell", *SMALL, "-o", str(out)])
+    err = capsys.readouterr().err
+    assert status == 0 and "Traceback" not in err, err
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+
+
+@pytest.mark.parametrize(
+    "plugin, words",
+    [
+        ("import sys\nsys.exit(0)\n", "it called sys.exit(0)"),
+        ("raise ValueError('one\\ntwo')\n", "ValueError: one\\ntwo"),
+        ("from rtpy.materials import register_material\nregister_material(None)\n", "TypeError"),
+    ],
+)
+def test_a_failing_plugin_is_one_line_exit_2_nothing_written(
+    tmp_path, capsys, material_registry, plugin, words
+):
+    (tmp_path / "student.py").write_text(plugin)
+    out = tmp_path / "o.png"
+    argv = ["render", "cornell", *SMALL, "-o", str(out), "--plugin", str(tmp_path / "student.py")]
+    status = main(argv)
+    err = capsys.readouterr().err
+    assert status == 2 and err.startswith("rtpy: error: --plugin ") and words in err, err
+    assert len(err.splitlines()) == 1 and not out.exists()
+
+
+@pytest.mark.parametrize(
+    "option, value",
+    [
+        ("-o", "no\nsuch/x.png"),
+        ("--linear", "no\nsuch/x.npy"),
+        ("--plugin", "a\nb.py"),
+        ("-o", "x\r.gif"),
+    ],
+)
+def test_a_line_break_in_a_path_is_shown_on_one_line(tmp_path, capsys, monkeypatch, option, value):
+    monkeypatch.chdir(tmp_path)
+    argv = ["render", "cornell", *SMALL, *(["-o", "o.png"] if option != "-o" else [])]
+    status = main([*argv, option, value])
+    err = capsys.readouterr().err
+    assert status == 2 and len(err.splitlines()) == 1, err
+    assert value.replace("\n", "\\n").replace("\r", "\\r") in err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("option", ["-o", "--linear", "--preview"])
+def test_an_empty_output_path_is_refused_for_every_output(tmp_path, capsys, monkeypatch, option):
+    monkeypatch.chdir(tmp_path)
+    argv = ["render", "cornell", *SMALL, *(["-o", "o.png"] if option != "-o" else [])]
+    status = main([*argv, option, ""])
+    err = capsys.readouterr().err
+    assert status == 2 and err.startswith("rtpy: error: cannot write '': no file extension"), err
+    assert list(tmp_path.iterdir()) == []

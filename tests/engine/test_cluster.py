@@ -20,12 +20,12 @@ import numpy as np
 import pytest
 
 import rtpy
-from rtpy.engine.cluster import make_cluster
+from rtpy.engine.cluster import CLUSTER_TIMEOUT, make_cluster
 from rtpy.engine.executor import WorkerError
 from rtpy.numpy_backend import renderer as numpy_renderer
 
 from ..cli.test_main import material_registry  # noqa: F401 (a fixture the tests use)
-from ..commands import read_until
+from ..commands import read_until, run_cli
 from .test_signals import child_processes, group_processes
 
 distributed = pytest.importorskip("distributed")
@@ -256,8 +256,74 @@ def test_a_cluster_is_local_an_address_or_a_client():
     assert make_cluster("tcp://127.0.0.1:8786", 3).workers == 3
 
 
+MALFORMED = {
+    "tcp://127.0.0.1": "the port is missing",
+    "tcp://:8786": "the host is empty",
+    "tcp://127.0.0.1:port": "the port 'port' is not a number",
+    "udp://127.0.0.1:8786": "the scheme is udp://, not tcp://",
+    "tcp://127.0.0.1:8786:8787": "it has two ports",
+    "tcp://127.0.0.1:0": "the port 0 is not from 1 to 65535",
+    "tcp://[::1": "an IPv6 host is written in brackets",
+    "tcp://lab 00:8786": "'lab 00' is not a host name or address",
+    "127.0.0.1:8786": "no tcp:// before the host",
+}
+
+
+@pytest.mark.parametrize("address", MALFORMED)
+def test_a_malformed_address_is_a_value_error_naming_cluster_before_dask_sees_it(
+    address, monkeypatch
+):
+    def no_client(*args, **kwargs):
+        raise AssertionError("Dask was asked")
+
+    monkeypatch.setattr(distributed, "Client", no_client)
+    with pytest.raises(ValueError) as caught:
+        rtpy.render(rtpy.load_scene(SCENE), width=8, spp=1, cluster=address)
+    message = str(caught.value)
+    assert message.startswith("cluster: expected") and MALFORMED[address] in message
+    assert repr(address) in message and "\n" not in message
+
+
+def test_addresses_dask_takes_are_kept():
+    for address in ("tcp://lab00:8786", "tcp://10.0.0.2:1", "tcp://[::1]:65535"):
+        assert make_cluster(address).cluster == address
+    assert make_cluster("tcp://127.0.0.1:08786").cluster == "tcp://127.0.0.1:8786"
+
+
+@pytest.mark.parametrize("timeout, error", [(0, ValueError), (-1.0, ValueError),
+                                            (float("nan"), ValueError), ("5", TypeError),
+                                            (True, TypeError)])  # fmt: skip
+def test_the_connect_timeout_is_checked(timeout, error):
+    with pytest.raises(error, match="^cluster_timeout: expected"):
+        make_cluster("tcp://127.0.0.1:8786", 1, timeout)
+    assert make_cluster("tcp://127.0.0.1:8786").timeout == CLUSTER_TIMEOUT <= 10
+
+
+def closed_port() -> int:
+    """A port of 127.0.0.1 where nothing listens (bound a moment, then released)."""
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_a_scheduler_that_is_not_there_is_one_error_within_the_timeout():
+    address = f"tcp://127.0.0.1:{closed_port()}"
+    started = time.monotonic()
+    with pytest.raises(
+        WorkerError, match=f"cannot reach the Dask scheduler at {address} within 1 s"
+    ):
+        rtpy.render(rtpy.load_scene(SCENE), width=8, spp=1, cluster=address, cluster_timeout=1)
+    assert time.monotonic() - started < 5  # Dask's own default is 30 s and more
+
+
 @pytest.mark.slow
-def test_a_scheduler_that_is_not_there_is_one_error(monkeypatch):
-    monkeypatch.setattr("rtpy.engine.cluster.CONNECT_SECONDS", 2)
-    with pytest.raises(WorkerError, match="cannot reach the Dask scheduler at tcp://127.0.0.1:9"):
-        rtpy.render(rtpy.load_scene(SCENE), width=8, spp=1, cluster="tcp://127.0.0.1:9")
+def test_the_default_timeout_answers_a_closed_port_within_10_seconds(tmp_path):
+    address = f"tcp://127.0.0.1:{closed_port()}"
+    started = time.monotonic()
+    result = run_cli("render", SCENE, "--width", "8", "--spp", "1", "-q", "-o",
+                     str(tmp_path / "x.png"), "--cluster", address, timeout=60)  # fmt: skip
+    assert time.monotonic() - started < 10, result.stderr
+    assert result.returncode == 1 and len(result.stderr.splitlines()) == 1, result.stderr
+    assert "cannot reach the Dask scheduler" in result.stderr and list(tmp_path.iterdir()) == []

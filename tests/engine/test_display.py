@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rtpy.engine.display import linear_to_srgb, to_8bit
+from rtpy.engine.display import linear_to_srgb, png_info, to_8bit
 from rtpy.texture import srgb_to_linear
 
 from ..io.test_image import rgb
@@ -111,3 +111,24 @@ def test_to_8bit_srgb() -> None:
 def test_to_8bit_refuses_other_transforms(gamma) -> None:
     with pytest.raises((TypeError, ValueError), match="gamma"):
         to_8bit(rgb([0.5]), gamma)
+
+
+@pytest.mark.parametrize("gamma", [1e-5, 5e-324, 4e-5, 2.2, 1.0, 2e5, 1e300, "srgb"])
+def test_every_gamma_in_range_has_png_chunks_pillow_writes(tmp_path, gamma) -> None:
+    """The gAMA chunk holds 100000 / gamma when that is a PNG integer (1 to 2^31 - 1);
+    a gamma beyond, as tiny as 5e-324 or as large as 1e300, writes no gAMA chunk
+    rather than failing (struct.error, OverflowError) after the render."""
+    from PIL import Image
+
+    path = tmp_path / "x.png"
+    Image.new("RGB", (2, 2)).save(path, pnginfo=png_info(gamma))
+    with Image.open(path) as im:
+        chunks = im.info
+    if gamma == "srgb":
+        assert "srgb" in chunks and "gamma" not in chunks
+        return
+    recorded = 100000.0 / gamma
+    if 1 <= recorded <= 2**31 - 1:
+        assert chunks["gamma"] == pytest.approx(round(recorded) / 100000.0)
+    else:
+        assert "gamma" not in chunks

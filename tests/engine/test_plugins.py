@@ -87,3 +87,90 @@ def test_a_bad_plugin_is_refused_naming_the_file(tmp_path, clean_plugins, name, 
     assert str(err.value).startswith(str(path))
     assert plugin_module_name(path) not in sys.modules
     assert plugin_module_name(path) not in PLUGINS
+
+
+BAD_PLUGINS = {
+    "a message of two lines": (
+        "raise RuntimeError('first line\\nsecond line')\n",
+        "RuntimeError: first line\\nsecond line",
+    ),
+    "sys.exit(0) at import": ("import sys\nsys.exit(0)\n", "it called sys.exit(0)"),
+    "sys.exit with a message": (
+        "raise SystemExit('bye\\nnow')\n",
+        "it called sys.exit('bye\\nnow')",
+    ),
+    "a name that is not a string": (
+        "from rtpy.materials import Lambertian, register_material\n"
+        "@register_material(3)\nclass A(Lambertian):\n    pass\n",
+        "TypeError: register_material: the name must be a non-empty string, got 3",
+    ),
+    "a registered function": (
+        "from rtpy.materials import register_material\n"
+        "@register_material('fn')\ndef make():\n    pass\n",
+        "TypeError: register_material('fn'): expected a subclass of Material, got <function",
+    ),
+    "an exception without a message": ("raise LookupError\n", "LookupError"),
+    "not UTF-8": (b"x = '\xff'\n", "SyntaxError: invalid or missing encoding declaration"),
+}
+
+
+@pytest.mark.parametrize("case", BAD_PLUGINS)
+def test_every_failure_of_a_plugin_is_one_line_naming_the_file(tmp_path, clean_plugins, case):
+    text, message = BAD_PLUGINS[case]
+    path = tmp_path / "bad.py"
+    path.write_bytes(text if isinstance(text, bytes) else text.encode())
+    with pytest.raises(PluginError) as caught:
+        load_plugin(path)
+    said = str(caught.value)
+    assert said.startswith(f"{path}: ") and message in said and "\n" not in said, said
+    assert plugin_module_name(path) not in sys.modules and "fn" not in MATERIALS
+
+
+def test_a_plugin_sent_to_another_machine_fails_the_same_way(clean_plugins):
+    from rtpy.engine.plugins import load_plugin_source
+
+    with pytest.raises(PluginError, match=r"^there\.py: it called sys\.exit\(3\)$"):
+        load_plugin_source("rtpy_plugin_there_0", "import sys\nsys.exit(3)\n", "there.py")
+    assert "rtpy_plugin_there_0" not in sys.modules
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="no FIFOs here")
+def test_a_plugin_path_that_is_a_fifo_is_refused_at_once(tmp_path, clean_plugins):
+    import os
+
+    path = tmp_path / "pipe.py"
+    os.mkfifo(path)
+    with pytest.raises(PluginError, match="not a .py file .*FIFO"):
+        load_plugin(path)
+
+
+def test_a_material_constructor_that_raises_is_one_line_naming_table_and_key(
+    tmp_path, clean_plugins
+):
+    from rtpy.io.scene_file import SceneError, load_scene
+
+    path = tmp_path / "raising.py"
+    path.write_text(
+        "from rtpy.materials import Lambertian, register_material\n"
+        "@register_material('raising')\nclass Raising(Lambertian):\n"
+        "    def __init__(self, level: float = 0.5):\n"
+        "        raise RuntimeError('not today\\nor tomorrow')\n"
+    )
+    load_plugin(path)
+    scene = tmp_path / "s.toml"
+    scene.write_text(
+        '[materials.m]\ntype = "raising"\n[[objects]]\ntype = "sphere"\n'
+        'center = [0, 0, -1]\nradius = 0.5\nmaterial = "m"\n'
+    )
+    with pytest.raises(SceneError) as caught:
+        load_scene(scene)
+    said = str(caught.value)
+    assert caught.value.key == "type" and "[materials.m]" in said and "\n" not in said
+    assert 'the "raising" constructor failed: RuntimeError: not today\\nor tomorrow' in said
+
+
+def test_a_plugin_is_decoded_as_python_decodes_a_file(tmp_path, clean_plugins):
+    (tmp_path / "bom.py").write_bytes(b"\xef\xbb\xbfX = 1\n")
+    (tmp_path / "latin.py").write_bytes(b"# -*- coding: latin-1 -*-\nX = '\xe9'\n")
+    assert load_plugin(tmp_path / "bom.py").X == 1
+    assert load_plugin(tmp_path / "latin.py").X == "\xe9"

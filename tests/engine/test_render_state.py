@@ -173,6 +173,9 @@ def test_another_rtpy_version_is_refused(stopped_state, monkeypatch):
         ("counts", "not those of whole passes"),
         ("negative", "not finite and non-negative"),
         ("rows", "its first row 10000 does not fit"),
+        ("huge", r"not a saved render \(sums: its header declares 8000000000000 bytes"),
+        ("zero-d", "its current are float64 of 0 dimensions, not 3"),
+        ("deep", "not a saved render"),
     ],
 )
 def test_a_file_that_is_not_a_saved_render_is_refused(stopped_state, corrupt, message):
@@ -189,6 +192,10 @@ def test_a_file_that_is_not_a_saved_render_is_refused(stopped_state, corrupt, me
             arrays["sums"][0, 0, 3] += 1
         elif corrupt == "rows":
             key["first_row"] = 10000
+        elif corrupt == "zero-d":
+            arrays["current"] = np.array(0.0)
+        elif corrupt in ("huge", "deep"):
+            return crafted(state, key, corrupt, (scene, camera))
         else:
             arrays["sums"][0, 0, 0] = -1.0
         arrays["key"] = np.array(json.dumps(key))
@@ -196,6 +203,42 @@ def test_a_file_that_is_not_a_saved_render_is_refused(stopped_state, corrupt, me
             np.savez(f, **arrays)
     with pytest.raises(ResumeError, match=message):
         rtpy.render(scene, camera=camera, spp=SPP, seed=1, checkpoint=state, resume=True)
+
+
+def crafted(state, key, how: str, render) -> None:
+    """Write a state whose sums header declares 10^12 numbers ("huge") or whose key
+    is JSON nested a million deep ("deep"), and check it is refused in one line."""
+    import io
+    import zipfile
+
+    header = io.BytesIO()
+    declared = {"descr": "<f8", "fortran_order": False, "shape": (10**6, 10**6)}
+    np.lib.format.write_array_header_1_0(header, declared)
+    text = "[" * 10**6 + "]" * 10**6 if how == "deep" else json.dumps(key)
+    with zipfile.ZipFile(state, "w") as z:
+        for name, array in (("key", np.array(text)), ("current", np.zeros((0, 40, 5)))):
+            member = io.BytesIO()
+            np.save(member, array)
+            z.writestr(f"{name}.npy", member.getvalue())
+        z.writestr("sums.npy", header.getvalue() if how == "huge" else b"")
+    scene, camera = render
+    with pytest.raises(ResumeError) as info:
+        rtpy.render(scene, camera=camera, spp=SPP, seed=1, checkpoint=state, resume=True)
+    message = str(info.value)
+    assert message.startswith(f"{state}: not a saved render") and "\n" not in message, message
+    if how == "huge":
+        assert "declares 8000000000000 bytes" in message
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="no FIFOs here")
+def test_a_state_that_is_a_fifo_is_refused_at_once(tmp_path):
+    import os
+
+    scene, camera = small_scene()
+    state = tmp_path / "s.npz"
+    os.mkfifo(state)  # no writer: a reader that opens it waits forever
+    with pytest.raises(ResumeError, match="cannot be read: it is a FIFO"):
+        rtpy.render(scene, camera=camera, spp=2, checkpoint=state, resume=True)
 
 
 def test_resume_without_a_saved_render_starts_from_the_first_pass(tmp_path):
@@ -211,6 +254,22 @@ def test_resume_without_a_saved_render_starts_from_the_first_pass(tmp_path):
 
 def test_the_command_line_keeps_the_state_beside_the_output(tmp_path):
     assert state_path(tmp_path / "out.png") == tmp_path / "out.png.resume.npz"
+
+
+@pytest.mark.parametrize("letter", ["a", "é"])
+def test_the_state_of_an_output_with_the_longest_name_fits_and_stays_apart(tmp_path, letter):
+    """A name of 255 bytes is legal; its state's name is cut and given a digest of
+    the whole name, so it fits, and two outputs that differ only at the end keep
+    their states apart."""
+    stem = letter * ((251 - 1) // len(letter.encode()))
+    first, second = (tmp_path / f"{stem}{end}.png" for end in "xy")
+    assert len(first.name.encode()) <= 255
+    states = [state_path(first), state_path(second)]
+    assert states[0] == state_path(first) and states[0] != states[1]
+    for state in states:
+        assert state.parent == tmp_path and state.name.endswith(".resume.npz")
+        assert len(state.name.encode()) <= 255 and state.name.startswith(stem[:100])
+        state.write_bytes(b"")  # the file system takes the name
 
 
 def scene_digest(tmp_path, scene: Scene) -> str:

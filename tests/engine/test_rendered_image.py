@@ -114,3 +114,12 @@ def test_rendered_image_save_unsupported(tmp_path: Path) -> None:
 def test_rendered_image_save_missing_directory(tmp_path: Path) -> None:
     with pytest.raises(OutputError, match="does not exist"):
         make_result().save(tmp_path / "missing" / "out.png")
+
+
+@pytest.mark.parametrize("gamma", [1e-5, 5e-324])
+def test_a_tiny_gamma_in_range_saves_and_shows(tmp_path, gamma):
+    image = RenderedImage(np.full((2, 3, 3), 0.5), gamma=gamma)
+    image.save(tmp_path / "x.png")
+    with Image.open(tmp_path / "x.png") as im:
+        assert im.size == (3, 2) and "gamma" not in im.info
+    assert image.pil.size == (3, 2)

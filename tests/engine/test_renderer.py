@@ -4,15 +4,20 @@ counts, Ctrl-C and time limits keeping whole passes, previews, the progress bar.
 from __future__ import annotations
 
 import re
+import signal
+import sys
 
 import numpy as np
 import pytest
 
 import rtpy
 from rtpy import Camera, Color, DiffuseLight, Lambertian, Metal, Scene, Sphere, Vec3
+from rtpy.engine import signals
 from rtpy.engine.backend import Backend
+from rtpy.engine.executor import InProcess
 from rtpy.engine.plan import Plan
 from rtpy.engine.renderer import Renderer
+from rtpy.render_settings import RenderSettings
 
 
 def small_scene() -> tuple[Scene, Camera]:
@@ -253,3 +258,83 @@ def test_time_is_the_time_limit_setting():
         ValueError, match=re.escape("time_limit: expected a number in [0, 1000000)")
     ):
         rtpy.render(scene, camera=camera, time=-1)
+
+
+class SignalledAtTheEnd(InProcess):
+    """This process, with a signal sent to it while the executor is closed (as the
+    workers are ended after the last pass)."""
+
+    def __init__(self, signum: int) -> None:
+        self.signum = signum
+
+    def run(self, backend, units, timeout=None):
+        try:
+            yield from super().run(backend, units, timeout)
+        finally:
+            signal.raise_signal(self.signum)
+            for _ in range(1000):  # bytecodes where a handler would run
+                pass
+
+
+class SignallingBar:
+    """A progress bar that sends `signum` when it is told the last path is done: the
+    moment right after the last unit's sums are added."""
+
+    def __init__(self, total: int, signum: int) -> None:
+        self.left, self.signum = total, signum
+
+    def update(self, n: int) -> None:
+        self.left -= n
+        if self.left == 0:
+            signal.raise_signal(self.signum)
+
+    def close(self) -> None:
+        pass
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+@pytest.mark.parametrize("moment", ["last unit added", "workers ended"])
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_once_the_last_pass_is_in_returns_the_finished_image(moment, signum, monkeypatch):
+    """Under the command line's handlers, a first signal after the last unit's sums
+    are in (while the workers are ended) is recorded: the render returns its
+    finished image, which the command writes, then exits with the signal's status."""
+    monkeypatch.setattr(signals, "_received", [])
+    scene, camera = small_scene()
+    expected = rtpy.render(scene, camera=camera, spp=4, seed=1).linear
+    executor = SignalledAtTheEnd(signum) if moment == "workers ended" else InProcess()
+    settings = RenderSettings(spp=4, seed=1)
+    renderer = Renderer(
+        scene, camera, settings, quiet=moment != "last unit added", executor=executor
+    )
+    monkeypatch.setattr(renderer, "_progress_bar", lambda total, done: SignallingBar(total, signum))
+    with signals.stop_on_signals():
+        try:
+            image = renderer.render(then_write=True)
+        except KeyboardInterrupt:  # (pytest would take it for the user's, and stop)
+            pytest.fail("the finished render was interrupted")
+        assert signals.received() == signum
+        with pytest.raises(KeyboardInterrupt):  # the next render stops at once
+            renderer.render()
+    assert image.stats["stopped"] is None and image.samples_min == 4
+    np.testing.assert_array_equal(image.linear, expected)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_a_signal_at_the_end_of_a_render_not_written_next_stops_the_command(monkeypatch):
+    """A command that goes on after a render (bench) stops when it returns: the
+    signal recorded while the workers were ended is raised then. A Ctrl-C that
+    stopped the render is not raised again: its image holds the whole passes."""
+    monkeypatch.setattr(signals, "_received", [])
+    scene, camera = small_scene()
+    settings = RenderSettings(spp=4, seed=1)
+    renderer = Renderer(scene, camera, settings, executor=SignalledAtTheEnd(signal.SIGINT))
+    with signals.stop_on_signals():
+        with pytest.raises(KeyboardInterrupt):
+            renderer.render()
+    monkeypatch.setattr(signals, "_received", [])
+    stopping = InterruptAfter(calls=3000)
+    scene.add_object(stopping)
+    with signals.stop_on_signals():
+        image = Renderer(scene, camera, settings).render()
+    assert image.stats["stopped"] == "interrupted"

@@ -384,3 +384,24 @@ def test_sigterm_after_a_pass_writes_it_and_exits_143(tmp_path):
     assert proc.returncode == 143, err
     check(run, proc, err, outputs, tmp_path)
     assert "holding" in err
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+@pytest.mark.parametrize(
+    "backend, workers, signum",
+    [("numpy", 2, signal.SIGINT), ("scalar", 2, signal.SIGINT), ("numpy", 2, signal.SIGTERM)],
+)
+def test_a_signal_once_the_bar_shows_100_percent_writes_the_finished_image(
+    tmp_path, backend, workers, signum
+):
+    """The signal sent the moment the progress bar shows every path done (the last
+    pass is in; the workers are being ended): the finished image is written, the
+    exit status is the signal's, promptly, with no process left."""
+    run = Run(backend, workers, signum, delay=-1.0, again=None, existing=True)
+    proc, outputs = start(run, tmp_path)  # delay < 0: with the progress bar
+    seen = read_until(proc, lambda text: "100%|" in text)
+    proc.send_signal(signum)
+    err = seen + proc.communicate(timeout=30)[1]  # a hang fails here, after 30 s
+    assert proc.returncode == signals.EXIT_STATUS[signum], err
+    check(run, proc, err, outputs, tmp_path)
+    assert "complete" in err and samples_of(run, np.load(outputs[1])) == run.samples, err

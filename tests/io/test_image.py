@@ -348,3 +348,12 @@ def test_exr_without_openexr_says_how_to_install(
         assert "a.exr" in message and "pip install 'rtpy[exr]'" in message
         assert "\n" not in message
     assert listing(tmp_path) == []
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs here")
+def test_read_pfm_refuses_a_fifo_at_once(tmp_path):
+    from rtpy.engine.user_files import NotAFileError
+
+    os.mkfifo(tmp_path / "x.pfm")
+    with pytest.raises(NotAFileError, match="FIFO"):
+        read_pfm(tmp_path / "x.pfm")

@@ -98,6 +98,59 @@ def test_a_damaged_entry_is_built_again(tmp_path, cache):
     same_mesh(again, built)
 
 
+def huge_header(path) -> None:
+    """Rewrite the .npy file at path with a header declaring 10^12 float64."""
+    header = {"descr": "<f8", "fortran_order": False, "shape": (10**6, 10**6)}
+    with open(path, "wb") as f:
+        np.lib.format.write_array_header_1_0(f, header)
+
+
+DAMAGES = {
+    "an emptied array file": lambda entry: (entry / "vertices.npy").write_bytes(b""),
+    "a header declaring a huge shape": lambda entry: huge_header(entry / "faces.npy"),
+    "a header declaring a few more bytes": lambda entry: np.save(
+        entry / "order.npy", np.load(entry / "order.npy")[:-1]
+    ),
+    "metadata that is a list": lambda entry: (entry / "meta.json").write_text("[1, 2]"),
+    "metadata with a string count": lambda entry: (entry / "meta.json").write_text(
+        '{"faces": "200", "skipped": 0}'
+    ),
+    "metadata without its keys": lambda entry: (entry / "meta.json").write_text("{}"),
+    "faces naming vertices that are not there": lambda entry: np.save(
+        entry / "faces.npy", np.load(entry / "faces.npy") + 10**6
+    ),
+    "metadata nested deeper than Python recurses": lambda entry: (entry / "meta.json").write_text(
+        "[" * 20000 + "]" * 20000
+    ),
+    "a vertex that is not a number": lambda entry: np.save(
+        entry / "vertices.npy", np.load(entry / "vertices.npy") * np.nan
+    ),
+    "a tree node whose children are not there": lambda entry: np.save(
+        entry / "child.npy", np.load(entry / "child.npy") + 10**6
+    ),
+    "index arrays of floats": lambda entry: np.save(
+        entry / "faces.npy", np.load(entry / "faces.npy").astype(float)
+    ),
+    "an array file that is a FIFO": lambda entry: (
+        (entry / "lo.npy").unlink(),
+        os.mkfifo(entry / "lo.npy"),
+    ),
+}
+
+
+@pytest.mark.parametrize("damage", DAMAGES)
+def test_every_kind_of_damaged_entry_is_built_again(tmp_path, cache, damage):
+    if damage.endswith("FIFO") and not hasattr(os, "mkfifo"):
+        pytest.skip("no FIFOs on this system")
+    path = sphere_file(tmp_path)
+    built, faces = load_mesh(path, MAT, Transform())
+    (entry,) = entries(cache)
+    DAMAGES[damage](entry)
+    again, faces_again = load_mesh(path, MAT, Transform())
+    same_mesh(again, built)
+    assert faces_again == faces
+
+
 def test_a_cache_that_cannot_be_written_does_not_stop_the_render(tmp_path, monkeypatch):
     blocked = tmp_path / "file"
     blocked.write_text("a file where the cache folder would be")

@@ -3,6 +3,7 @@ triangulation and the errors with their line numbers."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import rtpy
@@ -122,3 +123,24 @@ def test_mesh_from_obj_reads_a_file_into_a_mesh(tmp_path):
     assert [type(t) for t in mesh.triangles] == [SmoothTriangle, SmoothTriangle]
     assert mesh.triangles[1].c == Vec3(0, 2, 0)
     assert rtpy.mesh_from_obj is mesh_from_obj and len(mesh_from_obj(path, Lambertian())) == 2
+
+
+@pytest.mark.parametrize("control", ["\f", "\v", "\x1c", "\x85", "\u2028"])
+def test_a_comment_holding_a_form_feed_or_other_break_is_a_comment(control):
+    """Lines end at \\n, \\r\\n or \\r: a form feed (or another character that
+    str.splitlines takes for a line break) inside a comment leaves it one comment,
+    and the line numbers of errors after it right."""
+    text = f"# page one{control}page two: not a statement\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+    obj = parse_obj(text)
+    assert obj.triangles.shape == (1, 3, 2) and read_bytes_agree(text)
+    with pytest.raises(ObjError) as caught:
+        parse_obj(text + "f 1 2 x\n")
+    assert caught.value.line == 6
+
+
+def read_bytes_agree(text: str) -> bool:
+    """The numpy reader gives parse_obj's answer (or leaves the file to it)."""
+    from rtpy.io.obj_arrays import parse_obj_bytes
+
+    fast = parse_obj_bytes(text.encode())
+    return fast is None or np.array_equal(fast.triangles, parse_obj(text).triangles)

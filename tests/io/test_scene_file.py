@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 
 import numpy as np
 import pytest
@@ -669,6 +670,47 @@ def test_ply_errors_name_the_file_and_line(tmp_path, text, words):
     assert err.key == "path" and words in str(err) and len(str(err).splitlines()) == 1
 
 
+@pytest.mark.parametrize(
+    "body, words",
+    [
+        ("nan 0 0", "m.ply line 10: vertex 1: expected finite numbers for x, y, z, found nan"),
+        ("0 0 inf", "m.ply line 10: vertex 1: expected finite numbers for x, y, z, found 0.0"),
+    ],
+)
+def test_a_ply_vertex_that_is_not_finite_is_blamed_on_the_file_not_scale(tmp_path, body, words):
+    err = mesh_error(tmp_path, TETRA_PLY.replace("0 0 0\n1 0 0", f"{body}\n1 0 0"), name="m.ply")
+    assert err.key == "path" and words in str(err), str(err)
+
+
+def test_a_huge_binary_list_count_is_blamed_on_the_file_not_scale(tmp_path):
+    import struct
+
+    header = TETRA_PLY.split("end_header")[0].replace("ascii", "binary_little_endian")
+    header = header.replace("double", "float").replace("uchar", "uint") + "end_header\n"
+    vertices = struct.pack("<12f", 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1)
+    faces = struct.pack("<I3i", 4_000_000_000, 0, 2, 1) + struct.pack("<I3i", 3, 0, 1, 3) * 3
+    (tmp_path / "m.ply").write_bytes(header.encode() + vertices + faces)
+    err = mesh_error(tmp_path, None, name="m.ply")
+    assert err.key == "path" and "m.ply: the file ends inside face record 1" in str(err), str(err)
+
+
+special_files = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs here")
+
+
+@special_files
+@pytest.mark.parametrize("name", ["m.obj", "m.ply"])
+def test_a_mesh_path_that_is_a_fifo_is_refused_at_once(tmp_path, name):
+    os.mkfifo(tmp_path / name)  # no writer: a reader that opens it waits forever
+    err = mesh_error(tmp_path, None, name=name)
+    assert err.key == "path" and "FIFO (named pipe), not a regular file" in str(err), str(err)
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="no /dev/zero")
+def test_a_mesh_path_that_is_an_endless_device_is_refused_without_reading(tmp_path):
+    err = error_of(mesh_scene(tmp_path, None).replace("m.obj", "/dev/zero"), tmp_path / "s.toml")
+    assert err.key == "path" and "character device, not a regular file" in str(err), str(err)
+
+
 def test_degenerate_faces_are_skipped_and_counted_in_one_warning(tmp_path):
     from rtpy.io.scene_file import SceneWarning
 
@@ -836,3 +878,27 @@ def test_every_key_takes_its_range_and_refuses_the_rest(
 @given(x=extreme_floats(signed=True, zero=True, non_finite=True))
 def test_every_key_over_every_magnitude(key_scene_dir, label, path, key, component, ok, names, x):
     check_key_value(key_scene_dir, path, key, component, ok, names, x)
+
+
+@special_files
+def test_a_scene_or_texture_that_is_a_fifo_is_refused_at_once(tmp_path):
+    os.mkfifo(tmp_path / "pipe.png")
+    err = error_of('[textures.t]\ntype = "image"\npath = "pipe.png"\n', tmp_path / "s.toml")
+    assert err.key == "path" and "FIFO (named pipe), not a regular file" in str(err), str(err)
+    os.mkfifo(tmp_path / "scene.toml")
+    with pytest.raises(SceneError, match="FIFO"):
+        load_scene(tmp_path / "scene.toml")
+
+
+def test_files_beyond_their_limit_are_refused_before_they_are_read(tmp_path, monkeypatch):
+    from rtpy.io import obj, scene_file
+
+    monkeypatch.setattr(obj, "MAX_MESH_BYTES", 100)
+    monkeypatch.setattr("rtpy.io.ply.MAX_MESH_BYTES", 100)
+    for name, text in (("m.obj", TETRA), ("m.ply", TETRA_PLY)):
+        err = mesh_error(tmp_path, text, name=name)
+        assert err.key == "path" and "the most read is 100" in str(err), str(err)
+    monkeypatch.setattr(scene_file, "MAX_TEXTURE_BYTES", 10)
+    Image.new("RGB", (4, 4)).save(tmp_path / "t.png")
+    err = error_of('[textures.t]\ntype = "image"\npath = "t.png"\n', tmp_path / "s.toml")
+    assert err.key == "path" and "the most read is 10" in str(err), str(err)

@@ -105,9 +105,15 @@ def _setting(key: str, value, option: str):
         raise BenchUsageError(e.for_option(option)) from None
 
 
+def _default(given, default):
+    """The option's value as given, or `default` when it was not given."""
+    return default if given is None else given
+
+
 def _options(args: argparse.Namespace) -> dict:
     """run_bench's arguments from the command line's, every one checked."""
-    repeats = args.repeats or (QUICK["repeats"] if args.quick else 4)
+    # `is None`, not `or`: a 0 given is refused, not replaced by the default
+    repeats = _default(args.repeats, QUICK["repeats"] if args.quick else 4)
     if repeats < 2:
         raise BenchUsageError("--repeats: at least 2 (the bias test needs the spread)")
     if args.workers < 1 or args.reference_spp < 1:
@@ -132,7 +138,9 @@ def _options(args: argparse.Namespace) -> dict:
         "spps": _spp_list(args.spp) if args.spp else (QUICK["spp"] if args.quick else DEFAULT_SPP),
         "budget": args.budget,
         "repeats": repeats,
-        "width": _setting("width", args.width or (QUICK["width"] if args.quick else 64), "--width"),
+        "width": _setting(
+            "width", _default(args.width, QUICK["width"] if args.quick else 64), "--width"
+        ),
         "workers": args.workers,
         "cache": Path(args.cache) if args.cache else None,
         "reference_spp": min(args.reference_spp, 256) if args.quick else args.reference_spp,

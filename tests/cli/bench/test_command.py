@@ -70,6 +70,8 @@ def test_bench_plot_is_drawn_when_matplotlib_is_installed(tmp_path):
         (["--samplers", "sobol,halton"], "--samplers"),
         (["--spp", "1,x"], "--spp"),
         (["--repeats", "1"], "--repeats"),
+        (["--repeats", "0"], "--repeats: at least 2"),
+        (["--width", "0"], "--width: expected"),
         (["no_such_scene"], "no_such_scene"),
     ],
 )
