@@ -27,6 +27,7 @@ from ..engine.signals import (
     stop_on_signals,
     stopped,
 )
+from ..engine.unfinished import stub_message
 from ..engine.workers import WorkerError, available_cpus
 from ..io.image import check_image_path, check_linear_path, write_image
 from ..io.outputs import check_output
@@ -314,9 +315,12 @@ def command_render(args: argparse.Namespace) -> int:
     try:
         return _render(args)
     except BaseException as err:  # while loading, or before the render started
-        if not caused_by_interrupt(err):
+        if caused_by_interrupt(err):
+            return stopped(NOTHING_WRITTEN)
+        if (line := stub_message(err) if isinstance(err, Exception) else None) is None:
             raise
-        return stopped(NOTHING_WRITTEN)
+        print(f"rtpy: error: {line}", file=sys.stderr)  # a task not written yet
+        return EXIT_BAD_INPUT
 
 
 def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
@@ -370,9 +374,20 @@ def _render(args: argparse.Namespace) -> int:
         print(
             f"rtpy: note: starting over; --resume continues the render in {state}", file=sys.stderr
         )
+    elif args.resume and not state.exists():
+        print(f"rtpy: note: --resume: no saved render ({state}): starting from the beginning",
+              file=sys.stderr)  # fmt: skip
 
+    kept = state.exists()
     try:
         image = renderer.render()
+    except NotImplementedError as err:  # a task not written yet (rtpy.engine.unfinished)
+        if (line := stub_message(err, renderer, "--integrator {}")) is None:
+            raise
+        if not kept:  # the passes before it: nothing to resume once the task is written
+            state.unlink(missing_ok=True)
+        print(f"rtpy: error: {line}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except ResumeError as err:
         print(
             f"rtpy: error: --resume: {err}; render without --resume to start over", file=sys.stderr

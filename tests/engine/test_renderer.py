@@ -253,3 +253,14 @@ def test_time_is_the_time_limit_setting():
         ValueError, match=re.escape("time_limit: expected a number in [0, 1000000)")
     ):
         rtpy.render(scene, camera=camera, time=-1)
+
+
+def test_the_readmes_scene_built_in_code_renders_as_written():
+    """README.md's `rtpy.Scene([rtpy.Sphere(...)], sky=True)`: no camera given, the
+    default one sees the ball in the middle of the image and the sky around it."""
+    ball = rtpy.Scene([rtpy.Sphere(rtpy.Vec3(0, 0, -1), 0.5, rtpy.Lambertian())], sky=True)
+    image = rtpy.render(ball, width=16, spp=1, integrator="center")
+    assert (image.width, image.height) == (16, 9)
+    middle, corner = image.linear[4, 8], image.linear[0, 0]
+    assert np.allclose(middle, 0.5)  # Lambertian's default albedo, the center integrator
+    assert corner[2] > corner[0]  # the sky: bluer than red
