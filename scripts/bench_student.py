@@ -31,6 +31,12 @@ the time other programs take the CPUs from them.
 
 The full render takes minutes: run it at low priority, `nice -n 10 python ...`.
 --skip-full leaves out rows 1 and 2 (the profile and the course only).
+
+--weeks instead times the render list of every week (assignments/weekNN/tasks.toml)
+as submitted (480 wide, max depth 5, the scene's integrator), each scene at 2 and 8
+spp, and extrapolates to --spp on --workers idle cores: the CPU seconds fitted as
+a + b spp, the time as a + b spp / workers. The week READMEs state the largest of
+each week (tasks.toml's render_time).
 """
 
 from __future__ import annotations
@@ -133,11 +139,12 @@ def profile(spp: int) -> tuple[Counter, float, int]:
     return counts, image.stats["seconds"], image.width * image.height * spp
 
 
-def time_command(spp: int, workers: int) -> dict:
-    """The student's command, timed from start to exit."""
+def time_command(spp: int, workers: int, scene: str = SCENE, integrator="path") -> dict:
+    """The student's command, timed from start to exit (`integrator` None: the scene's)."""
     with tempfile.TemporaryDirectory() as tmp:
-        command = [sys.executable, "-m", "rtpy", "render", SCENE, "--width", str(WIDTH)]
-        command += ["--spp", str(spp), "--max-depth", str(MAX_DEPTH), "--integrator", "path"]
+        command = [sys.executable, "-m", "rtpy", "render", scene, "--width", str(WIDTH)]
+        command += ["--spp", str(spp), "--max-depth", str(MAX_DEPTH)]
+        command += ["--integrator", integrator] if integrator else []
         command += ["--backend", "scalar", "-j", str(workers), "-q", "-o", f"{tmp}/out.png"]
         before = os.times()
         wall = time.perf_counter()
@@ -185,6 +192,27 @@ def print_profile(spp: int, full_spp: int, command: dict | None, workers: int) -
         print(f"| {part} | {100.0 * f:.0f} % |")
 
 
+def week_times(spp: int, workers: int, low: tuple[int, int] = (2, 8)) -> None:
+    """Each week's submission render, per scene of its render list: the command at two
+    low spp, its CPU seconds fitted as a + b spp and the time on `workers` idle cores
+    extrapolated to `spp` as a + b spp / workers (a: start-up and writing, one process)."""
+    from rtpy.grading.tasks import load_weeks
+
+    print(f"| week | scene | CPU s at {low[0]} / {low[1]} spp | {spp} spp on {workers} cores |")
+    print("|---|---|---|---|")
+    for week in load_weeks(ROOT):
+        for render in week.renders:
+            scene = render.scene
+            if scene.endswith(".toml"):
+                scene = f"assignments/week{week.week}/{scene}"
+            cpu = [time_command(n, workers, scene, None)["cpu_seconds"] for n in low]
+            b = max(0.0, (cpu[1] - cpu[0]) / (low[1] - low[0]))
+            a = max(0.0, cpu[0] - b * low[0])
+            estimate = a + b * spp / workers
+            print(f"| {week.week} | {render.scene} | {cpu[0]:.1f} / {cpu[1]:.1f} | "
+                  f"{minutes(estimate)} |", flush=True)  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("course_dir", nargs="?", help="checkout of the course's week-8 code")
@@ -193,6 +221,9 @@ def main() -> None:
     parser.add_argument("--profile-spp", type=int, default=2)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--skip-full", action="store_true", help="profile and course only")
+    parser.add_argument(
+        "--weeks", action="store_true", help="every week's renders, extrapolated from low spp"
+    )
     parser.add_argument("--child", choices=("course", "rtpy"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child == "course":
@@ -208,6 +239,9 @@ def main() -> None:
         print(json.dumps(r))
         return
 
+    if args.weeks:
+        week_times(args.spp, args.workers)
+        return
     print(
         f"week-8 submission render: {WIDTH}x{WIDTH * 9 // 16}, {args.spp} spp, max depth "
         f"{MAX_DEPTH}, path, scalar, {args.workers} workers; {os.cpu_count()} CPUs here"

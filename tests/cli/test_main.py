@@ -363,6 +363,7 @@ def test_second_ctrl_c_exits_at_once(tmp_path, workers):
     if state.exists():
         with np.load(state) as saved:
             assert saved["sums"].shape == (3000, 3000, 4) and "rtpy" in str(saved["key"])
+        state.unlink()  # 290 MB
     # the workers have ended (stopped at the first Ctrl-C, killed at the second)
     assert all(wait_for_exit(pid) for pid in workers_pids), "worker processes still running"
 
