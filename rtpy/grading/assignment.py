@@ -51,6 +51,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .student_readme import student_rtpy_readme, workflow_section
+from .tasks import task_numbers
 
 WEEKS = ("03", "04", "05", "06", "07", "08")
 BEGIN = re.compile(r"^(?P<indent>[ \t]*)# BEGIN SOLUTION week(?P<week>\d\d)(?::\s*(?P<msg>.*))?$")
@@ -320,23 +321,10 @@ def make_assignment(week: str | int, out_dir: str | Path, root: str | Path | Non
     return out
 
 
-def task_numbers(root: Path) -> dict[tuple[str, str], str]:
-    """(file, function) of every task method of the weeks' task maps under root ->
-    the task's number: ("rtpy/materials/phong.py", "Phong.BRDF") -> "8.1"."""
-    from .tasks import load_weeks, method_file
-
-    numbers = {}
-    for week in load_weeks(root):
-        for task in week.tasks:
-            for method in task.methods:
-                numbers[method_file(method, root)] = task.number
-    return numbers
-
-
 def _write_repository(root: Path, week: str, dest: Path) -> None:
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")
     # rtpy with the stubs, the numpy backend withheld
-    numbers = task_numbers(root)
+    numbers = task_numbers(root)  # (file, function) -> "8.1"
 
     def stub(r: Region) -> list[str] | None:
         return (

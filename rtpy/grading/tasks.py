@@ -265,3 +265,14 @@ def method_file(name: str, root: str | Path | None = None) -> tuple[str, str]:
         if (root / path).is_file():
             return path.as_posix(), ".".join(parts[k:])
     raise ValueError(f"{name}: no module of it under {root}")
+
+
+def task_numbers(root: str | Path | None = None) -> dict[tuple[str, str], str]:
+    """(file, function) of every task method of the weeks' task maps under root ->
+    the task's number: ("rtpy/materials/phong.py", "Phong.BRDF") -> "8.1"."""
+    return {
+        method_file(method, root): task.number
+        for week in load_weeks(root)
+        for task in week.tasks
+        for method in task.methods
+    }

@@ -75,13 +75,8 @@ def test_each_task_section_shows_the_render_of_the_work_so_far():
 def student_repository_after(week: str, task: str, dest: Path) -> Path:
     """Week's student repository with its tasks up to `task` ("8.2") written (the
     reference's regions), the later ones still stubs."""
-    from rtpy.grading.assignment import (
-        find_regions,
-        make_assignment,
-        rewrite,
-        task_numbers,
-        withheld,
-    )
+    from rtpy.grading.assignment import find_regions, make_assignment, rewrite, withheld
+    from rtpy.grading.tasks import task_numbers
 
     make_assignment(week, dest, ROOT)
     numbers = task_numbers(ROOT)
