@@ -2,6 +2,7 @@
 
     python scripts/bench_student.py [COURSE_DIR] [--spp 128] [--course-spp 16]
                                     [--profile-spp 2] [--workers 2] [--skip-full]
+                                    [--skip-command] [--rtpy-spp N] [--weeks]
 
 The submission render of week 8 (assignments/week08/README.md): 480x270, 128 samples
 per pixel, max depth 5, the `path` integrator, the scalar backend (the student's own
@@ -30,7 +31,8 @@ not all busy (start-up, the workers' start, the last units, writing the PNG) and
 the time other programs take the CPUs from them.
 
 The full render takes minutes: run it at low priority, `nice -n 10 python ...`.
---skip-full leaves out rows 1 and 2 (the profile and the course only).
+--skip-full leaves out rows 1 and 2 (the profile and the course only), --skip-command
+row 1; --rtpy-spp renders row 2 at fewer spp, scaled to --spp as the course's row.
 
 --weeks instead times the render list of every week (assignments/weekNN/tasks.toml)
 as submitted (480 wide, max depth 5, the scene's integrator), each scene at 2 and 8
@@ -221,6 +223,8 @@ def main() -> None:
     parser.add_argument("--profile-spp", type=int, default=2)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--skip-full", action="store_true", help="profile and course only")
+    parser.add_argument("--skip-command", action="store_true", help="leave out row 1")
+    parser.add_argument("--rtpy-spp", type=int, default=0, help="row 2's spp (scaled to --spp)")
     parser.add_argument(
         "--weeks", action="store_true", help="every week's renders, extrapolated from low spp"
     )
@@ -248,18 +252,27 @@ def main() -> None:
     )
     print("| render | wall clock | CPU | paths per CPU second |\n|---|---|---|---|")
     command = None
-    if not args.skip_full:
+    if not args.skip_full and not args.skip_command:
         command = time_command(args.spp, args.workers)
         print_row(f"`rtpy render {SCENE}` (the command)", command)
-        print_row("rtpy on the course's scene", child("rtpy", args.spp, args.workers, None))
+    if not args.skip_full:
+        rtpy_spp = args.rtpy_spp or args.spp
+        r = scaled(child("rtpy", rtpy_spp, args.workers, None), args.spp / rtpy_spp)
+        print_row(f"rtpy on the course's scene, {args.workers} workers{r['label']}", r)
     if bench_course.has_course(args.course_dir):
-        r = child("course", args.course_spp, 1, args.course_dir)
-        scale = args.spp / args.course_spp
-        scaled = {k: r[k] * scale for k in ("seconds", "cpu_seconds", "paths")}
-        print_row(f"the course's code, one process ({args.course_spp} spp x {scale:g})", scaled)
+        r = scaled(child("course", args.course_spp, 1, args.course_dir), args.spp / args.course_spp)
+        print_row(f"the course's code, one process{r['label']}", r)
     else:
         print(f"(no course checkout at {args.course_dir!r}: the course's row is skipped)")
     print_profile(args.profile_spp, args.spp, command, args.workers)
+
+
+def scaled(r: dict, scale: float) -> dict:
+    """A render's times and paths scaled from the spp it rendered to the row's."""
+    if scale == 1:
+        return {**r, "label": ""}
+    out = {k: r[k] * scale for k in ("seconds", "cpu_seconds", "paths")}
+    return {**out, "label": f" ({r['paths'] / (WIDTH * (WIDTH * 9 // 16)):g} spp x {scale:g})"}
 
 
 def print_row(label: str, r: dict) -> None:

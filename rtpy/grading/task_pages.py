@@ -39,8 +39,8 @@ repositories). A material of your own, in a file of its own and registered with
 
 DRAFTS = """
 On a machine of 2 cores the submission render of one of this week's scenes takes
-about {time} with the scalar backend (`--workers 2`; measured by
-`scripts/bench_student.py` on the reference solution). To draft faster: `--time 30`
+about {time} with the scalar backend (`--workers 2`, measured with the reference
+solution; your code may take longer). To draft faster: `--time 30`
 (whole passes until 30 s are spent: a noisier image, sooner), a smaller `--width 240`
 (a quarter of the pixels) and `--sampler sobol` (less noise for the same samples).
 """

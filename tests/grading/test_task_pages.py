@@ -54,6 +54,9 @@ def test_each_readme_states_the_lecture_the_tasks_their_points_and_times():
             assert f"### {t.number} {t.title} — {t.points:g} points" in text
         assert ("## Extension tasks (optional, 0 points)" in text) == bool(week.extensions)
         assert ("## Given code to read" in text) == bool(week.readings)
+        words = " ".join(text.split())
+        assert f"takes about {week.render_time} with the scalar backend" in words
+        assert "`--time 30`" in words and "`--sampler sobol`" in words
 
 
 def test_durations_read_as_hours_and_minutes():
