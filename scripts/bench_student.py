@@ -203,7 +203,7 @@ def week_times(spp: int, workers: int, low: tuple[int, int] = (2, 8)) -> None:
     print(f"| week | scene | CPU s at {low[0]} / {low[1]} spp | {spp} spp on {workers} cores |")
     print("|---|---|---|---|")
     for week in load_weeks(ROOT):
-        for render in week.renders:
+        for render in {r.scene: r for r in week.renders}.values():  # each scene once
             scene = render.scene
             if scene.endswith(".toml"):
                 scene = f"assignments/week{week.week}/{scene}"
