@@ -131,8 +131,8 @@ def render_course(course_dir: str, width: int, spp: int, max_depth: int, seed: i
     return timed(renderer.render, lambda _: camera.img_width * camera.img_height * spp)
 
 
-def render_rtpy(width: int, spp: int, max_depth: int, seed: int) -> dict:
-    """Render with the rtpy on sys.path, scalar backend, one process."""
+def render_rtpy(width: int, spp: int, max_depth: int, seed: int, workers: int = 1) -> dict:
+    """Render with the rtpy on sys.path, scalar backend, `workers` processes."""
     import rtpy
     import rtpy.engine.renderer  # noqa: F401  imported here, they are not part of the render's time)
     import rtpy.io.preview  # noqa: F401  (these two rtpy.render imports on first use:
@@ -158,7 +158,13 @@ def render_rtpy(width: int, spp: int, max_depth: int, seed: int) -> dict:
 
     def render():
         return rtpy.render(
-            scene, camera=camera, spp=spp, max_depth=max_depth, seed=seed, workers=1, quiet=True
+            scene,
+            camera=camera,
+            spp=spp,
+            max_depth=max_depth,
+            seed=seed,
+            workers=workers,
+            quiet=True,
         )
 
     return timed(render, lambda image: image.width * image.height * spp)

@@ -77,3 +77,16 @@ def start_method(request):
     multiprocessing.set_start_method(request.param, force=True)
     yield request.param
     multiprocessing.set_start_method(before, force=True)
+
+
+@pytest.fixture(autouse=True)
+def plugins_of_this_test_only():
+    """A plugin a test loads is forgotten after it (rtpy.engine.plugins.PLUGINS, which
+    worker processes load again): its file lives in the test's tmp_path, which is
+    removed once the test passes (pyproject.toml's tmp_path_retention_policy)."""
+    from rtpy.engine.plugins import PLUGINS
+
+    saved = dict(PLUGINS)
+    yield
+    PLUGINS.clear()
+    PLUGINS.update(saved)

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import rtpy
-from rtpy.cli.main import UsageError
+from rtpy.cli.options import UsageError
 from rtpy.io.scene_file import SceneError, load_scene_text
 from rtpy.render_settings import (
     RENDER_KEYS,

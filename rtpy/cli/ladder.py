@@ -16,7 +16,7 @@ from ..engine.workers import WorkerError, available_cpus
 from ..io.image import check_image_path
 from ..io.outputs import check_output
 from ..render_settings import SettingError
-from .main import (
+from .options import (
     MAX_WORKERS,
     UsageError,
     add_setting_options,

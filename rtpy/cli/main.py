@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import tomllib
 import warnings
 from importlib.util import find_spec
 from pathlib import Path
@@ -30,64 +29,22 @@ from ..engine.signals import (
     stop_on_signals,
     stopped,
 )
+from ..engine.unfinished import stub_message
 from ..engine.workers import WorkerError, available_cpus
 from ..io.image import check_image_path, check_linear_path, write_image
 from ..io.outputs import check_output
-from ..render_settings import SETTINGS, SettingError, unknown_setting
+from ..render_settings import SettingError
 from .grade import add_grade_command, command_grade
-
-MAX_WORKERS = 256  # more processes than that only exhaust the machine
-
-
-def seconds(text: str, zero: bool = False) -> float:
-    """A number of seconds below 1e6: above 0, or from 0 with zero=True."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
-    if not ((value >= 0.0 if zero else value > 0.0) and value < 1e6):
-        lowest = "from 0" if zero else "above 0"
-        raise argparse.ArgumentTypeError(f"expected seconds {lowest}, got {text}")
-    return value
-
-
-def preview_seconds(text: str) -> float:
-    """--preview-seconds: 0 (a preview after every unit of work) or more."""
-    return seconds(text, zero=True)
-
-
-def worker_count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if not 1 <= value <= MAX_WORKERS:
-        raise argparse.ArgumentTypeError(f"expected 1 to {MAX_WORKERS} processes, got {value}")
-    return value
-
-
-def flag(name: str) -> str:
-    """The option of a render setting that has a flag: max_depth -> --max-depth."""
-    return "--" + name.replace("_", "-")
-
-
-def add_setting_options(r: argparse.ArgumentParser, hidden: tuple[str, ...] = ()) -> None:
-    """--NAME for the render settings that have a flag, and --set KEY=VALUE for all
-    of them (rtpy.render_settings.SETTINGS); the values are checked after parsing.
-    The flags of `hidden` are parsed but left out of the help (a command that refuses
-    them says so in one line)."""
-    for name, setting in SETTINGS.items():
-        if setting.flag:
-            metavar = {"int": "N", "float": "X", "choice": "NAME"}.get(setting.kind)
-            text = argparse.SUPPRESS if name in hidden else setting.help
-            r.add_argument(flag(name), dest=name, metavar=metavar, help=text)
-    r.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help=f"override a render setting, VALUE in TOML syntax ({', '.join(SETTINGS)})",
-    )
+from .options import (
+    MAX_WORKERS,
+    UsageError,
+    add_setting_options,
+    check_backend,
+    given_settings,
+    preview_seconds,
+    seconds,
+    worker_count,
+)
 
 
 class _Version(argparse.Action):
@@ -220,61 +177,6 @@ def load_plugins(paths: list[str]) -> None:
             raise UsageError(f"--plugin {err}") from None
 
 
-class UsageError(Exception):
-    pass
-
-
-def shown(text: str) -> str:
-    """text as a message shows it: as it is when printable, else quoted and escaped
-    (a message stays one line)."""
-    return text if text.isprintable() else repr(text)
-
-
-def read_value(text: str, option: str):
-    """A command-line value read as one TOML value (2, 2.5, true, [0.1, 0.2, 0.3],
-    "path"), or the text itself when it is not TOML (a bare word such as srgb) or more
-    than TOML takes (an integer of thousands of digits, arrays nested thousands deep).
-    UsageError naming `option` for a line break (TOML reads the next line as more
-    keys); a table is one value, refused by the setting's check as in a scene file."""
-    if "\n" in text or "\r" in text:
-        raise UsageError(f"{option}: expected one value on one line, got {text!r}")
-    try:
-        return tomllib.loads(f"v = {text}")["v"]
-    except (tomllib.TOMLDecodeError, ValueError, RecursionError):
-        return text.strip()
-
-
-def parse_set(items: list[str]) -> dict:
-    """--set KEY=VALUE pairs -> {key: value}, values read as TOML."""
-    result = {}
-    for item in items:
-        key, sep, text = item.partition("=")
-        key = key.strip()
-        if not sep:
-            raise UsageError(f"--set {item!r}: expected KEY=VALUE")
-        if key not in SETTINGS:
-            error = unknown_setting(key, list(SETTINGS))
-            raise UsageError(error.for_option(f"--set {shown(key)}"))
-        result[key] = read_value(text, f"--set {key}")
-    return result
-
-
-def given_settings(args: argparse.Namespace) -> dict[str, tuple[str, object]]:
-    """The render settings the command line gives: key -> (the option that gave it,
-    its value read as TOML); UsageError for a flag (--spp) and --set of one key."""
-    given = {key: (f"--set {key}", value) for key, value in parse_set(args.set).items()}
-    flags = {name: flag(name) for name, setting in SETTINGS.items() if setting.flag}
-    flags["time_limit"] = "--time"
-    for key, option in flags.items():
-        text = getattr(args, key)
-        if text is None:
-            continue
-        if key in given:
-            raise UsageError(f"{option} and --set {key} set one value: give one of them")
-        given[key] = (option, read_value(text, option))
-    return given
-
-
 def prepare(args: argparse.Namespace, scene, path: Path, given: dict, preview, state):
     """The Renderer of the command, its values checked by rtpy.render's boundary;
     UsageError naming the option of a value it refuses."""
@@ -308,18 +210,6 @@ def prepare(args: argparse.Namespace, scene, path: Path, given: dict, preview, s
         raise
 
 
-def check_backend(name: str) -> None:
-    """UsageError when the backend is withheld (the numpy backend in an assignment
-    repository, whose stub says so in WITHHELD)."""
-    if name != "numpy":
-        return
-    import rtpy.numpy_backend as backend
-
-    withheld = getattr(backend, "WITHHELD", None)
-    if withheld:
-        raise UsageError(f"--backend numpy: {withheld}")
-
-
 def command_scenes() -> int:
     from ..io.bundled import bundled_scenes
 
@@ -334,9 +224,12 @@ def command_render(args: argparse.Namespace) -> int:
     try:
         return _render(args)
     except BaseException as err:  # while loading, or before the render started
-        if not caused_by_interrupt(err):
+        if caused_by_interrupt(err):
+            return stopped(NOTHING_WRITTEN)
+        if (line := stub_message(err) if isinstance(err, Exception) else None) is None:
             raise
-        return stopped(NOTHING_WRITTEN)
+        print(f"rtpy: error: {line}", file=sys.stderr)  # a task not written yet
+        return EXIT_BAD_INPUT
 
 
 def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
@@ -390,9 +283,20 @@ def _render(args: argparse.Namespace) -> int:
         print(
             f"rtpy: note: starting over; --resume continues the render in {state}", file=sys.stderr
         )
+    elif args.resume and not state.exists():
+        print(f"rtpy: note: --resume: no saved render ({state}): starting from the beginning",
+              file=sys.stderr)  # fmt: skip
 
+    kept = state.exists()
     try:
         image = renderer.render(then_write=True)  # a signal from its end on: written
+    except NotImplementedError as err:  # a task not written yet (rtpy.engine.unfinished)
+        if (line := stub_message(err, renderer, "--integrator {}")) is None:
+            raise
+        if not kept:  # the passes before it: nothing to resume once the task is written
+            state.unlink(missing_ok=True)
+        print(f"rtpy: error: {line}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except ResumeError as err:
         print(
             f"rtpy: error: --resume: {one_line(str(err))}; render without --resume to start over",

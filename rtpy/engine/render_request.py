@@ -37,7 +37,8 @@ def render(scene: Scene, **options) -> RenderedImage:
 
     Keyword overrides: any [render] setting (integrator, spp, max_depth, nee,
     russian_roulette, seed, gamma, mis, sampler, time_limit), background, sky, the
-    camera width, or a whole `camera`. workers = number of processes
+    camera width, or a whole `camera` (default: the scene's, else rtpy.Camera(): at
+    the origin looking down -z, as RTIOW's first images). workers = number of processes
     (rtpy.engine.workers.available_cpus() is how many this process may use). progress=True
     shows a progress bar (a notebook's widget in Jupyter, else text on stderr); none
     by default; quiet is its negation (quiet=False shows it).
@@ -63,7 +64,15 @@ def render(scene: Scene, **options) -> RenderedImage:
     of an uninterrupted render (rtpy.engine.render_state).
     """
     renderer = prepare_render(scene, **options)
-    image = renderer.render()
+    try:
+        image = renderer.render()
+    except NotImplementedError as err:  # a task not written yet: one line, not two tracebacks
+        from .unfinished import find_unfinished, what_renders_now
+
+        if find_unfinished(err) is None:
+            raise
+        now = what_renders_now(renderer, "integrator={!r}")
+        raise NotImplementedError(f"{err.args[0]}; {now}") from None
     if renderer.checkpoint is not None and image.stats["stopped"] is None:
         renderer.checkpoint.remove()
     return image
@@ -136,9 +145,9 @@ def prepare_render(
 
 
 def _camera(scene: Scene, camera: Camera | None, width) -> Camera:
-    camera = camera or scene.camera
-    if camera is None:
-        raise ValueError("the scene has no camera: pass camera=rtpy.Camera(...)")
+    # A scene built in code has no camera of its own: RTIOW's first one, at the origin
+    # looking down -z, 90 degrees vertical field of view, 400 wide, 16:9.
+    camera = camera or scene.camera or Camera()
     if width is None:
         return camera
     width = SETTINGS["width"].check(width)

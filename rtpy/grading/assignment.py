@@ -51,6 +51,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .student_readme import student_rtpy_readme, workflow_section
+from .tasks import task_numbers
 from .weeks import WEEKS, AssignmentError, check_week
 
 __all__ = ["WEEKS", "AssignmentError", "check_week", "make_assignment", "map_tests"]
@@ -123,11 +124,13 @@ class Region:
     function: str  # qualified name of the enclosing function, e.g. "PointLight.sample"
     indent: str
 
-    def stub(self) -> list[str]:
+    def stub(self, task: str | None = None) -> list[str]:
         """The lines that replace the region: a TODO and a NotImplementedError naming
-        the task, its string split to fit 100 columns."""
+        the week's task, its number (`task`, "8.1") and file, split to fit 100 columns
+        (rtpy.engine.unfinished reads them back when a render reaches the stub)."""
         what = f"{self.function}: {self.message}" if self.message else self.function
-        text = f"week{self.week} task: {what} (see assignments/week{self.week}/README.md)"
+        where = f"task {task}, {self.path.as_posix()}" if task else self.path.as_posix()
+        text = f"week{self.week} task: {what} ({where}; see assignments/week{self.week}/README.md)"
         width = max(40, 92 - len(self.indent))
         parts = textwrap.wrap(text, width, drop_whitespace=False) or [text]
         return [
@@ -321,15 +324,20 @@ def make_assignment(week: str | int, out_dir: str | Path, root: str | Path | Non
 def _write_repository(root: Path, week: str, dest: Path) -> None:
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")
     # rtpy with the stubs, the numpy backend and the instructor's modules withheld
+    numbers = task_numbers(root)  # (file, function) -> "8.1"
+
+    def stub(r: Region) -> list[str] | None:
+        return (
+            r.stub(numbers.get((r.path.as_posix(), r.function))) if withheld(r.week, week) else None
+        )
+
     for path in sorted((root / "rtpy").rglob("*.py")):
         rel = path.relative_to(root)
         if rel.parts[1] == "numpy_backend" or rel.as_posix() in INSTRUCTOR_MODULES:
             continue
         target = dest / rel
         target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_text(
-            rewrite(path, root, lambda r: r.stub() if withheld(r.week, week) else None)
-        )
+        target.write_text(rewrite(path, root, stub))
     numpy_dir = root / "rtpy" / "numpy_backend"
     message = WITHHELD_MESSAGE.format(week=week)
     for package in sorted(numpy_dir.rglob("__init__.py")):  # pyproject lists every package

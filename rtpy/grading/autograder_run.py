@@ -203,6 +203,12 @@ def isolation(root: Path, log: list[str]) -> Isolation:
         log.append("not root: the student's code runs as this user (no user isolation)")
         return Isolation(socket_filter=socket_filter)
     user = f"{SANDBOX_USER}-{secrets.token_hex(4)}"
+    print(  # before anything changes on the machine (a local run as root, too)
+        f"rtpy autograder: running as root: creating the system user {user} for the "
+        f"student's code (removed when the run ends; else {SANDBOX_USER}, which stays) and "
+        f"closing {root}'s folders to other users",
+        flush=True,
+    )
     if not make_user(user):
         user = SANDBOX_USER
         if not make_user(user):

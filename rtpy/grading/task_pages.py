@@ -37,6 +37,20 @@ repositories). A material of your own, in a file of its own and registered with
 `type = "name"`).
 """
 
+DRAFTS = """
+On a machine of 2 cores the submission render of one of this week's scenes takes
+about {time} with the scalar backend (`--workers 2`, measured with the reference
+solution; your code may take longer). To draft faster: `--time 30`
+(whole passes until 30 s are spent: a noisier image, sooner), a smaller `--width 240`
+(a quarter of the pixels) and `--sampler sobol` (less noise for the same samples).
+"""
+
+
+def render_time(week: Week) -> str:
+    """What the README says of the submission render's time, if it was measured."""
+    return DRAFTS.format(time=week.render_time) if week.render_time else ""
+
+
 GRADING = """## Grading
 
 `python -m rtpy grade {week}` runs the graders in `assignments/week{week}/` and prints a
@@ -102,12 +116,32 @@ def paragraph(text: str, first: str = "") -> str:
     )
 
 
-def task_section(task: Task, root: Path) -> str:
+def task_section(task: Task, root: Path, shown_by: Task | None = None) -> str:
+    """A task's section: its methods, its text and the render that shows the work done
+    so far (`shown_by`: the first task from this one on that names a render)."""
+    if task.render:
+        see = f"See your work so far:\n\n```sh\npython -m rtpy render {task.render}\n```\n"
+    elif shown_by is not None:
+        see = (
+            paragraph(
+                f"Nothing renders this yet: the first render of it comes with task "
+                f"{shown_by.number} ({shown_by.title}). `python -m rtpy grade {task.id[:2]}` "
+                "checks it now."
+            )
+            + "\n"
+        )
+    else:
+        see = paragraph(f"`python -m rtpy grade {task.id[:2]}` checks it.") + "\n"
     return (
         f"### {task.number} {task.title} — {task.points:g} points, about "
         f"{duration(task.minutes)}\n\n{paragraph(methods_text(task, root))}\n\n"
-        f"{paragraph(task.text)}\n"
+        f"{paragraph(task.text)}\n\n{see}"
     )
+
+
+def shown_by(tasks: tuple[Task, ...], k: int) -> Task | None:
+    """The first of tasks[k:] that names a render."""
+    return next((t for t in tasks[k:] if t.render), None)
 
 
 def week_readme(week: Week, root: Path = ROOT) -> str:
@@ -137,7 +171,7 @@ def week_readme(week: Week, root: Path = ROOT) -> str:
             for t in week.tasks
         )
         + f"| | total | {sum(t.points for t in graded):g} | {duration(minutes)} |\n",
-        *(task_section(t, root) for t in graded),
+        *(task_section(t, root, shown_by(graded, k)) for k, t in enumerate(graded)),
     ]
     if extensions:
         out.append(
@@ -145,7 +179,7 @@ def week_readme(week: Week, root: Path = ROOT) -> str:
             "Not part of the week's score: their graders run in a group of their own and\n"
             "report passed or failed.\n"
         )
-        out.extend(task_section(t, root) for t in extensions)
+        out.extend(task_section(t, root, shown_by(extensions, k)) for k, t in enumerate(extensions))
     if week.readings:
         out.append("## Given code to read\n")
         for r in week.readings:
@@ -159,7 +193,7 @@ def week_readme(week: Week, root: Path = ROOT) -> str:
             paragraph(f"{scene_text(week, r.scene)}: {r.text}", "- ") + "\n" for r in week.renders
         )
     )
-    out.append(RENDER_SETTINGS)
+    out.append(RENDER_SETTINGS + render_time(week))
     note = (
         " Extension tasks are graded apart: their tests show passed or failed and are "
         "worth 0 points."

@@ -9,6 +9,7 @@ solution regions a student writes), with its points and an estimated time:
     lecture_title = "lighting and shadows"
     title = "Lighting and shadows"
     goals = ["Explain why a point light's irradiance falls off with 1/r^2.", ...]
+    render_time = "2 min"                    # the submission render of a scene, 2 cores
 
     [[tasks]]
     id = "05.1"                              # week.task; Gradescope numbers it 5.1
@@ -18,6 +19,7 @@ solution regions a student writes), with its points and an estimated time:
     minutes = 30                             # an estimate for a student
     text = "What to write, the formula, the convention that catches people out."
     extension = false                        # true: optional, 0 points, graded apart
+    render = "scenes/x.toml --time 30"       # `rtpy render` of the work done so far
 
     [[readings]]                             # given code to read, with a question
     title = "How light is counted once"
@@ -59,6 +61,9 @@ class Task:
     minutes: int
     text: str
     extension: bool = False
+    # what `python -m rtpy render` is given to show the work done once this task is
+    # written ("week08_phong --integrator direct"); "" when nothing new renders
+    render: str = ""
 
     @property
     def number(self) -> str:
@@ -91,6 +96,9 @@ class Week:
     tasks: tuple[Task, ...]
     readings: tuple[Reading, ...]
     renders: tuple[Render, ...]
+    # how long the submission render of one scene takes on a 2-core machine
+    # (scripts/bench_student.py --weeks measures it): "7 min"; "" when not measured
+    render_time: str = ""
 
     @property
     def graded(self) -> tuple[Task, ...]:
@@ -151,8 +159,17 @@ class _Table:
         return value
 
 
-TASK_KEYS = {"id", "title", "methods", "points", "minutes", "text", "extension"}
-WEEK_KEYS = {"title", "lecture", "lecture_title", "goals", "tasks", "readings", "renders"}
+TASK_KEYS = {"id", "title", "methods", "points", "minutes", "text", "extension", "render"}
+WEEK_KEYS = {
+    "title",
+    "lecture",
+    "lecture_title",
+    "goals",
+    "tasks",
+    "readings",
+    "renders",
+    "render_time",
+}
 
 
 def _task(data: dict, where: str, week: str) -> Task:
@@ -182,6 +199,7 @@ def _task(data: dict, where: str, week: str) -> Task:
         t.number("minutes", integer=True),
         t.text("text"),
         extension,
+        t.text("render") if "render" in t.data else "",
     )
 
 
@@ -227,6 +245,7 @@ def load_week(folder: str | Path) -> Week:
         tasks,
         tuple(readings),
         tuple(renders),
+        top.text("render_time") if "render_time" in data else "",
     )
 
 
@@ -246,3 +265,14 @@ def method_file(name: str, root: str | Path | None = None) -> tuple[str, str]:
         if (root / path).is_file():
             return path.as_posix(), ".".join(parts[k:])
     raise ValueError(f"{name}: no module of it under {root}")
+
+
+def task_numbers(root: str | Path | None = None) -> dict[tuple[str, str], str]:
+    """(file, function) of every task method of the weeks' task maps under root ->
+    the task's number: ("rtpy/materials/phong.py", "Phong.BRDF") -> "8.1"."""
+    return {
+        method_file(method, root): task.number
+        for week in load_weeks(root)
+        for task in week.tasks
+        for method in task.methods
+    }

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from .scene_file import SceneError
 
-__all__ = ["bundled_dir", "bundled_scenes", "resolve_scene"]
+__all__ = ["bundled_dir", "bundled_scenes", "is_path", "resolve_scene"]
 
 
 def bundled_dir() -> Path:
@@ -50,19 +50,46 @@ def bundled_scenes() -> list[tuple[str, str]]:
     return [(p.stem, _description(p)) for p in _bundled_files()]
 
 
+def is_path(argument: str) -> bool:
+    """Does a scene argument name a file (a suffix or a folder in it), not a bundled
+    scene? Such an argument never means a bundled scene."""
+    return bool(Path(argument).suffix) or any(sep in argument for sep in ("/", "\\"))
+
+
+def _nearby(path: Path) -> list[str]:
+    """The scene files beside a missing path, as the path would name them."""
+    folder = path.parent
+    try:
+        found = sorted(p.name for p in folder.glob("*.toml") if p.is_file())
+    except OSError:
+        return []
+    return [str(folder / name) if str(folder) != "." else name for name in found]
+
+
 def resolve_scene(name_or_path: str) -> Path:
-    """The scene file a command-line argument means: an existing file wins; else a
-    bundled scene of that name (with or without .toml); else a SceneError."""
+    """The scene file a command-line argument means: an existing file; else, for a
+    bare name (no suffix, no folder), the bundled scene of that name; else a
+    SceneError saying what is missing, with the closest bundled name or nearby file
+    (a bundled week scene also by its short name: "phong" -> "week08_phong")."""
     path = Path(name_or_path)
     if path.is_file():
         return path
     names = [p.stem for p in _bundled_files()]
-    stem = name_or_path[:-5] if name_or_path.endswith(".toml") else name_or_path
-    if stem in names:
-        return bundled_dir() / f"{stem}.toml"
-    matches = difflib.get_close_matches(stem, names, n=1, cutoff=0.6)
+    if not is_path(name_or_path) and name_or_path in names:
+        return bundled_dir() / f"{name_or_path}.toml"
+    stem = path.stem if is_path(name_or_path) else name_or_path
+    short = {name.partition("_")[2]: name for name in names if name.startswith("week")}
+    if stem in names or stem in short:
+        suggestion = stem if stem in names else short[stem]
+    else:
+        nearby = _nearby(path) if is_path(name_or_path) else []
+        candidates = {**{n: n for n in names}, **short, **{Path(f).stem: f for f in nearby}}
+        matches = difflib.get_close_matches(stem, list(candidates), n=1, cutoff=0.6)
+        suggestion = candidates[matches[0]] if matches else None
     listed = ", ".join(names) if names else "none"
-    raise SceneError(
-        f"no scene file '{name_or_path}' and no bundled scene of that name; bundled: {listed}",
-        suggestion=matches[0] if matches else None,
-    )
+    what = f"no scene file '{name_or_path}'"
+    if is_path(name_or_path):
+        what += " (a path, never a bundled scene)"
+    else:
+        what += " and no bundled scene of that name"
+    raise SceneError(f"{what}; bundled: {listed}", suggestion=suggestion)

@@ -20,15 +20,8 @@ from hypothesis import strategies as st
 from PIL import Image
 
 import rtpy
-from rtpy.cli.main import (
-    MAX_WORKERS,
-    UsageError,
-    build_parser,
-    given_settings,
-    main,
-    parse_set,
-    prepare,
-)
+from rtpy.cli.main import build_parser, main, prepare
+from rtpy.cli.options import MAX_WORKERS, UsageError, given_settings, parse_set
 from rtpy.engine.renderer import Renderer
 from rtpy.io.bundled import bundled_dir, bundled_scenes
 from rtpy.io.image import read_pfm
@@ -346,25 +339,32 @@ def test_second_ctrl_c_exits_at_once(tmp_path, workers):
         "cornell", "--width", "3000", "--spp", "8", "--max-depth", "1", "--backend", "numpy",
         "--workers", workers, "-o", str(out), "--linear", str(tmp_path / "big.npy"),
     )  # fmt: skip
-    read_until(proc, lambda text: percent_done(text) >= 13)  # a pass of 1 spp finished
-    ps = subprocess.run(["ps", "-o", "pid=", "--ppid", str(proc.pid)], capture_output=True)
-    workers_pids = [int(p) for p in ps.stdout.split()]
-    assert len(workers_pids) == (2 if workers == "2" else 0)
-    proc.send_signal(signal.SIGINT)
-    seen = read_until(proc, lambda text: "writing the samples finished so far" in text)
-    proc.send_signal(signal.SIGINT)
-    _, rest = proc.communicate(timeout=60)
-    assert proc.returncode == 130, seen + rest
-    assert "interrupted again" in rest and "Traceback" not in seen + rest
-    # No image, no temporary file; the render's state, saved whole after the first
-    # Ctrl-C, is kept for --resume.
-    state = tmp_path / "big.png.resume.npz"
-    assert list(tmp_path.iterdir()) in ([], [state])
-    if state.exists():
-        with np.load(state) as saved:
-            assert saved["sums"].shape == (3000, 3000, 4) and "rtpy" in str(saved["key"])
-    # the workers have ended (stopped at the first Ctrl-C, killed at the second)
-    assert all(wait_for_exit(pid) for pid in workers_pids), "worker processes still running"
+    try:
+        read_until(proc, lambda text: percent_done(text) >= 13)  # a pass of 1 spp finished
+        ps = subprocess.run(["ps", "-o", "pid=", "--ppid", str(proc.pid)], capture_output=True)
+        workers_pids = [int(p) for p in ps.stdout.split()]
+        assert len(workers_pids) == (2 if workers == "2" else 0)
+        proc.send_signal(signal.SIGINT)
+        seen = read_until(proc, lambda text: "writing the samples finished so far" in text)
+        proc.send_signal(signal.SIGINT)
+        _, rest = proc.communicate(timeout=60)
+        assert proc.returncode == 130, seen + rest
+        assert "interrupted again" in rest and "Traceback" not in seen + rest
+        # No image, no temporary file; the render's state, saved whole after the first
+        # Ctrl-C, is kept for --resume.
+        state = tmp_path / "big.png.resume.npz"
+        assert list(tmp_path.iterdir()) in ([], [state])
+        if state.exists():
+            with np.load(state) as saved:
+                assert saved["sums"].shape == (3000, 3000, 4) and "rtpy" in str(saved["key"])
+        # the workers have ended (stopped at the first Ctrl-C, killed at the second)
+        assert all(wait_for_exit(pid) for pid in workers_pids), "worker processes still running"
+    finally:  # the render's state and a partial image: hundreds of MB, pass or fail
+        if proc.poll() is None:  # a failed test's render
+            proc.kill()
+            proc.wait()
+        for path in tmp_path.iterdir():
+            path.unlink()
 
 
 @pytest.mark.parametrize(

@@ -338,3 +338,14 @@ def test_a_signal_at_the_end_of_a_render_not_written_next_stops_the_command(monk
     with signals.stop_on_signals():
         image = Renderer(scene, camera, settings).render()
     assert image.stats["stopped"] == "interrupted"
+
+
+def test_the_readmes_scene_built_in_code_renders_as_written():
+    """README.md's `rtpy.Scene([rtpy.Sphere(...)], sky=True)`: no camera given, the
+    default one sees the ball in the middle of the image and the sky around it."""
+    ball = rtpy.Scene([rtpy.Sphere(rtpy.Vec3(0, 0, -1), 0.5, rtpy.Lambertian())], sky=True)
+    image = rtpy.render(ball, width=16, spp=1, integrator="center")
+    assert (image.width, image.height) == (16, 9)
+    middle, corner = image.linear[4, 8], image.linear[0, 0]
+    assert np.allclose(middle, 0.5)  # Lambertian's default albedo, the center integrator
+    assert corner[2] > corner[0]  # the sky: bluer than red

@@ -361,16 +361,17 @@ def test_assignments_need_a_source_checkout(tmp_path, capsys, monkeypatch):
 
 @pytest.mark.skipif(not ROOT_USER, reason="the autograder as root")
 def test_as_root_a_students_code_never_runs_as_root(built, tmp_path):
-    """A judge's Python that no unprivileged user can run (this machine's default lives
-    under /root, closed to others): the autograder refuses to grade, score 0, rather
-    than run the student's code as root."""
+    """A judge's Python that no unprivileged user can run (a Python under /root, when
+    /root is closed to others): the autograder refuses to grade, score 0, rather than
+    run the student's code as root. The Python is this one reached through a folder
+    closed to others, whatever the permissions of the folders it lives in, so the
+    judge's own sys.executable (which starts the children) is closed too."""
     zip_path, student = built("05")
     root = tmp_path / "closed"
-    (root / "bin").mkdir(parents=True)
+    root.mkdir()
     os.chmod(root, 0o700)
-    python = root / "bin" / "python"
-    python.write_text(f'#!/bin/sh\nexec "{sys.executable}" "$@"\n')
-    python.chmod(0o755)
+    (root / "env").symlink_to(sys.prefix, target_is_directory=True)  # a venv stays one
+    python = root / "env" / Path(sys.executable).relative_to(sys.prefix)
     results = run_autograder(zip_path, student, tmp_path, PYTHON=str(python))[0]
     assert results["score"] == 0 and results["tests"] == []
     assert "only as an unprivileged user" in results["output"]

@@ -95,3 +95,27 @@ def test_the_autograders_own_failure_hides_its_folders(tmp_path, monkeypatch, ca
     assert results["output"].startswith("The autograder failed (not your code; tell your")
     assert "cannot read <grading folder>: closed" in results["output"]
     assert secret in capsys.readouterr().err  # the instructor's log has it all
+
+
+def test_as_root_it_says_what_it_creates_before_creating_it(tmp_path, monkeypatch, capsys):
+    """A local run as root creates a system user and closes folders: it says so, in
+    one line, before doing either (no user is made here: make_user is replaced)."""
+    from rtpy.grading import autograder_run
+
+    events = []
+
+    def make_user(name: str) -> bool:
+        events.append(("make", capsys.readouterr().out))  # what was said before
+        return True
+
+    monkeypatch.setattr(autograder_run.os, "geteuid", lambda: 0)
+    monkeypatch.setattr(autograder_run, "make_user", make_user)
+    monkeypatch.setattr(autograder_run, "sandbox_ids", lambda user: (54321, 54321))
+    monkeypatch.setattr(autograder_run, "remove_user_files", lambda uid, gid: [])
+    monkeypatch.setattr(autograder_run, "remove_user_ipc", lambda uid: [])
+    monkeypatch.setattr(autograder_run, "close", lambda root: events.append(("close", "")))
+    confined = autograder_run.isolation(tmp_path, [])
+    (step, said), *rest = events
+    assert step == "make" and [e[0] for e in rest] == ["close"]
+    assert said.count("\n") == 1 and f"creating the system user {confined.user}" in said
+    assert "removed when the run ends" in said and f"closing {tmp_path}'s folders" in said

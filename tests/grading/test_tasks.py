@@ -239,3 +239,16 @@ def test_a_missing_map_and_a_name_outside_rtpy_are_refused(tmp_path):
     )
     with pytest.raises(ValueError, match="no module"):
         method_file("rtpy.nowhere.f", ROOT)
+
+
+def test_every_region_has_the_number_of_its_task():
+    """The stubs of a student repository name their task's number (rtpy.engine.unfinished
+    reads it back when a render reaches one): every region's method is in a task."""
+    from rtpy.grading.tasks import task_numbers
+
+    numbers = task_numbers(ROOT)
+    assert numbers[("rtpy/materials/phong.py", "Phong.BRDF")] == "8.1"
+    assert numbers[("rtpy/light.py", "PointLight.sample")] == "5.1"
+    for r in find_regions(ROOT):
+        number = numbers[(r.path.as_posix(), r.function)]
+        assert number.startswith(f"{int(r.week)}."), (r.function, number)

@@ -40,10 +40,9 @@ def test_bundled_scenes_lists_names_and_descriptions(fake_bundled):
 
 
 def test_resolve_scene(fake_bundled, tmp_path, monkeypatch):
-    assert resolve_scene("alpha") == fake_bundled / "alpha.toml"
-    assert resolve_scene("alpha.toml") == fake_bundled / "alpha.toml"
-    # an existing file wins over a bundled name
     monkeypatch.chdir(tmp_path)
+    assert resolve_scene("alpha") == fake_bundled / "alpha.toml"
+    # an existing file wins over a bundled name
     (tmp_path / "alpha.toml").write_text(MINIMAL, encoding="utf-8")
     assert resolve_scene("alpha.toml") == Path("alpha.toml")
     own = tmp_path / "own.toml"
@@ -55,6 +54,39 @@ def test_resolve_scene(fake_bundled, tmp_path, monkeypatch):
     assert "no scene file 'zta' and no bundled scene of that name" in msg
     assert "bundled: alpha, plain, zeta" in msg
     assert info.value.suggestion == "zeta" and "did you mean 'zeta'?" in msg
+
+
+@pytest.mark.parametrize("argument", ["alpha.toml", "./alpha", "sub/alpha.toml", "sub\\alpha"])
+def test_a_path_is_never_a_bundled_scene(fake_bundled, tmp_path, monkeypatch, argument):
+    """A missing file is refused (the bundled scene of its name only suggested), so a
+    render never overwrites the output of one's own scene with a bundled one's."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SceneError) as info:
+        resolve_scene(argument)
+    assert str(info.value).startswith(f"no scene file '{argument}' (a path, never a bundled")
+    assert info.value.suggestion == "alpha"
+
+
+def test_a_misspelt_path_is_offered_the_file_beside_it(fake_bundled, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "my_room.toml").write_text(MINIMAL, encoding="utf-8")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "glass_balls.toml").write_text(MINIMAL, encoding="utf-8")
+    with pytest.raises(SceneError) as info:
+        resolve_scene("my_rom.toml")
+    assert info.value.suggestion == "my_room.toml"
+    with pytest.raises(SceneError) as info:
+        resolve_scene("sub/glass_ball.toml")
+    assert info.value.suggestion == str(Path("sub") / "glass_balls.toml")
+
+
+def test_a_week_scene_is_suggested_by_its_short_name(fake_bundled, tmp_path, monkeypatch):
+    _write_scene(fake_bundled, "week08_phong", "Week 8: Phong balls")
+    monkeypatch.chdir(tmp_path)
+    for argument in ("phong", "phong.toml", "phnog"):
+        with pytest.raises(SceneError) as info:
+            resolve_scene(argument)
+        assert info.value.suggestion == "week08_phong", argument
 
 
 def test_bundled_dir_is_the_scenes_folder():
