@@ -94,7 +94,9 @@ def test_rtpy_render_stops_with_one_line_in_this_process_and_in_workers(workers,
     message = str(info.value)
     assert "\n" not in message
     assert message.startswith("week08 task: Phong.BRDF: the lobe (task 8.1")  # graders read it
-    assert message.endswith("; this scene renders now with integrator='shading' (or jittered, center)")
+    assert message.endswith(
+        "; this scene renders now with integrator='shading' (or jittered, center)"
+    )
     assert info.value.__cause__ is None and info.value.__suppress_context__
 
 
