@@ -23,12 +23,13 @@ student's exception, such as the NotImplementedError of a stub).
 Renders are compared by `assert_render_matches`: R renders with different seeds are
 cut into 8 x 8 pixel blocks and each block mean is compared with a stored reference
 (rendered by rtpy's solution, `assignments/weekNN/reference/*.npz`) by a z-test
-whose variance is the reference's noise alone (each pixel's per-sample variance,
-measured when the reference was made, for the reference's samples and for the
-submission's), Bonferroni-corrected over blocks and channels: a correct renderer
-fails with probability about ALPHA, while a missing 1/pdf, a light counted twice, a
-missing 1/r^2 or an estimator far noisier than the reference's (even one right on
-average) moves block means by many of the reference's sigmas.
+whose variance is bounded by the reference's noise (each pixel's per-sample
+variance, measured when the reference was made: the renders' own counts only
+between it and NOISE_CAP times it), Bonferroni-corrected over blocks and channels:
+a correct renderer rarely fails (at the rates docs/instructors.md states), while a
+missing 1/pdf, a light counted twice, a missing 1/r^2 or an estimator far noisier
+than the reference's (even one right on average) moves block means by many of the
+reference's sigmas.
 """
 
 from __future__ import annotations
@@ -41,6 +42,11 @@ import numpy as np
 from ..testing.statistics import BlockTest, block_z_test
 
 ALPHA = 1e-3
+# A render's own noise counts, pixel by pixel, between the reference's and this many
+# times it: never narrower than the reference's (a correct renderer's sample variance
+# from R = 4 renders is often below its true value), and never wide enough to excuse
+# an estimator far noisier than the reference's (measured: docs/instructors.md).
+NOISE_CAP = 4.0
 PROBES_FILE = "probes.py"  # assignments/weekNN/probes.py: the week's probes
 # Where a local run (grade()) draws the failed chi-square checks; None elsewhere (the
 # autograder, plain pytest): the message then says how to get the picture.
@@ -106,15 +112,22 @@ def compare(graded: dict, reference: dict, alpha: float = ALPHA) -> BlockTest:
     )
 
 
-def compare_with_reference(
-    mean: np.ndarray, samples: int, reference: dict, alpha: float = ALPHA
-) -> BlockTest:
-    """z-test of the block means of an image of `samples` samples per pixel against
-    the reference, both sides' variance from the reference's per-sample noise: what
-    the graded image spreads is never asked, so noise cannot widen the test."""
+def compare_with_reference(stack: np.ndarray, spp: int, reference: dict, alpha: float = ALPHA):
+    """z-test of the block means of R renders at spp against the reference, the noise
+    of each side from the reference's per-sample variance: the renders' own variance
+    counts pixel by pixel only between the reference's and NOISE_CAP times it, so
+    that a correct render's rare bright paths widen the test a little where they
+    fall, and a noisier estimator cannot widen it further (BlockTest)."""
+    stack = np.asarray(stack, dtype=np.float64)
     s2 = reference["s2"]
+    own = stack.var(axis=0, ddof=1) * spp
+    graded = np.clip(own, s2, NOISE_CAP * s2)
     return block_z_test(
-        mean, s2 / float(samples), reference["mean"], s2 / float(reference["samples"]), alpha
+        stack.mean(axis=0),
+        graded / float(spp * len(stack)),
+        reference["mean"],
+        s2 / float(reference["samples"]),
+        alpha,
     )
 
 
@@ -141,9 +154,8 @@ def reference_summary(probe, scene: str, render: dict, reference: dict) -> dict:
 def assert_render_matches(stack: np.ndarray, spp: int, reference: dict, what: str) -> None:
     """AssertionError naming the worst block unless the renders agree with the reference
     (and have its shape, and only finite, non-negative pixels). The noise allowed is
-    the reference's (compare_with_reference), whatever the renders' own spread: a
-    correct renderer with the reference's sampling passes at the rate ALPHA, a
-    noisier one is told so."""
+    bounded by the reference's (compare_with_reference), whatever the renders' own
+    spread: a noisier estimator fails, and is told so."""
     stack = np.asarray(stack, dtype=np.float64)
     want = reference["mean"].shape
     assert stack.ndim == 4 and stack.shape[1:] == want, (
@@ -152,7 +164,7 @@ def assert_render_matches(stack: np.ndarray, spp: int, reference: dict, what: st
     assert np.isfinite(stack).all() and (stack >= 0).all(), (
         f"{what}: some pixels are negative, infinite or NaN"
     )
-    result = compare_with_reference(stack.mean(axis=0), spp * len(stack), reference)
+    result = compare_with_reference(stack, spp, reference)
     if result.passed:
         return
     spread = noise_ratio(stack, spp, reference)
