@@ -11,7 +11,8 @@ the submission. `main()`
 2. as root, closes source/, submission/ and results/ to everyone else, and runs the
    student's code as an unprivileged user of this run's own, in a temporary folder
    that user can reach (checked: when it cannot, the autograder says it failed,
-   never the student), without network (rtpy.grading.confinement);
+   never the student), without network (rtpy.grading.confinement), its writable
+   folders small tmpfs of its own where the kernel allows (rtpy.grading.private_space);
 3. makes a work copy of repo/ without the hidden checks and the references, puts the
    submission's task files over it (rtpy.grading.autograder_submission) and makes it
    read-only to the sandbox; a task file that does not compile, or whose import
@@ -54,6 +55,7 @@ from .autograder_submission import (
 )
 from .confinement import kill_user, network_closed, remove_user_files, remove_user_ipc
 from .graders import HIDDEN, PROBES_FILE, child_config
+from .private_space import space_bounded
 from .results import gradescope_results, scrub, write_results
 from .sandbox import SANDBOX_USER, Child, Isolation, sandbox_ids
 
@@ -195,10 +197,17 @@ def isolation(root: Path, log: list[str]) -> Isolation:
     ending every process of the user ends this run's alone, even beside other runs
     on the machine), else by SANDBOX_USER (made by setup.sh), with the autograder's
     folders closed to both; without root, not by a user. Either way without network
-    where the socket filter can be installed (the log says so once where not)."""
+    where the socket filter can be installed, in a bounded private space of its own
+    where the kernel allows (the log says so once where not)."""
     socket_filter, why = network_closed(sys.executable)
     if socket_filter is None:
         log.append(f"the student's code can reach the network: {why}")
+    space, why = space_bounded()
+    if space is None:
+        log.append(
+            "the student's code may make any number of files in the shared temporary "
+            f"folders (each at most the file size limit; removed at the end): {why}"
+        )
     if not hasattr(os, "geteuid") or os.geteuid() != 0:
         log.append("not root: the student's code runs as this user (no user isolation)")
         return Isolation(socket_filter=socket_filter)
@@ -217,7 +226,7 @@ def isolation(root: Path, log: list[str]) -> Isolation:
     remove_user_files(*ids)  # an earlier run's user may have had this uid
     remove_user_ipc(ids[0])
     close(root)
-    return Isolation(user=user, socket_filter=socket_filter)
+    return Isolation(user=user, socket_filter=socket_filter, space=space)
 
 
 def close(root: Path) -> None:

@@ -16,9 +16,12 @@ folder, limits on CPU time, memory, file size and processes (setrlimit), a scrub
 environment, Python's isolated mode, and its own session. Such a child cannot signal
 the judge, read what is readable by root alone (the autograder's source: graders,
 hidden checks, references; results/) or write anything outside its folder and the
-shared temporary folders (emptied of its files at the end). On Linux a seccomp filter
-refuses it every socket but a local one (no network). Without root (a laptop) the
-same protocol, limits, filter and session, but the user is the judge's:
+shared temporary folders (emptied of its files at the end), and where the kernel
+allows, those folders and its own are small tmpfs of a mount namespace of its own
+(rtpy.grading.private_space: bounded in bytes and files, gone with the child). On
+Linux a seccomp filter refuses it every socket but a local one (no network).
+Without root (a laptop) the same protocol, limits, filter and session, but the user
+is the judge's:
 docs/instructors.md says what that leaves open.
 
 `InProcess` runs the probes in the judge's own process, through the same codec: for
@@ -87,9 +90,13 @@ class Isolation:
     processes: int | None = 16
     home: Path | None = None  # the child's HOME and TMPDIR (its user's, when it has one)
     socket_filter: object = None  # a confinement.SocketFilter installed before Python starts
+    space: object = None  # a private_space.PrivateSpace: the writable space bounded (root)
 
-    def preexec(self):
-        """The function subprocess runs in the child before it starts Python."""
+    def preexec(self, space=None, ids: tuple[int, int] | None = None, cwd: Path | None = None):
+        """The function subprocess runs in the child before it starts Python: with a
+        space (private_space.PrivateSpace.for_child), its mounts are made as root, then
+        the child becomes the user `ids` and goes back to `cwd` (its folder, mounted
+        again)."""
         import resource
 
         limits = [
@@ -103,6 +110,12 @@ class Isolation:
         socket_filter = self.socket_filter
 
         def apply() -> None:
+            if space is not None:
+                space.enter()
+                os.setgroups([])
+                os.setgid(ids[1])
+                os.setuid(ids[0])
+                os.chdir(cwd)
             for kind, value in limits:
                 if value is not None:
                     resource.setrlimit(kind, (value, value))
@@ -210,10 +223,17 @@ class Child:
         command.append(str(self.start_timeout))
         options: dict = {}
         ids = sandbox_ids(self.isolation.user)
-        if ids is not None:
+        space = self.isolation.space if ids is not None else None
+        if space is not None:  # the user is taken in preexec, after the mounts
+            python = os.path.abspath(self.python)
+            prefixes = {Path(p).parents[1] for p in (python, os.path.realpath(python))}
+            keep = [self.work, config_path, *prefixes]
+            space = space.for_child(keep, home, ids)
+        elif ids is not None:
             options.update(user=ids[0], group=ids[1], extra_groups=[])
         if os.name == "posix":
-            options.update(start_new_session=True, preexec_fn=self.isolation.preexec())
+            preexec = self.isolation.preexec(space, ids, self.work)
+            options.update(start_new_session=True, preexec_fn=preexec)
         self._proc = subprocess.Popen(
             command,
             cwd=self.work,

@@ -33,9 +33,11 @@ ending every process of that user ends that run's alone.
 Issue 44's attacks have checks of their own: a child that stops reading its requests
 and a child that stops every newer process (a helper of the judge's) end within the
 run's time limit; files written to /tmp, /var/tmp, /dev/shm and /run/lock do not
-outlive the run; a connection to a listener on 127.0.0.1 is refused and the listener
-gets nothing; reply bombs (200 MiB and 32 MiB of `[{},{},...]`) leave the judge's peak
-memory, which it prints, under 1 GiB; a symbolic link loop named in a fake traceback
+outlive the run, and 100k files in /tmp and /dev/shm and 256 MiB in /dev/shm are
+bounded by the sandbox's private space (where the judge has one) and gone after it;
+a connection to a listener on 127.0.0.1 is refused and the listener gets nothing;
+reply bombs (200 MiB and 32 MiB of `[{},{},...]`) leave the judge's peak memory,
+which it prints, under 1 GiB; a symbolic link loop named in a fake traceback
 is not the autograder's failure.
 
 Week 05 gets every attack; the other weeks the patching (all at once), forging and leaking
@@ -770,6 +772,30 @@ _shm = ctypes.CDLL(None).shmget(0, 4096, 0o1600)  # System V shared memory: kept
 if _shm >= 0:
     _attack_mark("@NAME@-shm-%d" % _shm)
 """
+FILL_TEMP = """
+import os
+_size = 0
+try:
+    for _k in range(8):  # 256 MiB at most, each file within the file size limit
+        with open(os.path.join("/dev/shm", @LEFT@ + "-fill-%d" % _k), "wb") as f:
+            for _ in range(32):
+                f.write(b"x" * 2**20)
+                f.flush()
+                _size += 2**20
+except OSError:
+    pass
+_attack_mark("@NAME@-bytes-%d" % _size)
+for _folder in ("/tmp", "/dev/shm"):
+    _path, _n = os.path.join(_folder, @LEFT@ + "-many"), 0
+    try:
+        os.makedirs(_path, exist_ok=True)
+        while _n < 100000:
+            open(os.path.join(_path, str(_n)), "w").close()
+            _n += 1
+    except OSError:
+        pass
+    _attack_mark("@NAME@-files%s-%d" % (_folder.replace("/", "_"), _n))
+"""
 NETWORK = """
 import socket
 
@@ -1040,6 +1066,23 @@ def nothing_left(outcome: Outcome, ctx: Context) -> None:
     assert not kept, f"the sandbox's shared memory outlived the run: {kept}"
 
 
+def space_bounded_and_gone(outcome: Outcome, ctx: Context) -> None:
+    """100k files in /tmp and /dev/shm and 256 MiB in /dev/shm: where the judge gives the
+    sandbox its private space, each child made at most FILES files and MEGABYTES MiB
+    there; wherever they went, none of them is left."""
+    from rtpy.grading.private_space import FILES, MEGABYTES
+
+    made = [m.rsplit("-", 2) for m in outcome.marks if "-files_" in m or "-bytes-" in m]
+    files = [int(n) for what, n, _ in made if what.endswith(("files_tmp", "files_dev_shm"))]
+    sizes = [int(n) for what, n, _ in made if what.endswith("bytes")]
+    assert files and sizes, f"the attack did not say what it made: {outcome.marks}"
+    if "may make any number of files" not in outcome.stdout:  # the space is bounded
+        assert max(files) < FILES, f"files made in one folder: {files}"
+        assert max(sizes) <= MEGABYTES * 2**20, f"bytes made in /dev/shm: {sizes}"
+    left = [path for folder in ("/tmp", "/dev/shm") for path in Path(folder).glob(f"{ctx.left}-*")]
+    assert not left, f"the sandbox's files outlived the run: {left[:5]}"
+
+
 def no_connection(outcome: Outcome, ctx: Context) -> None:
     assert not [m for m in outcome.marks if "-connected-" in m], "a connection was made"
     assert [m for m in outcome.marks if "-refused-" in m], outcome.marks
@@ -1108,6 +1151,7 @@ ATTACKS = [
     Attack("stop_reading", append_code(STOP_READING), check=in_time),
     Attack("stop_the_killer", append_code(STOP_THE_KILLER), needs_user=True, check=stopped_nothing),
     Attack("write_everywhere", append_code(WRITE_EVERYWHERE), needs_user=True, check=nothing_left),
+    Attack("fill_temp", append_code(FILL_TEMP), needs_user=True, check=space_bounded_and_gone),
     Attack("network", append_code(NETWORK), check=no_connection),
     Attack("reply_bomb", append_code(REPLY_BOMB), check=judge_memory_bounded),
     Attack("loop_in_traceback", append_code(LOOP_IN_TRACEBACK), check=the_judge_stood),
@@ -1270,7 +1314,9 @@ METADATA = {"users": [{"email": METADATA_MARK, "name": "A Student"}], "previous_
 def bench(request):
     """Starts, in order, every run the selected tests need (the untouched repository of
     a week first), so that they overlap with the tests that wait for them."""
-    shm = Path("/dev/shm")  # memory: a run's thousand files are made and removed fast
+    # memory: a run's thousand files are made and removed fast; as root, /run, which
+    # the sandbox's private space does not cover (the marks must reach this process)
+    shm = Path("/run" if SANDBOXED else "/dev/shm")
     there = shm if shm.is_dir() and os.access(shm, os.W_OK) else None
     base = Path(tempfile.mkdtemp(prefix="rtpy-attacks-", dir=there))
     os.chmod(base, 0o755)  # like /autograder: the sandbox user may pass, as on Gradescope

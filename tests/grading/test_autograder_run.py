@@ -78,6 +78,22 @@ def test_where_the_network_stays_open_the_instructor_is_told_once(tmp_path, monk
     assert not [ln for ln in log if "network" in ln]
 
 
+def test_where_the_writable_space_is_not_bounded_the_instructor_is_told_once(tmp_path, monkeypatch):
+    from rtpy.grading import autograder_run as run
+
+    monkeypatch.setattr(run, "network_closed", lambda python: ("a filter", ""))
+    monkeypatch.setattr(run, "space_bounded", lambda: (None, "the kernel refused (EPERM)"))
+    monkeypatch.setattr(os, "geteuid", lambda: 1000, raising=False)
+    log: list[str] = []
+    assert run.isolation(tmp_path, log).space is None
+    told = [ln for ln in log if "number of files" in ln]
+    assert len(told) == 1 and told[0].endswith("the kernel refused (EPERM)"), log
+    monkeypatch.setattr(run, "space_bounded", lambda: ("a space", ""))
+    log.clear()
+    run.isolation(tmp_path, log)
+    assert not [ln for ln in log if "number of files" in ln]
+
+
 def test_the_autograders_own_failure_hides_its_folders(tmp_path, monkeypatch, capsys):
     from rtpy.grading import autograder_run as run
 

@@ -716,6 +716,64 @@ def test_noise_aware_comparison_accepts_noise_and_rejects_bias():
     assert not compare(a, brighter).passed
 
 
+def reference_like(reference: dict, spp: int, renders: int, rng, spread: float = 1.0):
+    """`renders` simulated renders at spp with the reference's mean and `spread` times
+    its noise, never negative: each pixel a gamma variable of that mean and variance."""
+    import numpy as np
+
+    mean, var = reference["mean"], (spread**2) * reference["s2"] / spp
+    lit = (mean > 0) & (var > 0)
+    shape = np.where(lit, mean**2 / np.where(lit, var, 1.0), 1.0)
+    scale = np.where(lit, var / np.where(lit, mean, 1.0), 0.0)
+    return np.stack([np.where(lit, rng.gamma(shape, scale), mean) for _ in range(renders)])
+
+
+NOISY_REFERENCES = [("05", "direct_area_light"), ("08", "path_three_balls")]
+
+
+def render_reference(week: str, name: str) -> dict:
+    from rtpy.grading.graders import load_reference
+
+    return load_reference(ROOT / f"assignments/week{week}/reference/{name}.npz")
+
+
+@pytest.mark.parametrize("week, name", NOISY_REFERENCES)
+def test_the_render_verdict_passes_the_reference_noise(week, name):
+    """assert_render_matches: renders right on average with the reference's noise pass
+    (of 300 sets, at most 3 fail: ALPHA = 1e-3 makes 0.3 expected, and more than 3 has
+    probability 4e-4)."""
+    import numpy as np
+
+    from rtpy.grading.graders import assert_render_matches
+
+    reference, spp, renders = render_reference(week, name), 8, 4  # the graders' settings
+    rng = np.random.default_rng(4408)
+    failed = 0
+    for _ in range(300):
+        try:
+            assert_render_matches(reference_like(reference, spp, renders, rng), spp, reference, "x")
+        except AssertionError:
+            failed += 1
+    assert failed <= 3, f"{failed} of 300 correct renders failed"
+
+
+@pytest.mark.parametrize("week, name", NOISY_REFERENCES)
+def test_the_render_verdict_fails_huge_zero_mean_noise(week, name):
+    """Renders right on average but 10 times noisier than the reference (a weight that
+    is huge where it should be small) fail every time, though their own spread would
+    mostly excuse them; the message says they are too noisy."""
+    import numpy as np
+
+    from rtpy.grading.graders import assert_render_matches
+
+    reference, spp, renders = render_reference(week, name), 8, 4
+    rng = np.random.default_rng(4409)
+    for _ in range(20):
+        noisy = reference_like(reference, spp, renders, rng, spread=10.0)
+        with pytest.raises(AssertionError, match="times as noisy as the reference"):
+            assert_render_matches(noisy, spp, reference, "huge zero-mean noise")
+
+
 def test_graders_that_cannot_load_score_zero(tmp_path, capsys, monkeypatch):
     """A grader folder whose module fails to import (a syntax error in rtpy, say)
     gives score 0 with the error, and exit status 1 — never 0 of 0 as a pass."""
