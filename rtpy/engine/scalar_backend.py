@@ -42,13 +42,15 @@ def render_unit(
         spp = 1 if integrator.uses_center_ray else integrator.settings.spp
         source = SAMPLERS[sampler](seed, spp, camera.defocus_angle > 0.0, fallback=source)
         start = source.start_pixel_sample
+    width = camera.width
     with use_generator(source):
         for j in range(unit.y0, unit.y1):
             for i in range(unit.x0, unit.x1):
                 r = g = b = 0.0
+                pixel = j * width + i
                 for index in samples:
-                    if start:
-                        start(j * camera.width + i, index)
+                    if start is not None:
+                        start(pixel, index)
                     c = radiance(get_ray(i, j), scene)
                     r += c.e0
                     g += c.e1
