@@ -21,6 +21,7 @@ from ..sampling import make_generator, use_generator
 from ..scene import Scene
 from .backend import Backend
 from .plan import Unit
+from .sphere_lights import prepared_scene
 
 __all__ = ["ScalarBackend", "render_unit"]
 
@@ -75,7 +76,7 @@ class ScalarBackend(Backend):
         settings = self.settings
         return partial(
             render_unit,
-            self.scene,
+            prepared_scene(self.scene),
             self.camera,
             integrator,
             settings.seed,
