@@ -63,7 +63,8 @@ def render_unit(
 class ScalarBackend(Backend):
     """The readable reference: one Ray at a time through the scalar integrators, in
     units of at most 4,096 paths (a fraction of a second to a few seconds each).
-    Registered as "scalar" by rtpy.engine.backends."""
+    Sphere lights are sampled by rtpy.engine.sphere_lights (the course's numbers,
+    computed per component). Registered as "scalar" by rtpy.engine.backends."""
 
     name = "scalar"
     paths_per_unit = 4096
