@@ -10,7 +10,7 @@ an AreaLight whose shape is a Sphere (prepared_scene); a sphere light it could n
 match bit for bit on a probe (a Sphere subclass, an edited Sphere) keeps the course's
 own method. tests/engine/test_sphere_lights.py checks the floats against the course's.
 It takes the in-process scalar render of week08_three_balls from 1.15x to 1.09x of
-09f919b's CPU time (docs/performance.md#scalar-backend-against-an-older-commit).
+the CPU time of issue 42's bar (docs/performance.md#scalar-backend-against-an-older-commit).
 """
 
 from __future__ import annotations
