@@ -7,10 +7,11 @@ Vec3 algebra, which makes about fifteen short-lived vectors per sample; SphereLi
 computes the same floats, operation for operation, on three plain numbers each and
 builds only the vectors it returns. The scalar backend renders with it in place of
 an AreaLight whose shape is a Sphere (prepared_scene); a sphere light it could not
-match bit for bit on a probe (a Sphere subclass, an edited Sphere) keeps the course's
-own method. tests/engine/test_sphere_lights.py checks the floats against the course's.
-It takes the in-process scalar render of week08_three_balls from 1.15x to 1.09x of
-the CPU time of issue 42's bar (docs/performance.md#scalar-backend-against-an-older-commit).
+match bit for bit on probes (a Sphere subclass, an edited Sphere or AreaLight) keeps
+the course's own method. tests/engine/test_sphere_lights.py checks the floats against
+the course's. It takes the in-process scalar render of week08_three_balls from 1.15x
+to 1.09x of the CPU time of issue 42's bar
+(docs/performance.md#scalar-backend-against-an-older-commit).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import math
 
 from ..hit_info import HitInfo
 from ..light import AreaLight, LightSample
-from ..sampling import generator
+from ..sampling import generator, use_generator
 from ..scene import Scene
 from ..sphere import Sphere
 from ..vec3 import Vec3
@@ -100,22 +101,32 @@ PROBES = [
 ]
 
 
-def numbers(sample) -> tuple | None:
-    """The floats of a sample_hit result: direction, pdf, t, point, normal."""
+class Draws:
+    """A generator that gives the numbers it was made with, in turn."""
+
+    def __init__(self, *numbers: float) -> None:
+        self.random = iter(numbers).__next__
+
+
+def numbers(sample: LightSample | None) -> tuple | None:
+    """The floats of a light sample: direction, distance, radiance, pdf, point."""
     if sample is None:
         return None
-    direction, pdf, hit = sample
-    return direction.tolist(), pdf, hit.t, hit.point.tolist(), hit.normal.tolist()
+    s = sample
+    return s.direction.tolist(), s.distance, s.radiance.tolist(), s.pdf, s.point.tolist()
 
 
 def matches(light: AreaLight) -> bool:
-    """True when sample_sphere_hit gives light.shape.sample_hit's numbers on PROBES."""
-    sphere = light.shape
-    c, r = sphere.center, sphere.radius
+    """True when SphereLight(light) samples the numbers light.sample does on PROBES."""
+    ours = SphereLight(light)
+    c, r = light.shape.center, light.shape.radius
     for (x, y, z), r1, r2 in PROBES:
         p = Vec3(c.e0 + x * r, c.e1 + y * r, c.e2 + z * r)
-        expected = numbers(sphere.sample_hit(p, r1, r2))
-        if expected is None or numbers(sample_sphere_hit(sphere, p, r1, r2)) != expected:
+        with use_generator(Draws(r1, r2)):
+            expected = numbers(light.sample(p))
+        with use_generator(Draws(r1, r2)):
+            got = numbers(ours.sample(p))
+        if expected is None or got != expected:
             return False
     return True
 

@@ -10,9 +10,10 @@ from hypothesis import strategies as st
 import rtpy
 from rtpy.engine.plan import Unit
 from rtpy.engine.scalar_backend import ScalarBackend, render_unit
-from rtpy.engine.sphere_lights import SphereLight, prepared_scene, sample_sphere_hit
+from rtpy.engine.sphere_lights import Draws, SphereLight, prepared_scene, sample_sphere_hit
 from rtpy.light import AreaLight
 from rtpy.materials import DiffuseLight, Lambertian
+from rtpy.sampling import generator, use_generator
 from rtpy.scene import Scene
 from rtpy.sphere import Sphere
 from rtpy.vec3 import Color, Vec3
@@ -93,6 +94,20 @@ def test_a_sphere_whose_sampling_differs_keeps_the_courses(monkeypatch):
     scene = lit_scene(Sphere(Vec3(0.0, 1.0, -1.0), 0.3, DiffuseLight(Color(4.0, 4.0, 4.0))))
     course = Sphere.sample_hit
     monkeypatch.setattr(Sphere, "sample_hit", lambda s, p, r1, r2: course(s, p, r2, r1))
+    assert prepared_scene(scene) is scene
+
+
+def test_a_light_whose_sampling_differs_keeps_the_courses(monkeypatch):
+    """An edited AreaLight.sample (here: the draws swapped) is what renders."""
+    scene = lit_scene(Sphere(Vec3(0.0, 1.0, -1.0), 0.3, DiffuseLight(Color(4.0, 4.0, 4.0))))
+    assert prepared_scene(scene) is not scene
+    course = AreaLight.sample
+
+    def swapped(light, p):
+        with use_generator(Draws(*reversed([generator().random() for _ in range(2)]))):
+            return course(light, p)
+
+    monkeypatch.setattr(AreaLight, "sample", swapped)
     assert prepared_scene(scene) is scene
 
 
