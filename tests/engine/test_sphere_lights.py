@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import rtpy
+import rtpy.sphere
 from rtpy.engine.plan import Unit
 from rtpy.engine.scalar_backend import ScalarBackend, render_unit
 from rtpy.engine.sphere_lights import Draws, SphereLight, prepared_scene, sample_sphere_hit
@@ -108,6 +109,18 @@ def test_a_light_whose_sampling_differs_keeps_the_courses(monkeypatch):
             return course(light, p)
 
     monkeypatch.setattr(AreaLight, "sample", swapped)
+    assert prepared_scene(scene) is scene
+
+
+def test_a_course_that_cannot_sample_yet_keeps_its_light(monkeypatch):
+    """Before the week that writes unit_vector, the scene still renders with the
+    course's light (which raises only if a render samples it)."""
+
+    def unwritten(v):
+        raise NotImplementedError("unit_vector")
+
+    monkeypatch.setattr(rtpy.sphere, "unit_vector", unwritten)
+    scene = lit_scene(Sphere(Vec3(0.0, 1.0, -1.0), 0.3, DiffuseLight(Color(4.0, 4.0, 4.0))))
     assert prepared_scene(scene) is scene
 
 
