@@ -21,6 +21,7 @@ from ..sampling import make_generator, use_generator
 from ..scene import Scene
 from .backend import Backend
 from .plan import Unit
+from .sphere_lights import prepared_scene
 
 __all__ = ["ScalarBackend", "render_unit"]
 
@@ -42,13 +43,15 @@ def render_unit(
         spp = 1 if integrator.uses_center_ray else integrator.settings.spp
         source = SAMPLERS[sampler](seed, spp, camera.defocus_angle > 0.0, fallback=source)
         start = source.start_pixel_sample
+    width = camera.width
     with use_generator(source):
         for j in range(unit.y0, unit.y1):
             for i in range(unit.x0, unit.x1):
                 r = g = b = 0.0
+                pixel = j * width + i
                 for index in samples:
-                    if start:
-                        start(j * camera.width + i, index)
+                    if start is not None:
+                        start(pixel, index)
                     c = radiance(get_ray(i, j), scene)
                     r += c.e0
                     g += c.e1
@@ -60,7 +63,8 @@ def render_unit(
 class ScalarBackend(Backend):
     """The readable reference: one Ray at a time through the scalar integrators, in
     units of at most 4,096 paths (a fraction of a second to a few seconds each).
-    Registered as "scalar" by rtpy.engine.backends."""
+    Sphere lights are sampled by rtpy.engine.sphere_lights (the course's numbers,
+    computed per component). Registered as "scalar" by rtpy.engine.backends."""
 
     name = "scalar"
     paths_per_unit = 4096
@@ -73,7 +77,7 @@ class ScalarBackend(Backend):
         settings = self.settings
         return partial(
             render_unit,
-            self.scene,
+            prepared_scene(self.scene),
             self.camera,
             integrator,
             settings.seed,
