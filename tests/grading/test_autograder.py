@@ -406,7 +406,7 @@ def test_a_typo_costs_only_its_files_tasks(built, tmp_path, typo):
     light = broken / "rtpy" / "light.py"
     light.write_text(light.read_text() + TYPOS[typo])
     results, _ = run_autograder(
-        zip_path, broken, tmp_path, RTPY_AUTOGRADER_IMPORT_TIMEOUT=3,
+        zip_path, broken, tmp_path, RTPY_AUTOGRADER_IMPORT_TIMEOUT=8,
         RTPY_AUTOGRADER_TOTAL_TIMEOUT=TOTAL_TIMEOUT,
     )  # fmt: skip
     assert results["score"] == expected["score"], results["output"]
