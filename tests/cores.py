@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 import traceback
 from collections.abc import Callable
 from typing import Any, TypeVar
@@ -24,7 +25,10 @@ def on_every_core(function: Callable[[T], R], items: list[T]) -> list[R]:
     ones listed first keep both cores busy to the end."""
     workers = min(len(items), os.cpu_count() or 1)
     if workers > 1 and "fork" in multiprocessing.get_all_start_methods():
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
+        # SIGTERM as by default in the workers, whatever handler the tests' process
+        # has: the pool ends them with it
+        context = multiprocessing.get_context("fork")
+        with context.Pool(workers, signal.signal, (signal.SIGTERM, signal.SIG_DFL)) as pool:
             return pool.map(function, items, chunksize=1)
     return [function(x) for x in items]
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -106,7 +107,9 @@ def test_the_autograders_own_failure_hides_its_folders(tmp_path, monkeypatch, ca
         raise run.Unconfined(f"cannot read {secret}: closed")
 
     monkeypatch.setattr(run, "grade_submission", fail)
+    before = signal.getsignal(signal.SIGTERM)
     assert run.main() == 0
+    assert signal.getsignal(signal.SIGTERM) is before  # the caller's handler, as it was
     results = json.loads((tmp_path / "results" / "results.json").read_text())
     assert results["output"].startswith("The autograder failed (not your code; tell your")
     assert "cannot read <grading folder>: closed" in results["output"]
