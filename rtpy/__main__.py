@@ -8,6 +8,7 @@ from .engine import memory, signals
 
 signals.defer()  # rtpy/__init__.py did it already when run as `python -m rtpy`
 memory.small_pages_for_numpy()  # this process is rtpy's own: before numpy is imported
+memory.tune_for_large_scenes()  # and a render's memory policy (never for a library call)
 
 from .cli.main import main  # noqa: E402 (imported with the signals deferred)
 

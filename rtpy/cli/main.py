@@ -257,12 +257,9 @@ def check_outputs(args: argparse.Namespace, scene, path: Path) -> tuple:
 
 
 def _render(args: argparse.Namespace) -> int:
-    from ..engine.memory import tune_for_large_scenes
     from ..engine.render_state import ResumeError
     from ..io.bundled import resolve_scene
     from ..io.scene_file import SceneError, SceneWarning, load_scene
-
-    tune_for_large_scenes()
 
     try:
         load_plugins(args.plugin)
@@ -410,3 +407,13 @@ def _run_command(args: argparse.Namespace) -> int:
 
 if __name__ == "__main__":
     sys.exit(main())
+
+
+def console() -> int:
+    """The `rtpy` console script: a process of rtpy's own, its memory tuned as
+    `python -m rtpy` tunes it (rtpy.engine.memory); main() called from Python is not."""
+    from ..engine import memory
+
+    memory.small_pages_for_numpy()
+    memory.tune_for_large_scenes()
+    return main()

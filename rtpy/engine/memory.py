@@ -8,8 +8,9 @@ started. The module imports `resource` only when asked (Windows has none).
 Tuning, for rtpy's own processes only (`python -m rtpy` and its workers; a library
 call such as rtpy.render changes nothing process-wide): it took the first render of
 the 1M-triangle OBJ scene from 2.95 s to 2.2 s and of its PLY twin from 1.9 s to
-1.4 s (docs/performance.md#scene-size). The command line calls small_pages_for_numpy()
-before numpy is imported and tune_for_large_scenes() before it loads a scene: glibc
+1.4 s (docs/performance.md#scene-size). The command line's process (`python -m rtpy`, the
+`rtpy` script; not rtpy.cli.main.main called from Python) calls both at its start,
+before numpy is imported: glibc
 keeps freed memory for the next array (reuse_freed_memory), numpy backs its arrays
 with ordinary pages, and the workers it starts get both through the documented
 environment variables. A render that forks its workers from such a process hands the

@@ -76,8 +76,8 @@ print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
 """
 
 
-def child_says(code: str, mode: str) -> str:
-    """What a fresh process running `code` with argument `mode` prints (the settings
+def child_says(code: str, *mode: str) -> str:
+    """What a fresh process running `code` with arguments `mode` prints (the settings
     are process-wide), under glibc's and numpy's own defaults: no malloc thresholds or
     huge-page choice taken from the environment."""
     env = {
@@ -86,7 +86,7 @@ def child_says(code: str, mode: str) -> str:
         if not k.startswith(("MALLOC_", "GLIBC_TUNABLES", "NUMPY_MADVISE_HUGEPAGE"))
     }
     return subprocess.run(
-        [sys.executable, "-c", code, mode], capture_output=True, text=True, check=True, env=env
+        [sys.executable, "-c", code, *mode], capture_output=True, text=True, check=True, env=env
     ).stdout.strip()
 
 
@@ -212,6 +212,11 @@ scene, camera = rtpy.Scene([ball], sky=True), rtpy.Camera(width=16)
 for backend in ("scalar", "numpy"):
     for workers in (1, 2):
         rtpy.render(scene, camera=camera, spp=2, backend=backend, workers=workers)
+if sys.argv[-1] == "main":  # the command line's main() called from Python, too
+    from rtpy.cli.main import main
+
+    out = os.path.join(sys.argv[-2], "out.png")
+    main(["render", "cornell", "--width", "8", "--spp", "1", "-j", "2", "-q", "-o", out])
 names = set(os.environ) | set(environment)
 changed = sorted(k for k in names if os.environ.get(k) != environment.get(k))
 print(json.dumps([calls, changed]))
@@ -223,5 +228,14 @@ def test_a_library_render_changes_nothing_process_wide():
     """import rtpy; rtpy.render(...) in a fresh interpreter, either backend, with and
     without workers, sets no allocator option and no environment variable."""
     calls, changed = json.loads(child_says(LIBRARY_CALL_CHILD, "library"))
+    assert calls == []
+    assert changed == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="Windows cannot fork")
+def test_the_command_lines_main_called_from_python_changes_nothing_either(tmp_path):
+    """rtpy.cli.main.main(["render", ...]) in someone else's interpreter: the tuning
+    is the command-line process's own (rtpy/__main__.py, the `rtpy` script)."""
+    calls, changed = json.loads(child_says(LIBRARY_CALL_CHILD, str(tmp_path), "main"))
     assert calls == []
     assert changed == []
