@@ -23,6 +23,7 @@ when the render starts. A worker renders one unit at a time whatever its threads
 from __future__ import annotations
 
 import logging
+import os
 import pickle
 import re
 import sys
@@ -193,7 +194,12 @@ class DaskCluster(Executor):
         if isinstance(self.cluster, distributed.Client):
             return self.cluster, _nothing
         if self.cluster == "local":
-            cluster = _local_cluster(distributed, self.workers)
+            environment = dict(os.environ)  # Dask's nanny sets its workers' variables here
+            try:
+                cluster = _local_cluster(distributed, self.workers)
+            finally:  # started: this process's environment as it was (a library call)
+                os.environ.clear()
+                os.environ.update(environment)
             try:
                 with signals.held():
                     client = distributed.Client(cluster)

@@ -263,13 +263,16 @@ def import_problem(child, files: list[str], work: Path) -> tuple[str | None, str
         return None, str(err)
     except ChildFailure as err:
         text = child.output()
+        dump = "Timeout (" in text and "Traceback" not in text  # faulthandler's
+        frames = [(_relative(path, work), line) for path, line in FRAME.findall(text)]
+        if dump:  # faulthandler lists the most recent call first, a traceback last
+            frames.reverse()
         blamed = None
-        for path, line in FRAME.findall(text):
-            rel = _relative(path, work)
+        for rel, line in frames:
             if rel in files:
-                blamed = (rel, line)
+                blamed = (rel, line)  # the innermost task file
         lines = [ln.strip() for ln in text.strip().splitlines() if ln.strip()]
-        if "Timeout (" in text and "Traceback" not in text:  # faulthandler's dump
+        if dump:
             what = f"importing it did not finish within {child.start_timeout:g} s"
         else:
             what = printable(lines[-1], 300) if lines and "Traceback" in text else str(err)

@@ -202,9 +202,13 @@ def test_a_worker_killed_mid_render_changes_nothing(dask_cluster, small_units, t
 
 
 def test_a_local_cluster_gives_the_image_of_two_local_workers(small_units, two_workers_here):
+    """... and leaves this process's environment as it was (Dask's nanny sets its
+    workers' variables, MALLOC_TRIM_THRESHOLD_ among them, in the process)."""
+    environment = dict(os.environ)
     image = rtpy.render(rtpy.load_scene(SCENE), cluster="local", workers=2, **RENDER)
     assert image.stats["executor"] == "dask" and image.stats["workers"] == 2
     np.testing.assert_array_equal(image.linear, two_workers_here)
+    assert dict(os.environ) == environment
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
