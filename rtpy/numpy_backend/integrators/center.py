@@ -6,22 +6,18 @@ import numpy as np
 
 from ..arrays import max3
 from ..scene import BatchScene
-from .integrator import BatchIntegrator
+from .integrator import BatchIntegrator, first_hits
 
 
 def flat_color(o: np.ndarray, d: np.ndarray, scene: BatchScene) -> np.ndarray:
     """(N, 3): emitted radiance where a ray hits an emitter's emitting face, else the
     albedo (texture value) of the surface hit, else the background."""
     out = np.empty((len(o), 3))
-    obj, t = scene.find_intersection(o, d)
-    miss = obj < 0
-    out[miss] = scene.background_radiance(d[miss])
-    h = np.flatnonzero(~miss)
-    if h.size == 0:
+    found = first_hits(o, d, scene, out)
+    if found is None:
         return out
-    hits = scene.hit_batch(obj[h], o[h], d[h], t[h])
+    h, hits, ids = found
     materials = scene.materials
-    ids = scene.material_id[obj[h]]
     color = np.zeros((h.size, 3))
     flat = np.ones(h.size, dtype=bool)
     em = np.flatnonzero(materials.is_emitter[ids])

@@ -35,3 +35,16 @@ class BatchIntegrator:
         self, o: np.ndarray, d: np.ndarray, scene: BatchScene, rng: np.random.Generator
     ) -> np.ndarray:
         raise NotImplementedError
+
+
+def first_hits(o: np.ndarray, d: np.ndarray, scene: BatchScene, out: np.ndarray):
+    """The first hits of the rays (o, d): out's rows of the rays that miss get the
+    background; (indices of the rays that hit, their HitBatch, their material ids),
+    or None when none hits."""
+    obj, t = scene.find_intersection(o, d)
+    miss = obj < 0
+    out[miss] = scene.background_radiance(d[miss])
+    h = np.flatnonzero(~miss)
+    if h.size == 0:
+        return None
+    return h, scene.hit_batch(obj[h], o[h], d[h], t[h]), scene.material_id[obj[h]]

@@ -8,7 +8,7 @@ import numpy as np
 from ..arrays import add_rows
 from ..sampler import first_hit_generator
 from .direct_lighting import light_sample_estimate
-from .integrator import BatchIntegrator
+from .integrator import BatchIntegrator, first_hits
 
 
 class ShadingIntegrator(BatchIntegrator):
@@ -20,15 +20,11 @@ class ShadingIntegrator(BatchIntegrator):
 
     def compute_scattering(self, o, d, scene, rng):
         out = np.zeros((len(o), 3))
-        obj, t = scene.find_intersection(o, d)
-        miss = obj < 0
-        out[miss] = scene.background_radiance(d[miss])
-        h = np.flatnonzero(~miss)
-        if h.size == 0:
+        found = first_hits(o, d, scene, out)
+        if found is None:
             return out
-        hits = scene.hit_batch(obj[h], o[h], d[h], t[h])
+        h, hits, ids = found
         materials = scene.materials
-        ids = scene.material_id[obj[h]]
         em = np.flatnonzero(materials.is_emitter[ids])
         if em.size:
             emitted = materials.emitting(ids[em], hits.take(em))
