@@ -52,8 +52,9 @@ class PixelSums:
 
     @property
     def done(self) -> bool:
-        """Every pass of the plan is added."""
-        return self.passes == len(self.plan.passes)
+        """Every pass of the plan is added, as `total` says (a Ctrl-C between adding
+        the last pass and counting it in `passes` leaves the render finished)."""
+        return self.plan.passes_holding(self.whole_samples()) == len(self.plan.passes)
 
     def holds(self, unit: Unit) -> bool:
         """The unit's sums are added (a resumed render need not render it)."""

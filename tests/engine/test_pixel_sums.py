@@ -126,6 +126,7 @@ def test_a_ctrl_c_at_any_bytecode_leaves_whole_passes_and_a_state_to_resume(seed
         counts = sums.total[..., 3]
         assert (counts == counts.flat[0]).all(), f"cut at bytecode {opcode}"
         assert plan.passes_holding(sums.whole_samples()) is not None
+        assert sums.done == (sums.whole_samples() == plan.samples_after(len(plan.passes)))
         resumed = PixelSums(plan, sums.total.copy(), sums.current())
         for unit, s in order:
             resumed.add(unit, s)

@@ -48,18 +48,41 @@ DEFER_LINE = next(  # the line of rtpy/__init__.py that installs the handlers
 )
 
 
+# The modules imported before rtpy/__init__.py calls signals.defer(): the engine
+# package, rtpy.engine.signals and what it imports.
+BEFORE_DEFER = [INIT] + [
+    INIT.parent / "engine" / f for f in ("__init__.py", "signals.py", "exit_status.py")
+]
+
+
 def before_handlers(err: str) -> bool:
     """The traceback on stderr is from before rtpy installs its handlers: no frame in
     rtpy but the module-level code of rtpy/__init__.py up to signals.defer() and of
-    rtpy/engine/signals.py (Python's own KeyboardInterrupt, while the interpreter starts)."""
+    the modules imported before it (Python's own KeyboardInterrupt, while the
+    interpreter starts)."""
     for path, line, function in FRAME.findall(err):
         if not path.startswith(RTPY_FILES):
             continue
-        if function != "<module>" or path not in (str(INIT), str(INIT.parent / "signals.py")):
+        if function != "<module>" or path not in map(str, BEFORE_DEFER):
             return False
         if path == str(INIT) and int(line) > DEFER_LINE:
             return False
     return True
+
+
+def test_a_traceback_is_told_from_before_the_handlers_by_its_frames():
+    """The interpreter's KeyboardInterrupt while `import rtpy` reaches signals.defer()
+    is told apart from one later (the random-moment runs accept only the first)."""
+    assert all(path.is_file() for path in BEFORE_DEFER)
+
+    def frame(path, line):
+        return f'  File "{path}", line {line}, in <module>\n'
+
+    signals_py, exit_status_py = BEFORE_DEFER[2:]
+    early = frame(INIT, DEFER_LINE - 1) + frame(signals_py, 1) + frame(exit_status_py, 1)
+    assert before_handlers("Traceback (most recent call last):\n" + early)
+    late = frame(INIT, DEFER_LINE + 1) + frame(INIT.parent / "camera.py", 1)
+    assert not before_handlers("Traceback (most recent call last):\n" + late)
 
 
 # --- the handlers, in this process ------------------------------------------------
