@@ -21,7 +21,7 @@ from ..sampling import make_generator, use_generator
 from ..scene import Scene
 from .backend import Backend
 from .plan import Unit
-from .sphere_lights import prepared_scene
+from .prepared_scene import prepared_scene
 
 __all__ = ["ScalarBackend", "render_unit"]
 
@@ -63,8 +63,8 @@ def render_unit(
 class ScalarBackend(Backend):
     """The readable reference: one Ray at a time through the scalar integrators, in
     units of at most 4,096 paths (a fraction of a second to a few seconds each).
-    Sphere lights are sampled by rtpy.engine.sphere_lights (the course's numbers,
-    computed per component). Registered as "scalar" by rtpy.engine.backends."""
+    Spheres are hit and sphere lights sampled per component, the course's numbers
+    (rtpy.engine.prepared_scene). Registered as "scalar" by rtpy.engine.backends."""
 
     name = "scalar"
     paths_per_unit = 4096

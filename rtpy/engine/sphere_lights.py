@@ -6,27 +6,24 @@ and normal there) runs at every bounce of every path. The course writes it as pl
 Vec3 algebra, which makes about fifteen short-lived vectors per sample; SphereLight
 computes the same floats, operation for operation, on three plain numbers each and
 builds only the vectors it returns. The scalar backend renders with it in place of
-an AreaLight whose shape is a Sphere (prepared_scene); a sphere light it could not
-match bit for bit on probes (a Sphere subclass, an edited Sphere or AreaLight) keeps
-the course's own method. tests/engine/test_sphere_lights.py checks the floats against
-the course's. It takes the in-process scalar render of week08_three_balls from 1.15x
-to 1.09x of the CPU time of issue 42's bar
-(docs/performance.md#scalar-backend-against-an-older-commit).
+an AreaLight whose shape is a Sphere (rtpy.engine.prepared_scene); a sphere light it
+could not match bit for bit on probes (a Sphere subclass, an edited Sphere or
+AreaLight) keeps the course's own method. tests/engine/test_sphere_lights.py checks
+the floats against the course's. It and rtpy.engine.sphere_hits make the scalar
+backend's speed (docs/performance.md#scalar-backend-against-an-older-commit).
 """
 
 from __future__ import annotations
 
-import copy
 import math
 
 from ..hit_info import HitInfo
 from ..light import AreaLight, LightSample
 from ..sampling import generator, use_generator
-from ..scene import Scene
 from ..sphere import Sphere
 from ..vec3 import Vec3
 
-__all__ = ["SphereLight", "prepared_scene", "sample_sphere_hit"]
+__all__ = ["SphereLight", "matches", "sample_sphere_hit"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -134,22 +131,3 @@ def matches(light: AreaLight) -> bool:
         if expected is None or got != expected:
             return False
     return True
-
-
-def prepared_scene(scene: Scene) -> Scene:
-    """The scene to render: itself, or a shallow copy whose sphere lights are
-    SphereLights (the same objects, lists and settings otherwise). Only an AreaLight
-    of a Sphere, both exactly those classes, whose numbers match on the probes."""
-    lights = [
-        SphereLight(light)
-        if type(light) is AreaLight and type(light.shape) is Sphere and matches(light)
-        else light
-        for light in scene.lights
-    ]
-    if all(new is old for new, old in zip(lights, scene.lights, strict=True)):
-        return scene
-    if len(scene.objects) >= scene.bvh_min_objects:
-        scene.bvh()  # built on the scene itself, so the next render finds it there too
-    prepared = copy.copy(scene)
-    prepared.lights = lights
-    return prepared

@@ -61,17 +61,15 @@ END = re.compile(r"^[ \t]*# END SOLUTION\s*$")
 # What the student repository holds besides rtpy/ (top-level names of the source tree).
 COPIED = ("pyproject.toml", ".gitignore", "LICENSE", "scenes", "docs")
 TEST_WEEKS_FILE = "assignments/test_weeks.toml"
-# Tests that belong to rtpy's own repository only (and are not mapped): the assignment machinery's,
-# which grade every week, generate repositories and check the task maps against the solution
-# regions and the pages made from them, the checks of rtpy's README (a student repository's
-# README.md is the week's) and of its layout (which counts the numpy backend's modules and tests).
+# Tests of rtpy's own repository only (not mapped): the assignment machinery's (they grade
+# every week, make repositories, check task maps and pages), the README's and the layout's.
 MACHINERY_TESTS = (
     "tests/docs/test_pages.py",
     "tests/test_layout.py",
     "tests/cli/test_assignment.py",
 )  # and tests/grading/*
-# The instructor's modules: assignment authoring and Gradescope packaging. Students get
-# the course, the engine and `rtpy grade`; these stay with the instructor's install.
+# Withheld from a student's repository: the instructor's modules (authoring, packaging), and
+# engine modules holding a week's answer and their tests (the engine does without them).
 INSTRUCTOR_MODULES = (
     "rtpy/grading/assignment.py",
     "rtpy/grading/autograder.py",
@@ -79,6 +77,8 @@ INSTRUCTOR_MODULES = (
     "rtpy/grading/task_pages.py",
     "rtpy/cli/assignment.py",
 )
+ANSWER_MODULES = ("rtpy/engine/sphere_hits.py",)
+ANSWER_TESTS = ("tests/engine/test_sphere_hits.py", "tests/engine/test_prepared_scene.py")
 # A test file that uses the numpy backend (withheld from student repositories).
 NUMPY_USE = re.compile(r"numpy_backend|[\"']numpy[\"']|rtpy\.BACKENDS")
 
@@ -89,8 +89,8 @@ def machinery(rel: str) -> bool:
 
 
 def never_mapped(rel: str) -> bool:
-    """Test files no week ships nor maps: the numpy backend's (withheld) and the machinery's."""
-    return rel.startswith("tests/numpy_backend/") or machinery(rel)
+    """Test files no week ships nor maps: the withheld modules' and the machinery's."""
+    return rel.startswith("tests/numpy_backend/") or rel in ANSWER_TESTS or machinery(rel)
 
 
 NUMPY_STUB = '''"""The numpy backend is withheld from the weekly assignment repositories: its
@@ -333,7 +333,7 @@ def _write_repository(root: Path, week: str, dest: Path) -> None:
 
     for path in sorted((root / "rtpy").rglob("*.py")):
         rel = path.relative_to(root)
-        if rel.parts[1] == "numpy_backend" or rel.as_posix() in INSTRUCTOR_MODULES:
+        if rel.parts[1] == "numpy_backend" or rel.as_posix() in INSTRUCTOR_MODULES + ANSWER_MODULES:
             continue
         target = dest / rel
         target.parent.mkdir(parents=True, exist_ok=True)

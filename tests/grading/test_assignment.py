@@ -35,6 +35,7 @@ import pytest
 
 from rtpy.cli.main import main
 from rtpy.grading.assignment import (
+    ANSWER_MODULES,
     INSTRUCTOR_MODULES,
     NUMPY_USE,
     TEST_WEEKS_FILE,
@@ -300,7 +301,7 @@ def test_a_student_repository_holds_no_authoring_or_packaging(tmp_path):
     them, no `assignment` in `python -m rtpy`, and `rtpy grade 08` grading there."""
     with MAKING:
         repo = make_assignment("08", tmp_path / "week08")
-    for rel in INSTRUCTOR_MODULES:
+    for rel in INSTRUCTOR_MODULES + ANSWER_MODULES:
         assert (ROOT / rel).exists() and not (repo / rel).exists(), rel
 
     def rtpy_there(*args: str) -> subprocess.CompletedProcess:
