@@ -30,6 +30,7 @@ from hypothesis import settings
 
 import rtpy
 
+from . import ahead
 from .tiers import record_fast_tests
 
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
@@ -56,6 +57,11 @@ def pytest_collection_modifyitems(config, items):
 
 def pytest_collection_finish(session):
     freeze_what_lives()
+    ahead.start(session)  # the heavy checks, computed ahead at low priority
+
+
+def pytest_sessionfinish(session):
+    ahead.finish()
 
 
 @pytest.hookimpl(trylast=True)

@@ -32,7 +32,7 @@ from rtpy.testing import (
 )
 from rtpy.vec3 import Color, dot, halfvector
 
-from ..cores import on_every_core
+from ..cores import module_outcomes, outcome
 
 ALBEDO = Color(0.9, 0.6, 0.3)
 ANGLES = (0.0, 45.0, 80.0, 89.9)
@@ -150,10 +150,14 @@ def run_case(case: tuple[str, float]) -> Outcome:
     )
 
 
-@pytest.fixture(scope="module")
-def outcomes() -> dict[tuple[str, float], Outcome]:
-    """All grid points, computed once, on every core."""
-    return dict(zip(CASES, on_every_core(run_case, CASES), strict=True))
+# The grid's tests share each case's one run of run_case, on every core.
+outcomes = module_outcomes(
+    {
+        "test_sampling_follows_pdf": run_case,
+        "test_weight_is_brdf_cos_over_pdf": run_case,
+        "test_albedo_by_sampling_and_quadrature_agree_and_is_bounded": run_case,
+    }
+)
 
 
 def case_id(case: tuple[str, float]) -> str:
@@ -162,22 +166,22 @@ def case_id(case: tuple[str, float]) -> str:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=case_id)
-def test_sampling_follows_pdf(outcomes, case):
-    o = outcomes[case]
+def test_sampling_follows_pdf(outcomes, request, case):
+    o = outcome(outcomes, request)
     assert o.chi2_p >= ALPHA, f"p = {o.chi2_p:.3g} < {ALPHA:.3g}: {o.chi2_summary}"
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=case_id)
-def test_weight_is_brdf_cos_over_pdf(outcomes, case):
-    o = outcomes[case]
+def test_weight_is_brdf_cos_over_pdf(outcomes, request, case):
+    o = outcome(outcomes, request)
     assert o.weights, o.weights_detail
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=case_id)
-def test_albedo_by_sampling_and_quadrature_agree_and_is_bounded(outcomes, case):
-    o = outcomes[case]
+def test_albedo_by_sampling_and_quadrature_agree_and_is_bounded(outcomes, request, case):
+    o = outcome(outcomes, request)
     assert o.energy, o.energy_detail
     assert not o.energy_skipped, o.energy_detail
 
@@ -257,13 +261,13 @@ def planted_chi2(name: str) -> tuple[float, str]:
     return r.p_value, r.summary()
 
 
-@pytest.fixture(scope="module")
-def planted_outcomes() -> dict[str, tuple[float, str]]:
-    return dict(zip(PLANTED, on_every_core(planted_chi2, list(PLANTED)), strict=True))
+planted_outcomes = module_outcomes(
+    {"test_the_grid_test_rejects_planted_sampling_mistakes": planted_chi2}
+)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(PLANTED))
-def test_the_grid_test_rejects_planted_sampling_mistakes(planted_outcomes, name):
-    p, summary = planted_outcomes[name]
+def test_the_grid_test_rejects_planted_sampling_mistakes(planted_outcomes, request, name):
+    p, summary = outcome(planted_outcomes, request)
     assert p < ALPHA, summary

@@ -39,7 +39,7 @@ from rtpy.testing import (
 )
 from rtpy.vec3 import Color, dot
 
-from ..cores import outcome, selected_checks
+from ..cores import module_outcomes, outcome
 from ..tiers import slow_except
 from ..vectors import angle, dot3, unit3
 from .directions import (
@@ -491,11 +491,10 @@ def check_glass(name: str) -> MaterialReport:
     return check_material(glass(name), incident_angles=CHECKED_ANGLES, n_samples=50_000)
 
 
-@pytest.fixture(scope="module")
-def slow_outcomes(request) -> dict[str, object]:
-    """node id -> the outcome of each selected test's heavy part, all of them on every
-    core, the longest (the glasses, then the losses) first."""
-    checks = {
+# node id -> the outcome of each selected test's heavy part, all of them on every core,
+# the longest (the glasses, then the losses) first.
+slow_outcomes = module_outcomes(
+    {
         "test_check_material_passes_the_lecture_glasses": check_glass,
         "test_the_light_lost_is_what_the_facets_block": loss_outcome,
         "test_scattering_draws_the_pdf_and_weighs_by_it": sampling_outcome,
@@ -506,7 +505,7 @@ def slow_outcomes(request) -> dict[str, object]:
             chi2_passes_without_the_dot_m
         ),
     }
-    return selected_checks(request, checks)
+)
 
 
 @pytest.mark.slow

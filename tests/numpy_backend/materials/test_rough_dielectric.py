@@ -18,7 +18,7 @@ from rtpy.numpy_backend.materials.rough_dielectric import (
 )
 from rtpy.testing import chi2_test
 
-from ...cores import outcome, selected_checks
+from ...cores import module_outcomes, outcome
 from ...tiers import slow_except
 from .kernel_checks import CHI2_ALPHA, compare_with_scalar_sampler, head
 
@@ -57,11 +57,10 @@ def sampler_check(glass: int, theta: float, inside: int) -> None:
     assert result.passed(CHI2_ALPHA), result.summary()
 
 
-@pytest.fixture(scope="module")
-def sampler_checks(request) -> dict[str, None]:
-    """The selected cases' sampler_check, on every core."""
-    test = "test_sampler_agrees_with_scalar_and_follows_the_pdf"
-    return selected_checks(request, {test: sampler_check})
+# The selected cases' sampler_check, on every core.
+sampler_checks = module_outcomes(
+    {"test_sampler_agrees_with_scalar_and_follows_the_pdf": sampler_check}
+)
 
 
 @pytest.mark.parametrize("glass, theta, inside", slow_except(CASES, (1, 45.0, 1), (0, 80.0, 0)))
