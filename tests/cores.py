@@ -2,7 +2,8 @@
 
 The checks are pure Python (threads would take turns), so they run in forked
 processes, one per core. Each test still asserts on its own outcome, so a failure is
-reported on the test (and the parameters) it belongs to.
+reported on the test (and the parameters) it belongs to. In a long run the checks of
+module_outcomes are computed ahead, in the background (tests/ahead.py).
 """
 
 from __future__ import annotations
@@ -70,16 +71,25 @@ def selected_checks(request, checks: dict[str, Callable[..., R]]) -> dict[str, R
     calls = [(checks[item.originalname], params_of(item)) for item in items]
     keys = [(check, repr(sorted(params.items()))) for check, params in calls]
     distinct = dict(zip(keys, calls, strict=True))
-    module = request.module.__name__
-    names = {k: ahead.key(module, item.originalname, params_of(item))
-             for item, k in zip(items, keys, strict=True) if module in CHECKS}  # fmt: skip
-    known = ahead.take(list(dict.fromkeys(names.values())))
-    outcomes = {k: known[names[k]] for k in distinct if names.get(k) in known}
+    outcomes = _computed_ahead(request.module.__name__, items, keys)
     missing = [k for k in distinct if k not in outcomes]
     outcomes.update(
         zip(missing, on_every_core(run_check, [distinct[k] for k in missing]), strict=True)
     )
     return {item.nodeid: outcomes[key] for item, key in zip(items, keys, strict=True)}
+
+
+def _computed_ahead(module: str, items: list, keys: list) -> dict:
+    """key -> outcome, of the checks tests/ahead.py has computed (named there by module,
+    function and parameters, across processes)."""
+    registered = CHECKS.get(module, {})
+    names = {
+        k: ahead.key(module, item.originalname, params_of(item))
+        for item, k in zip(items, keys, strict=True)
+        if item.originalname in registered
+    }
+    known = ahead.take(list(dict.fromkeys(names.values())))
+    return {k: known[name] for k, name in names.items() if name in known}
 
 
 def module_outcomes(checks: dict[str, Callable[..., Any]]):
