@@ -878,6 +878,7 @@ def test_a_malformed_cluster_address_is_one_line_and_exit_2(tmp_path, capsys, ad
     assert len(err.splitlines()) == 1 and list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_the_cluster_timeout_option_reaches_the_connection(tmp_path, capsys):
     """In a process of its own: Dask's client leaves a thread running in the process
     that made it (which rtpy.io.forked's tests must not inherit)."""

@@ -201,6 +201,7 @@ def test_a_worker_killed_mid_render_changes_nothing(dask_cluster, small_units, t
     np.testing.assert_array_equal(image.linear, two_workers_here)
 
 
+@pytest.mark.slow
 def test_a_local_cluster_gives_the_image_of_two_local_workers(small_units, two_workers_here):
     """... and leaves this process's environment as it was (Dask's nanny sets its
     workers' variables, MALLOC_TRIM_THRESHOLD_ among them, in the process)."""
@@ -212,6 +213,7 @@ def test_a_local_cluster_gives_the_image_of_two_local_workers(small_units, two_w
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+@pytest.mark.slow
 def test_a_local_cluster_leaves_no_process_when_the_render_returns():
     """Not even multiprocessing's resource tracker, which the cluster's processes
     (started by spawn) start, and which would otherwise end only after this one."""
@@ -312,6 +314,7 @@ def closed_port() -> int:
         return s.getsockname()[1]
 
 
+@pytest.mark.slow
 def test_a_scheduler_that_is_not_there_is_one_error_within_the_timeout():
     address = f"tcp://127.0.0.1:{closed_port()}"
     started = time.monotonic()

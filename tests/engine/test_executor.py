@@ -4,6 +4,7 @@ depend on which or on the order units come back in."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import rtpy
 from rtpy.engine.executor import Executor, InProcess, WorkerError
@@ -24,6 +25,7 @@ class Backwards(Executor):
         yield from reversed(done)
 
 
+@pytest.mark.slow
 def test_any_executor_gives_the_same_image():
     scene, camera = small_scene()
     camera = camera.with_width(100)  # 100 x 56: 2, 2, 3 and 2 units a pass

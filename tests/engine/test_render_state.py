@@ -63,6 +63,7 @@ def test_a_render_stopped_by_ctrl_c_resumes_to_the_uninterrupted_image(tmp_path,
     assert not state.exists()  # finished: the state goes
 
 
+@pytest.mark.slow
 def test_a_render_stopped_by_its_time_limit_resumes_to_the_same_image(tmp_path, monkeypatch):
     """The state holds the whole passes and the units of the pass in progress; the
     resumed render renders the rest (fewer paths than the whole)."""
@@ -96,6 +97,7 @@ def test_a_failure_mid_render_keeps_what_is_finished(tmp_path, stopping):
     np.testing.assert_array_equal(resumed.linear, full.linear)
 
 
+@pytest.mark.slow
 def test_the_state_is_saved_as_the_render_goes(tmp_path, monkeypatch):
     """A crash that writes nothing more (a killed process, a power cut) loses only
     what came after the last save: here one after every unit, each holding more."""

@@ -394,6 +394,7 @@ def test_a_signal_at_a_random_moment(tmp_path, index):
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+@pytest.mark.slow
 def test_sigterm_after_a_pass_writes_it_and_exits_143(tmp_path):
     """SIGTERM once the progress bar shows the first passes done (scalar, 2 workers):
     exit 143, the image of the finished passes. The render is long (seconds) so that

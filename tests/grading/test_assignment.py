@@ -256,6 +256,7 @@ def solve(repo: Path, week: str) -> None:
             (repo / rel).write_text(text)
 
 
+@pytest.mark.slow
 def test_map_tests_of_some_files_records_their_weeks_and_keeps_the_rest(tmp_path):
     """map-tests FILES runs only those files on the instrumented copy: their entries
     are replaced by the weeks they execute, every other entry is kept."""
@@ -296,6 +297,7 @@ print(len(names))
 """
 
 
+@pytest.mark.slow
 def test_a_student_repository_holds_no_authoring_or_packaging(tmp_path):
     """Week 08's repository: none of INSTRUCTOR_MODULES, nothing shipped that names
     them, no `assignment` in `python -m rtpy`, and `rtpy grade 08` grading there."""

@@ -7,6 +7,8 @@ from __future__ import annotations
 import textwrap
 import time
 
+import pytest
+
 from rtpy.grading.judge import Judge, judge, probe_registry
 from rtpy.grading.sandbox import InProcess
 
@@ -85,6 +87,7 @@ def test_outcomes_are_worded_by_the_judge(tmp_path):
     assert out["test_slow[1]"].name == "slow[1]"
 
 
+@pytest.mark.slow
 def test_a_test_under_way_ends_with_the_total_time(tmp_path):
     """The whole run's time bounds the test under way too: its probe gets what is left
     of it, and the tests after it are marked not run."""

@@ -149,6 +149,7 @@ def test_a_flood_of_output_is_bounded_and_memory_is_limited(child):
         child.call("hog", {}, 30)
 
 
+@pytest.mark.slow
 def test_a_child_that_stops_reading_cannot_block_the_judge(child):
     """After its answer the child shrinks its request pipe and stops reading: the next,
     larger request is not written by its deadline, and the child is stopped."""
@@ -162,6 +163,7 @@ def test_a_child_that_stops_reading_cannot_block_the_judge(child):
     assert child.call("double", {"x": 4}, 30) == 8.0  # a new child
 
 
+@pytest.mark.slow
 def test_no_call_outlives_the_childs_deadline(child):
     child.deadline = time.monotonic() + 2.0
     start = time.monotonic()
@@ -199,6 +201,7 @@ print(json.dumps([outcome, time.monotonic() - start, grown]))
     "size, refused",
     [(200 * 2**20, "bytes announced"), (8 * 2**20, "more than the 10,001 values asked for")],
 )
+@pytest.mark.slow
 def test_a_reply_far_larger_than_asked_is_refused_cheaply(child, size, refused):
     """A reply of [{},{},...] (200 MiB, beyond any answer; 8 MiB, within the frame
     limit) to a request for one number: refused before it is parsed, fast, the judge's

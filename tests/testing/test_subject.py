@@ -126,6 +126,7 @@ def test_each_check_asks_the_subject_few_times():
     assert set(glass.tags[-2 * len(GRAZING_ANGLES) :]) == {NON_NEGATIVE}
 
 
+@pytest.mark.slow
 def test_check_material_through_a_subject_asks_tens_of_times():
     glass = Counting(DiffuseTransmitter())
     report = check_material(glass, incident_angles=(0.0, 60.0), n_samples=20_000)

@@ -160,6 +160,7 @@ def same_image(a: np.ndarray, b: np.ndarray) -> BlockTest:
     return block_z_test(a.mean(axis=0), var_a, b.mean(axis=0), var_b, alpha=1e-3)
 
 
+@pytest.mark.slow
 def test_fixed_roulette_converges_to_the_image_without_roulette_and_throughputs():
     """Fixed p_RR = 0.6 from segment 2 on, throughput roulette and no roulette at all
     (the same depth cap) estimate one image: the block means agree (z-test on blocks,
