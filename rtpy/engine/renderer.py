@@ -123,6 +123,7 @@ class Renderer:
         try:
             self._loop(run, work, bar)
         except BaseException:
+            bar.leave = False  # cleared: the failure says its own line (a stub's, a worker's)
             signals.finish_from_here()
             try:
                 run.keep()  # a failure (a worker lost, a bug): what is finished, for --resume

@@ -3,6 +3,7 @@ naming the task, the method and its file, and the integrators that render now.""
 
 from __future__ import annotations
 
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -12,7 +13,7 @@ from rtpy.engine import renderer
 from rtpy.engine.unfinished import find_unfinished, stub_message, working_integrators
 from rtpy.grading.assignment import Region
 
-from ..commands import run_cli
+from ..commands import rtpy_command, run_cli
 
 STUB = Region(Path("rtpy/materials/phong.py"), 0, 1, "08", "the lobe", "Phong.BRDF", "    ")
 
@@ -147,3 +148,18 @@ def test_the_command_line_says_one_line_exits_2_and_writes_nothing(tmp_path, wor
         "(or jittered, center)"
     ]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["half.py", "half.toml"]
+
+
+def test_without_q_the_progress_bar_is_cleared_before_the_line(tmp_path):
+    """What a terminal shows (each line from its last carriage return): the one line."""
+    (tmp_path / "half.py").write_text(PLUGIN)
+    (tmp_path / "half.toml").write_text(SCENE)
+    command = rtpy_command("render", "half.toml", "--plugin", "half.py", "-j", "1")
+    run = subprocess.run(command, capture_output=True, cwd=tmp_path, timeout=120)  # bytes: \r kept
+    assert run.returncode == 2, run.stderr
+    shown = [line.rsplit("\r", 1)[-1] for line in run.stderr.decode().split("\n")]
+    assert [line for line in shown if line.strip()] == [
+        "rtpy: error: task 8.1 is not written yet: HalfWritten.BRDF in rtpy/materials/phong.py "
+        "raised NotImplementedError; this scene renders now with --integrator shading "
+        "(or jittered, center)"
+    ]
