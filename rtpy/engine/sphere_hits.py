@@ -93,15 +93,19 @@ def fast_copy(sphere: Sphere) -> FastSphere:
 
 
 # Probe rays (origin, direction, t_min, t_max) against a sphere of radius 0.7 at
-# (0.2, -0.1, -1.5): from outside, from inside, past it, grazing, behind the origin,
-# cut short by t_max, from a spawned origin on the surface, and unnormalised.
+# (0.2, -0.1, -1.5): from outside, from inside, past it, grazing, just past it (where
+# only the test without cancellation tells), behind the origin, ended by t_max after
+# the hit and before it, from a spawned origin on the surface, and unnormalised. They
+# end hit_t at each of its returns but the degenerate q == 0 (test_sphere_hits.py).
 PROBES = [
     ((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 1e-9, math.inf),
     ((0.1, 0.2, -1.4), (0.3, -0.5, 0.8), 0.0, math.inf),
     ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), 0.0, math.inf),
     ((0.9, 5.0, -1.5), (0.0, -1.0, 0.0), 0.0, math.inf),
+    ((0.9000000000001, 5.0, -1.5), (0.0, -1.0, 0.0), 0.0, math.inf),
     ((0.0, 0.0, -4.0), (0.0, 0.0, -1.0), 0.0, math.inf),
     ((0.0, 0.0, 0.0), (0.1, -0.05, -1.0), 0.0, 1.0),
+    ((0.0, 0.0, 0.0), (0.1, -0.05, -1.0), 0.0, 0.5),
     ((0.2, -0.1, -0.8000000007), (0.0, 0.6, 0.8), 0.0, math.inf),
     ((-3.0, 2.0, 1.0), (6.4, -4.2, -5.0), 0.001, 0.9),
 ]

@@ -3,12 +3,15 @@ Sphere.hit_t numbers bit for bit, and says where it does (hits_match)."""
 
 from __future__ import annotations
 
+import inspect
 import math
+import sys
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rtpy.engine.sphere_hits import (
+    PROBE_SPHERE,
     PROBES,
     FastSphere,
     fast_copy,
@@ -67,10 +70,32 @@ def test_rays_aimed_at_the_sphere_hit_it_as_the_course_does():
     assert hits > 500
 
 
-def test_the_probes_hit_miss_and_cut_short():
-    """The probes try each way hit_t can end, so an edit of one shows."""
+def test_the_probes_reach_every_return_of_hit_t():
+    """The probes end the sphere test at each of its returns (all but q == 0, which
+    needs a ray through the center with a zero discriminant), so an edit of any
+    branch of the course's hit_t shows on them."""
     assert hits_match()
-    assert len(PROBES) >= 6
+    lines, first = inspect.getsourcelines(sphere_hit_t)
+    returns = {first + i for i, line in enumerate(lines) if line.strip().startswith("return")}
+    degenerate = {first + i + 1 for i, line in enumerate(lines) if "if q == 0.0:" in line}
+    reached = set()
+
+    def tracer(frame, event, arg):
+        if frame.f_code is not sphere_hit_t.__code__:
+            return None
+        if event == "return":
+            reached.add(frame.f_lineno)
+        return tracer
+
+    (cx, cy, cz), radius = PROBE_SPHERE
+    sphere = Sphere(Vec3(cx, cy, cz), radius, GREY)
+    sys.settrace(tracer)
+    try:
+        for origin, direction, t_min, t_max in PROBES:
+            sphere_hit_t(sphere, Ray(Vec3(*origin), Vec3(*direction)), t_min, t_max)
+    finally:
+        sys.settrace(None)
+    assert len(degenerate) == 1 and sorted(returns - degenerate - reached) == []
 
 
 def test_an_edited_hit_info_is_noticed(monkeypatch):
